@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Installs everything speculum needs from Debian 12's packages. Safe to run again.
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends \
+  g++ cmake ninja-build pkg-config \
+  libglm-dev libopenimageio-dev openimageio-tools \
+  libtinygltf-dev nlohmann-json3-dev libstb-dev \
+  libopenmesh-dev libtbb-dev \
+  libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev \
+  assimp-testmodels graphviz

@@ -1,0 +1,19 @@
+// The speculum command line: global options and the subcommand registration hooks.
+// Each subcommand lives in its own apps/cmd_*.cpp and is added by main.cpp.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace speculum::cli {
+
+struct GlobalOptions {
+  int threads = 0;  // 0: all cores
+  int lanes = 0;    // 0: the widest the build's ISA supports
+  bool quiet = false;
+};
+
+// Each add_* adds one subcommand (with its own --help) to `app`.
+void add_scenes_command(CLI::App& app, GlobalOptions& global);
+void add_info_command(CLI::App& app, GlobalOptions& global);
+
+}  // namespace speculum::cli

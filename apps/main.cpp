@@ -1,0 +1,44 @@
+// speculum: render, inspect, profile and compare GPU reflection techniques on the CPU.
+#include <cstdio>
+#include <exception>
+
+#include "apps/cli.h"
+#include "core/error.h"
+
+int main(int argc, char** argv) {
+  using namespace speculum;
+  CLI::App app{
+      "speculum — a deterministic CPU renderer for specular and glossy reflections,\n"
+      "refractions and caustics: each GPU technique is a pass in a job graph.\n"
+      "Example: speculum render sphere-in-room -o out.png",
+      "speculum"};
+  app.set_version_flag("--version", "speculum 0.1.0");
+  app.require_subcommand(1);
+  cli::GlobalOptions global;
+  app.add_option("--threads", global.threads, "Worker threads (0: all cores; 1: synchronous)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  app.add_option("--lanes", global.lanes, "SIMD lane width 1, 4, 8 or 16 (0: widest built)")
+      ->check(CLI::IsMember({0, 1, 4, 8, 16}))
+      ->capture_default_str();
+  app.add_flag("--quiet,-q", global.quiet, "No progress output on stderr");
+
+  cli::add_scenes_command(app, global);
+  cli::add_info_command(app, global);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "speculum: %s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "speculum: out of memory (input too large?)\n");
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "speculum: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

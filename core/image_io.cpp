@@ -1,0 +1,144 @@
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/error.h"
+#include "core/image.h"
+
+namespace speculum {
+
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+float linear_to_srgb(float c) {
+  return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+namespace {
+
+constexpr long long kMaxPixels = 1ll << 28;  // 16384^2: anything larger is refused
+
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext;
+}
+
+}  // namespace
+
+ImageRGBA read_image(const std::string& path, bool to_linear) {
+  if (!std::filesystem::exists(path)) throw InputError(path, "no such file");
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    std::string msg = OIIO::geterror();
+    if (msg.empty()) msg = "not a readable image";
+    auto nl = msg.find('\n');
+    throw InputError(path, "cannot read image: " + msg.substr(0, nl));
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 ||
+      static_cast<long long>(spec.width) * spec.height > kMaxPixels)
+    throw InputError(path, "absurd image size " + std::to_string(spec.width) + "x" +
+                               std::to_string(spec.height));
+  const int nc = spec.nchannels;
+  std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * nc);
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data())) {
+    std::string msg = in->geterror();
+    throw InputError(path, "truncated or corrupt image: " + msg.substr(0, msg.find('\n')));
+  }
+  const bool is_float = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
+                        spec.format.basetype == OIIO::TypeDesc::HALF ||
+                        spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+  const bool decode = to_linear && !is_float;
+  ImageRGBA img(spec.width, spec.height, glm::vec4(0, 0, 0, 1));
+  for (std::size_t i = 0; i < img.size(); ++i) {
+    const float* p = &data[i * nc];
+    glm::vec4 c(0, 0, 0, 1);
+    if (nc == 1 || nc == 2) {
+      c = glm::vec4(p[0], p[0], p[0], nc == 2 ? p[1] : 1.0f);
+    } else {
+      c = glm::vec4(p[0], p[1], p[2], nc >= 4 ? p[3] : 1.0f);
+    }
+    if (decode) {
+      c.x = srgb_to_linear(c.x);
+      c.y = srgb_to_linear(c.y);
+      c.z = srgb_to_linear(c.z);
+    }
+    img.pixels[i] = c;
+  }
+  return img;
+}
+
+namespace {
+
+void write_float_channels(const std::string& path, int w, int h, int nc,
+                          const std::vector<float>& linear) {
+  const std::string ext = extension_of(path);
+  const bool is_exr = ext == ".exr";
+  const bool is_png = ext == ".png";
+  if (!is_exr && !is_png) throw InputError(path, "unsupported output format (use .png or .exr)");
+  if (w <= 0 || h <= 0) throw InputError(path, "refusing to write an empty image");
+
+  const std::filesystem::path final_path(path);
+  const std::filesystem::path tmp_path =
+      final_path.parent_path() / (final_path.filename().string() + ".tmp" + ext);
+  auto out = OIIO::ImageOutput::create(tmp_path.string());
+  if (!out) throw InputError(path, "no image writer for this format");
+
+  bool ok = false;
+  if (is_exr) {
+    OIIO::ImageSpec spec(w, h, nc, OIIO::TypeDesc::FLOAT);
+    spec.attribute("compression", "zip");
+    ok = out->open(tmp_path.string(), spec) &&
+         out->write_image(OIIO::TypeDesc::FLOAT, linear.data());
+  } else {
+    std::vector<unsigned char> bytes(linear.size());
+    for (std::size_t i = 0; i < linear.size(); ++i) {
+      const bool alpha = nc == 4 && (i % 4) == 3;
+      float v = linear[i];
+      if (!(v >= 0.0f)) v = 0.0f;  // also maps NaN to 0
+      v = std::min(v, 1.0f);
+      if (!alpha) v = linear_to_srgb(v);
+      bytes[i] = static_cast<unsigned char>(std::lround(v * 255.0f));
+    }
+    OIIO::ImageSpec spec(w, h, nc, OIIO::TypeDesc::UINT8);
+    ok = out->open(tmp_path.string(), spec) &&
+         out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+  }
+  ok = out->close() && ok;
+  if (!ok) {
+    std::string msg = out->geterror();
+    std::error_code ec;
+    std::filesystem::remove(tmp_path, ec);
+    throw InputError(path, "cannot write image: " + msg.substr(0, msg.find('\n')));
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp_path, final_path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp_path, ec);
+    throw InputError(path, "cannot write image: " + ec.message());
+  }
+}
+
+}  // namespace
+
+void write_image(const std::string& path, const ImageRGBA& image) {
+  std::vector<float> data(image.size() * 4);
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    data[i * 4 + 0] = image.pixels[i].x;
+    data[i * 4 + 1] = image.pixels[i].y;
+    data[i * 4 + 2] = image.pixels[i].z;
+    data[i * 4 + 3] = image.pixels[i].w;
+  }
+  write_float_channels(path, image.width, image.height, 4, data);
+}
+
+void write_image(const std::string& path, const ImageF& image) {
+  write_float_channels(path, image.width, image.height, 1, image.pixels);
+}
+
+}  // namespace speculum

@@ -1,0 +1,107 @@
+#include "core/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "core/error.h"
+
+namespace speculum {
+
+const char* to_string(MaterialKind kind) {
+  switch (kind) {
+    case MaterialKind::Diffuse: return "diffuse";
+    case MaterialKind::Glossy: return "glossy";
+    case MaterialKind::Mirror: return "mirror";
+    case MaterialKind::Refractor: return "refractor";
+  }
+  return "?";
+}
+
+const char* to_string(LightType type) {
+  switch (type) {
+    case LightType::Point: return "point";
+    case LightType::Spot: return "spot";
+    case LightType::Directional: return "directional";
+  }
+  return "?";
+}
+
+MaterialKind Material::kind() const {
+  if (transmission > 0.5f) return MaterialKind::Refractor;
+  if (roughness <= kMirrorRoughness && metallic >= 0.5f) return MaterialKind::Mirror;
+  if (roughness < kGlossyRoughness && metallic >= 0.5f) return MaterialKind::Glossy;
+  return MaterialKind::Diffuse;
+}
+
+float Material::phong_exponent() const {
+  const float alpha = std::max(roughness * roughness, 1e-3f);
+  return std::clamp(2.0f / (alpha * alpha) - 2.0f, 0.0f, 1e6f);
+}
+
+void Bounds::grow(const glm::vec3& p) {
+  lo = glm::min(lo, p);
+  hi = glm::max(hi, p);
+}
+
+Bounds Scene::bounds() const {
+  Bounds b;
+  for (const auto& p : mesh.positions) b.grow(p);
+  return b;
+}
+
+void Scene::validate() const {
+  const auto& m = mesh;
+  const std::size_t nv = m.positions.size();
+  const std::size_t nt = m.triangle_count();
+  if (m.indices.size() % 3 != 0) throw InputError(name, "index count is not a multiple of 3");
+  if (m.normals.size() != nv) throw InputError(name, "normal count differs from vertex count");
+  if (m.uvs.size() != nv) throw InputError(name, "uv count differs from vertex count");
+  if (!m.tangents.empty() && m.tangents.size() != nv)
+    throw InputError(name, "tangent count differs from vertex count");
+  if (m.triangle_material.size() != nt || m.triangle_object.size() != nt)
+    throw InputError(name, "per-triangle id streams have the wrong length");
+  if (materials.empty()) throw InputError(name, "no materials");
+  for (std::size_t i = 0; i < nv; ++i) {
+    const glm::vec3& p = m.positions[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw InputError(name, "vertex " + std::to_string(i) + " has a NaN or infinite position");
+    const glm::vec3& n = m.normals[i];
+    if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
+      throw InputError(name, "vertex " + std::to_string(i) + " has a NaN or infinite normal");
+  }
+  for (std::size_t i = 0; i < m.indices.size(); ++i)
+    if (m.indices[i] >= nv)
+      throw InputError(name, "triangle " + std::to_string(i / 3) + " indexes vertex " +
+                                 std::to_string(m.indices[i]) + " of " + std::to_string(nv));
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (m.triangle_material[t] >= materials.size())
+      throw InputError(name, "triangle " + std::to_string(t) + " has material id out of range");
+    if (m.triangle_object[t] >= objects.size())
+      throw InputError(name, "triangle " + std::to_string(t) + " has object id out of range");
+  }
+  for (const auto& mat : materials) {
+    for (const TextureRef* t : {&mat.base_color_texture, &mat.metallic_roughness_texture,
+                                &mat.normal_texture, &mat.emissive_texture,
+                                &mat.transmission_texture})
+      if (t->texture >= static_cast<int>(textures.size()))
+        throw InputError(name, "material '" + mat.name + "' names a missing texture");
+  }
+}
+
+Camera framing_camera(const Bounds& bounds) {
+  Camera cam;
+  if (!bounds.valid()) return cam;
+  const glm::vec3 c = bounds.center();
+  const float radius = std::max(0.5f * glm::length(bounds.extent()), 1e-3f);
+  const float dist = radius / std::tan(glm::radians(cam.vfov_degrees) * 0.5f) * 1.1f;
+  cam.target = c;
+  cam.eye = c + glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)) * dist;
+  cam.znear = std::max(dist - radius * 1.5f, dist * 1e-3f);
+  cam.zfar = dist + radius * 2.0f;
+  return cam;
+}
+
+}  // namespace speculum

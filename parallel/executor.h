@@ -1,0 +1,97 @@
+// The executor: named, timed data-parallel launches on oneTBB over fixed-size chunks.
+// Chunk boundaries never depend on the thread count, so any kernel whose chunks write
+// disjoint outputs is deterministic for every thread count (DESIGN.md "Determinism").
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+namespace speculum::par {
+
+// One named kernel launch, as the profiler and `inspect` show it.
+struct LaunchRecord {
+  std::string name;
+  std::size_t elements = 0;
+  std::size_t chunks = 0;
+  std::int64_t start_ns = 0;  // since the executor's epoch
+  std::int64_t duration_ns = 0;
+};
+
+class Executor {
+ public:
+  // threads == 0: all hardware threads; threads == 1: synchronous, in chunk order, on the
+  // calling thread (the debugging mode).
+  explicit Executor(int threads = 0);
+
+  int threads() const { return threads_; }
+  bool synchronous() const { return threads_ == 1; }
+
+  // Calls body(begin, end) for each chunk [c*chunk, min(n, (c+1)*chunk)).
+  template <class Body>
+  void parallel_for(std::string_view name, std::size_t n, std::size_t chunk, Body&& body) {
+    if (chunk == 0) chunk = 1;
+    const std::size_t chunks = (n + chunk - 1) / chunk;
+    const auto t0 = now_ns();
+    auto run_chunk = [&](std::size_t c) {
+      const std::size_t begin = c * chunk;
+      const std::size_t end = begin + chunk < n ? begin + chunk : n;
+      body(begin, end);
+    };
+    if (synchronous() || chunks <= 1) {
+      for (std::size_t c = 0; c < chunks; ++c) run_chunk(c);
+    } else {
+      arena_->execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, chunks, 1),
+            [&](const tbb::blocked_range<std::size_t>& r) {
+              for (std::size_t c = r.begin(); c != r.end(); ++c) run_chunk(c);
+            },
+            tbb::simple_partitioner());
+      });
+    }
+    record(name, n, chunks, t0, now_ns() - t0);
+  }
+
+  // Runs f inside this executor's arena (so nested TBB work obeys the thread limit).
+  template <class F>
+  void run(F&& f) {
+    if (synchronous()) f();
+    else arena_->execute(std::forward<F>(f));
+  }
+
+  // Launch records since the last clear; recording is on by default and cheap.
+  std::vector<LaunchRecord> launches() const;
+  void clear_launches();
+  void set_recording(bool on) { recording_ = on; }
+
+  std::int64_t now_ns() const {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now() - epoch_)
+        .count();
+  }
+
+ private:
+  void record(std::string_view name, std::size_t n, std::size_t chunks, std::int64_t start,
+              std::int64_t duration);
+
+  int threads_;
+  std::unique_ptr<tbb::task_arena> arena_;
+  std::chrono::steady_clock::time_point epoch_;
+  bool recording_ = true;
+  mutable std::mutex records_mutex_;
+  std::vector<LaunchRecord> records_;
+};
+
+}  // namespace speculum::par

@@ -1,0 +1,68 @@
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/image.h"
+
+namespace speculum {
+namespace {
+
+std::filesystem::path temp_dir() {
+  auto dir = std::filesystem::temp_directory_path() / "speculum_image_test";
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+TEST(ImageIo, ExrRoundTripIsExact) {
+  ImageRGBA img(7, 5);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      img.at(x, y) = glm::vec4(x * 0.37f, y * 1.5f + 100.0f, -0.25f * x, 1.0f / (1 + x + y));
+  const std::string path = (temp_dir() / "round.exr").string();
+  write_image(path, img);
+  ImageRGBA back = read_image(path);
+  ASSERT_EQ(back.width, 7);
+  ASSERT_EQ(back.height, 5);
+  for (std::size_t i = 0; i < img.size(); ++i) EXPECT_EQ(back.pixels[i], img.pixels[i]) << i;
+}
+
+TEST(ImageIo, PngEncodesSrgbAndDecodesBack) {
+  ImageRGBA img(4, 1);
+  img.pixels = {glm::vec4(0, 0, 0, 1), glm::vec4(0.5f, 0.5f, 0.5f, 1),
+                glm::vec4(1, 1, 1, 1), glm::vec4(2, -1, 0.2140f, 1)};
+  const std::string path = (temp_dir() / "srgb.png").string();
+  write_image(path, img);
+  ImageRGBA back = read_image(path);
+  ASSERT_EQ(back.width, 4);
+  EXPECT_NEAR(back.pixels[1].x, 0.5f, 0.005f);  // 8-bit sRGB quantization
+  EXPECT_EQ(back.pixels[3].x, 1.0f);            // clamped
+  EXPECT_EQ(back.pixels[3].y, 0.0f);
+  EXPECT_NEAR(back.pixels[3].z, 0.2140f, 0.003f);
+}
+
+TEST(ImageIo, SrgbTransferFunctionsInvertEachOther) {
+  for (int i = 0; i <= 1000; ++i) {
+    float c = i / 1000.0f;
+    EXPECT_NEAR(srgb_to_linear(linear_to_srgb(c)), c, 1e-5f);
+  }
+}
+
+TEST(ImageIo, MissingFileNamesTheFile) {
+  try {
+    read_image("/nonexistent/dir/nothing.exr");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/nothing.exr"), std::string::npos);
+  }
+}
+
+TEST(ImageIo, UnsupportedOutputFormatIsRejectedWithoutWriting) {
+  ImageRGBA img(2, 2);
+  const auto path = temp_dir() / "out.bmpx";
+  EXPECT_THROW(write_image(path.string(), img), InputError);
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+}  // namespace
+}  // namespace speculum
