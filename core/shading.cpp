@@ -1,0 +1,166 @@
+// The shared shading model (see core/shading.h for the model in full).
+#include "core/shading.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "core/optics.h"
+#include "core/sampling.h"
+
+namespace speculum {
+
+SurfaceParams surface_params(const Material& m) {
+  SurfaceParams s;
+  s.base_color = glm::vec3(m.base_color);
+  s.metallic = std::clamp(m.metallic, 0.0f, 1.0f);
+  s.roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+  s.transmission = std::clamp(m.transmission, 0.0f, 1.0f);
+  s.ior = m.ior;
+  s.emissive = m.emissive;
+  s.phong_exponent = m.phong_exponent();
+  return s;
+}
+
+glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
+  if (image.empty()) return glm::vec4(1.0f);
+  const float fx = uv.x * static_cast<float>(image.width) - 0.5f;
+  const float fy = uv.y * static_cast<float>(image.height) - 0.5f;
+  if (!std::isfinite(fx) || !std::isfinite(fy)) return image.pixels[0];
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  const float ax = fx - x0f, ay = fy - y0f;
+  auto wrap = [](long long i, int n) { long long r = i % n; return static_cast<int>(r < 0 ? r + n : r); };
+  const long long x0 = static_cast<long long>(x0f), y0 = static_cast<long long>(y0f);
+  const int xa = wrap(x0, image.width), xb = wrap(x0 + 1, image.width);
+  const int ya = wrap(y0, image.height), yb = wrap(y0 + 1, image.height);
+  const glm::vec4 top = image.at(xa, ya) * (1.0f - ax) + image.at(xb, ya) * ax;
+  const glm::vec4 bottom = image.at(xa, yb) * (1.0f - ax) + image.at(xb, yb) * ax;
+  return top * (1.0f - ay) + bottom * ay;
+}
+
+namespace {
+const ImageRGBA* texture_of(const Scene& scene, const TextureRef& ref) {
+  if (!ref.valid() || static_cast<std::size_t>(ref.texture) >= scene.textures.size()) return nullptr;
+  return &scene.textures[static_cast<std::size_t>(ref.texture)];
+}
+glm::vec4 lookup(const Scene& scene, const TextureRef& ref, glm::vec2 uv, glm::vec2 uv1) {
+  const ImageRGBA* tex = texture_of(scene, ref);
+  if (!tex) return glm::vec4(1.0f);
+  const glm::vec2 base = ref.texcoord == 1 ? uv1 : uv;
+  const glm::vec3 t = ref.uv_transform * glm::vec3(base, 1.0f);
+  return sample_bilinear_repeat(*tex, glm::vec2(t));
+}
+}  // namespace
+
+SurfaceParams surface_params(const Scene& scene, std::uint32_t material_index, glm::vec2 uv,
+                             glm::vec2 uv1) {
+  if (material_index >= scene.materials.size()) return SurfaceParams{};
+  const Material& m = scene.materials[material_index];
+  SurfaceParams s = surface_params(m);
+  if (m.base_color_texture.valid())
+    s.base_color *= glm::vec3(lookup(scene, m.base_color_texture, uv, uv1));
+  if (m.metallic_roughness_texture.valid()) {
+    const glm::vec4 mr = lookup(scene, m.metallic_roughness_texture, uv, uv1);
+    s.metallic = std::clamp(s.metallic * mr.z, 0.0f, 1.0f);
+    s.roughness = std::clamp(s.roughness * mr.y, 0.0f, 1.0f);
+    Material tmp;
+    tmp.roughness = s.roughness;
+    s.phong_exponent = tmp.phong_exponent();
+  }
+  if (m.emissive_texture.valid()) s.emissive *= glm::vec3(lookup(scene, m.emissive_texture, uv, uv1));
+  if (m.transmission_texture.valid())
+    s.transmission = std::clamp(s.transmission * lookup(scene, m.transmission_texture, uv, uv1).x, 0.0f, 1.0f);
+  return s;
+}
+
+LightSample sample_light(const Light& light, const glm::vec3& position) {
+  LightSample out;
+  if (light.type == LightType::Directional) {
+    out.direction = -glm::normalize(light.direction);
+    out.distance = std::numeric_limits<float>::infinity();
+    out.irradiance = light.color * light.intensity;
+    return out;
+  }
+  const glm::vec3 to_light = light.position - position;
+  const float d2 = glm::dot(to_light, to_light);
+  if (!(d2 > 0.0f)) return out;  // at the light itself: no defined direction
+  const float d = std::sqrt(d2);
+  out.direction = to_light / d;
+  out.distance = d;
+  float window = 1.0f;
+  if (light.range > 0.0f) {
+    const float r = d / light.range;
+    const float r2 = r * r;
+    window = std::clamp(1.0f - r2 * r2, 0.0f, 1.0f);
+  }
+  float cone = 1.0f;
+  if (light.type == LightType::Spot) {
+    // glTF KHR_lights_punctual reference falloff: linear in cos between the cones, squared.
+    const float cos_outer = std::cos(light.outer_cone);
+    const float cos_inner = std::cos(light.inner_cone);
+    const float scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
+    const float cd = glm::dot(glm::normalize(light.direction), -out.direction);
+    const float a = std::clamp((cd - cos_outer) * scale, 0.0f, 1.0f);
+    cone = a * a;
+  }
+  out.irradiance = light.color * (light.intensity * window * cone / d2);
+  return out;
+}
+
+glm::vec3 specular_f0(const SurfaceParams& s) {
+  const float dielectric = fresnel_f0(s.ior);
+  return glm::vec3(dielectric) * (1.0f - s.metallic) + s.base_color * s.metallic;
+}
+
+glm::vec3 specular_fresnel(const SurfaceParams& s, float cos_nv) {
+  return fresnel_schlick(cos_nv, specular_f0(s));
+}
+
+glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv) {
+  const glm::vec3 f = specular_fresnel(s, cos_nv);
+  return (glm::vec3(1.0f) - f) * s.base_color * ((1.0f - s.metallic) * (1.0f - s.transmission) / kPi);
+}
+
+glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
+                      const LightSample& light) {
+  const float cos_nl = glm::dot(n, light.direction);
+  if (cos_nl <= 0.0f) return glm::vec3(0.0f);
+  const float cos_nv = std::max(glm::dot(n, v), 0.0f);
+  glm::vec3 out = diffuse_albedo_over_pi(s, cos_nv) * light.irradiance * cos_nl;
+  if (!s.is_mirror_lobe()) {
+    const glm::vec3 r = reflect(-v, n);
+    const float cos_rl = glm::dot(r, light.direction);
+    out += specular_fresnel(s, cos_nv) * (phong_lobe_pdf(cos_rl, s.phong_exponent) * light.irradiance);
+  }
+  if (s.is_refractor()) out *= (1.0f - s.transmission);
+  return out;
+}
+
+glm::vec2 equirect_uv(const glm::vec3& d) {
+  const float u = 0.5f + std::atan2(d.x, -d.z) / (2.0f * kPi);
+  const float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) / kPi;
+  return {u, v};
+}
+
+glm::vec3 equirect_direction(glm::vec2 uv) {
+  const float phi = (uv.x - 0.5f) * 2.0f * kPi;
+  const float theta = uv.y * kPi;
+  const float st = std::sin(theta);
+  return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
+}
+
+glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d) {
+  if (!env.has_image()) return env.constant * env.intensity;
+  const glm::vec2 uv = equirect_uv(glm::normalize(d));
+  // Repeat in u is the longitude wrap; v is clamped to the row centres by construction of
+  // acos range, and the one-texel wrap at the poles is a negligible blend.
+  const ImageRGBA& img = env.equirect;
+  const float fy = std::clamp(uv.y * img.height - 0.5f, 0.0f, static_cast<float>(img.height - 1));
+  const glm::vec2 clamped{uv.x, (fy + 0.5f) / static_cast<float>(img.height)};
+  return glm::vec3(sample_bilinear_repeat(img, clamped)) * env.intensity;
+}
+
+}  // namespace speculum
