@@ -1,12 +1,27 @@
 #include "parallel/executor.h"
 
-#include <thread>
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/task_arena.h>
 
 namespace speculum::par {
 
+namespace {
+int resolve_threads(int threads) {
+  if (threads < 0)
+    throw std::invalid_argument("thread count must be >= 0 (0: all cores), got " +
+                                std::to_string(threads));
+  if (threads > 0) return threads;
+  // The arena's default concurrency respects the process affinity mask and cgroup limits,
+  // which hardware_concurrency() does not.
+  return std::max(1, tbb::this_task_arena::max_concurrency());
+}
+}  // namespace
+
 Executor::Executor(int threads)
-    : threads_(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency())),
-      epoch_(std::chrono::steady_clock::now()) {
+    : threads_(resolve_threads(threads)), epoch_(std::chrono::steady_clock::now()) {
   if (threads_ > 1) arena_ = std::make_unique<tbb::task_arena>(threads_);
 }
 
@@ -24,7 +39,7 @@ void Executor::record(std::string_view name, std::size_t n, std::size_t chunks,
                       std::int64_t start, std::int64_t duration) {
   if (!recording_) return;
   std::lock_guard lock(records_mutex_);
-  records_.push_back({std::string(name), n, chunks, start, duration});
+  records_.push_back({std::string(name), n, chunks, start, duration, LaunchScope::current()});
 }
 
 }  // namespace speculum::par

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -27,13 +28,41 @@ struct LaunchRecord {
   std::size_t chunks = 0;
   std::int64_t start_ns = 0;  // since the executor's epoch
   std::int64_t duration_ns = 0;
+  std::string scope;  // the graph node that issued it ("" outside a graph)
+};
+
+// Names the graph node running on this thread, so launches can be attributed to it in
+// traces. Set by the graph around each node's execute(); nested scopes restore the outer.
+class LaunchScope {
+ public:
+  explicit LaunchScope(std::string name) : previous_(std::move(current())) {
+    current() = std::move(name);
+  }
+  ~LaunchScope() { current() = std::move(previous_); }
+  LaunchScope(const LaunchScope&) = delete;
+  LaunchScope& operator=(const LaunchScope&) = delete;
+  static std::string& current() {
+    thread_local std::string name;
+    return name;
+  }
+
+ private:
+  std::string previous_;
 };
 
 class Executor {
  public:
   // threads == 0: all hardware threads; threads == 1: synchronous, in chunk order, on the
-  // calling thread (the debugging mode).
+  // calling thread (the debugging mode). threads < 0 throws std::invalid_argument. More
+  // threads than cores is allowed (the arena asks for them; TBB may grant fewer), and
+  // results never depend on it.
   explicit Executor(int threads = 0);
+
+  // Number of chunks parallel_for(n, chunk) uses; chunk 0 is treated as 1.
+  static std::size_t chunk_count(std::size_t n, std::size_t chunk) {
+    if (chunk == 0) chunk = 1;
+    return (n + chunk - 1) / chunk;
+  }
 
   int threads() const { return threads_; }
   bool synchronous() const { return threads_ == 1; }
@@ -42,7 +71,7 @@ class Executor {
   template <class Body>
   void parallel_for(std::string_view name, std::size_t n, std::size_t chunk, Body&& body) {
     if (chunk == 0) chunk = 1;
-    const std::size_t chunks = (n + chunk - 1) / chunk;
+    const std::size_t chunks = chunk_count(n, chunk);
     const auto t0 = now_ns();
     auto run_chunk = [&](std::size_t c) {
       const std::size_t begin = c * chunk;
@@ -64,11 +93,27 @@ class Executor {
     record(name, n, chunks, t0, now_ns() - t0);
   }
 
+  // Deterministic reduction: partial = chunk_fn(begin, end) per fixed chunk (in parallel),
+  // then result = combine(...combine(combine(identity, p0), p1)..., pk) serially in chunk
+  // order. The result is therefore the same for every thread count even for floats.
+  template <class T, class ChunkFn, class Combine>
+  T parallel_reduce(std::string_view name, std::size_t n, std::size_t chunk, T identity,
+                    ChunkFn&& chunk_fn, Combine&& combine) {
+    if (chunk == 0) chunk = 1;
+    std::vector<T> partial(chunk_count(n, chunk), identity);
+    parallel_for(name, n, chunk, [&](std::size_t begin, std::size_t end) {
+      partial[begin / chunk] = chunk_fn(begin, end);
+    });
+    T result = std::move(identity);
+    for (auto& p : partial) result = combine(std::move(result), std::move(p));
+    return result;
+  }
+
   // Runs f inside this executor's arena (so nested TBB work obeys the thread limit).
   template <class F>
-  void run(F&& f) {
-    if (synchronous()) f();
-    else arena_->execute(std::forward<F>(f));
+  decltype(auto) run(F&& f) {
+    if (synchronous()) return std::forward<F>(f)();
+    return arena_->execute(std::forward<F>(f));
   }
 
   // Launch records since the last clear; recording is on by default and cheap.

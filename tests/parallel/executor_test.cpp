@@ -1,0 +1,95 @@
+// Executor: fixed chunking, chunk-order reduction, named launch records, thread settings.
+#include "parallel/executor.h"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+namespace speculum::par {
+namespace {
+
+TEST(Executor, ChunksCoverRangeExactlyOnce) {
+  for (int threads : {1, 2, 8}) {
+    Executor ex(threads);
+    for (std::size_t n : {0u, 1u, 999u, 1000u, 1001u, 12345u}) {
+      std::vector<int> hits(n, 0);
+      ex.parallel_for("cover", n, 1000, [&](std::size_t b, std::size_t e) {
+        ASSERT_EQ(b % 1000, 0u);
+        ASSERT_LE(e - b, 1000u);
+        for (std::size_t i = b; i < e; ++i) ++hits[i];
+      });
+      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(hits[i], 1) << i;
+    }
+  }
+}
+
+TEST(Executor, ReduceIsChunkOrderedAndThreadIndependent) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> d(-1e6f, 1e6f);
+  std::vector<float> x(100003);
+  for (auto& v : x) v = d(rng);
+  auto sum_with = [&](int threads) {
+    Executor ex(threads);
+    return ex.parallel_reduce(
+        "sum", x.size(), 4096, 0.f,
+        [&](std::size_t b, std::size_t e) {
+          float s = 0.f;
+          for (std::size_t i = b; i < e; ++i) s += x[i];
+          return s;
+        },
+        [](float a, float b) { return a + b; });
+  };
+  // Serial oracle with the same association: chunk sums folded in chunk order.
+  float oracle = 0.f;
+  for (std::size_t b = 0; b < x.size(); b += 4096) {
+    float s = 0.f;
+    for (std::size_t i = b; i < std::min(x.size(), b + 4096); ++i) s += x[i];
+    oracle += s;
+  }
+  for (int t : {1, 2, 8}) EXPECT_EQ(std::bit_cast<std::uint32_t>(sum_with(t)), std::bit_cast<std::uint32_t>(oracle)) << t;
+  Executor ex(2);
+  EXPECT_EQ(ex.parallel_reduce("empty", 0, 16, 5, [](auto, auto) { return 1; }, std::plus<>()), 5);
+}
+
+TEST(Executor, RecordsNamedLaunchesWithScope) {
+  Executor ex(2);
+  ex.clear_launches();
+  ex.parallel_for("alpha", 10, 3, [](auto, auto) {});
+  {
+    LaunchScope scope("node-x");
+    ex.parallel_for("beta", 100, 7, [](auto, auto) {});
+  }
+  const auto l = ex.launches();
+  ASSERT_EQ(l.size(), 2u);
+  EXPECT_EQ(l[0].name, "alpha");
+  EXPECT_EQ(l[0].chunks, 4u);
+  EXPECT_EQ(l[0].elements, 10u);
+  EXPECT_EQ(l[0].scope, "");
+  EXPECT_EQ(l[1].name, "beta");
+  EXPECT_EQ(l[1].chunks, 15u);
+  EXPECT_EQ(l[1].scope, "node-x");
+  EXPECT_GE(l[1].start_ns, l[0].start_ns);
+  EXPECT_EQ(LaunchScope::current(), "");
+}
+
+TEST(Executor, ThreadSettings) {
+  EXPECT_GE(Executor(0).threads(), 1);
+  EXPECT_TRUE(Executor(1).synchronous());
+  EXPECT_EQ(Executor(3).threads(), 3);
+  EXPECT_THROW(Executor(-1), std::invalid_argument);
+  // Synchronous mode runs chunks in order on the calling thread.
+  Executor ex(1);
+  std::vector<std::size_t> seen;
+  ex.parallel_for("order", 50, 8, [&](std::size_t b, std::size_t) { seen.push_back(b); });
+  EXPECT_EQ(seen, (std::vector<std::size_t>{0, 8, 16, 24, 32, 40, 48}));
+  EXPECT_EQ(ex.run([] { return 42; }), 42);
+  EXPECT_EQ(Executor(2).run([] { return 7; }), 7);
+}
+
+}  // namespace
+}  // namespace speculum::par
