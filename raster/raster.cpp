@@ -1,2 +1,0 @@
-// Placeholder translation unit so the raster library exists before its first node lands.
-namespace speculum::raster {}

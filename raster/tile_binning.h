@@ -1,0 +1,38 @@
+// Binning of set-up triangles into 64×64 screen tiles. Each chunk of input triangles bins
+// its own output (a counting sort by tile), so a tile's list is the concatenation of the
+// chunks' lists in chunk order = submission order, for any thread count (issue 4).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "raster/triangle_setup.h"
+
+namespace speculum::raster {
+
+constexpr int kTileSize = 64;
+constexpr int kTileShift = 6;
+
+struct TileGrid {
+  int tiles_x = 0;
+  int tiles_y = 0;
+  int count() const { return tiles_x * tiles_y; }
+};
+
+inline TileGrid make_tile_grid(int width, int height) {
+  return {(width + kTileSize - 1) / kTileSize, (height + kTileSize - 1) / kTileSize};
+}
+
+// The set-up triangles of one chunk of input triangles and their per-tile lists:
+// tile t's triangles are triangles[tile_list[tile_offsets[t] .. tile_offsets[t+1])].
+struct BinnedChunk {
+  std::vector<SetupTriangle> triangles;
+  std::vector<ClipMap> clip_maps;
+  std::vector<std::uint32_t> tile_offsets;  // grid.count() + 1
+  std::vector<std::uint32_t> tile_list;
+};
+
+// Fills chunk.tile_offsets / tile_list from chunk.triangles (which keep their order).
+void bin_chunk(BinnedChunk& chunk, const TileGrid& grid);
+
+}  // namespace speculum::raster

@@ -1,0 +1,209 @@
+// Per-tile rasterization: see tile_rasterizer.h. Coverage and depth are computed from
+// exact 64-bit edge values, so the result of a sample never depends on how the pixels were
+// grouped (block size, lane width) or which thread ran the tile.
+#include "raster/tile_rasterizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "parallel/lanes.h"
+
+namespace speculum::raster {
+namespace {
+
+constexpr int kBlock = 8;  // coverage block side: blocks whose corners all fail are skipped
+constexpr int kTilePixels = kTileSize * kTileSize;
+
+// The winner so far of every sample of one tile (the early depth test's state).
+struct TileScratch {
+  float inv_w[kTilePixels];
+  std::uint32_t triangle[kTilePixels];
+  const SetupTriangle* setup[kTilePixels];
+  const ClipMap* clip_map[kTilePixels];
+  std::uint32_t coverage[kTilePixels];
+  bool count_coverage;
+};
+
+// E_i(p) = A_i p.x + B_i p.y + C_i for the edge opposite vertex i, positive inside;
+// a sample on the edge (E_i == 0) is covered only for top or left edges (threshold 0).
+struct Edges {
+  std::int64_t a[3], b[3], c[3];
+  std::int64_t threshold[3];
+  float inv_area;
+  float inv_w[3];
+};
+
+Edges make_edges(const SetupTriangle& t) {
+  Edges e;
+  for (int i = 0; i < 3; ++i) {
+    const int p = (i + 1) % 3, q = (i + 2) % 3;
+    e.a[i] = std::int64_t(t.y[p]) - t.y[q];
+    e.b[i] = std::int64_t(t.x[q]) - t.x[p];
+    e.c[i] = std::int64_t(t.x[p]) * t.y[q] - std::int64_t(t.y[p]) * t.x[q];
+    // Gradient (a, b) points inside: a left edge has the inside to its right (a > 0), a top
+    // edge is horizontal with the inside below it (y down: b > 0).
+    const bool top_left = e.a[i] > 0 || (e.a[i] == 0 && e.b[i] > 0);
+    e.threshold[i] = top_left ? 0 : 1;
+    e.inv_w[i] = t.inv_w[i];
+  }
+  const std::int64_t area = e.a[0] * t.x[0] + e.b[0] * t.y[0] + e.c[0];
+  e.inv_area = 1.0f / static_cast<float>(area);
+  return e;
+}
+
+inline std::int64_t centre(int pixel) {
+  return std::int64_t(pixel) * kSubpixelOne + kSubpixelOne / 2;
+}
+inline std::int64_t edge_at(const Edges& e, int i, int px, int py) {
+  return e.a[i] * centre(px) + e.b[i] * centre(py) + e.c[i];
+}
+
+// Perspective weights p_i = λ_i / w_i; their sum is the interpolated 1/w (the depth key).
+// Written once and used by both the depth test and the resolve so both see equal bits.
+struct Weights {
+  float p0, p1, p2, inv_w;
+};
+inline Weights weights(const Edges& e, std::int64_t e0, std::int64_t e1, std::int64_t e2) {
+  const float p0 = static_cast<float>(e0) * e.inv_area * e.inv_w[0];
+  const float p1 = static_cast<float>(e1) * e.inv_area * e.inv_w[1];
+  const float p2 = static_cast<float>(e2) * e.inv_area * e.inv_w[2];
+  return {p0, p1, p2, (p0 + p1) + p2};
+}
+
+// Coverage + early depth test over the pixel rectangle [x0,x1]×[y0,y1] (inclusive,
+// absolute pixels inside the tile at (ox, oy)), W pixels of a row at a time.
+template <int W>
+void raster_rect(const Edges& e, const SetupTriangle& t, const ClipMap* map, int x0, int y0,
+                 int x1, int y1, int ox, int oy, TileScratch& s) {
+  const std::int64_t step0 = e.a[0] * kSubpixelOne, step1 = e.a[1] * kSubpixelOne,
+                     step2 = e.a[2] * kSubpixelOne;
+  for (int y = y0; y <= y1; ++y) {
+    std::int64_t r0 = edge_at(e, 0, x0, y), r1 = edge_at(e, 1, x0, y), r2 = edge_at(e, 2, x0, y);
+    for (int x = x0; x <= x1; x += W) {
+      std::int64_t v0[W], v1[W], v2[W];
+      bool covered[W];
+      bool any = false;
+      for (int l = 0; l < W; ++l) {
+        v0[l] = r0 + step0 * l;
+        v1[l] = r1 + step1 * l;
+        v2[l] = r2 + step2 * l;
+        covered[l] = (x + l <= x1) & (v0[l] >= e.threshold[0]) & (v1[l] >= e.threshold[1]) &
+                     (v2[l] >= e.threshold[2]);
+        any |= covered[l];
+      }
+      r0 += step0 * W, r1 += step1 * W, r2 += step2 * W;
+      if (!any) continue;
+      for (int l = 0; l < W; ++l) {
+        if (!covered[l]) continue;
+        const float inv_w = weights(e, v0[l], v1[l], v2[l]).inv_w;
+        const int idx = (y - oy) * kTileSize + (x + l - ox);
+        if (s.count_coverage) ++s.coverage[idx];
+        // Nearer = larger 1/w; equal depth: the lower triangle index wins, so the result
+        // does not depend on submission order.
+        if (inv_w > s.inv_w[idx] || (inv_w == s.inv_w[idx] && t.triangle < s.triangle[idx])) {
+          s.inv_w[idx] = inv_w;
+          s.triangle[idx] = t.triangle;
+          s.setup[idx] = &t;
+          s.clip_map[idx] = map;
+        }
+      }
+    }
+  }
+}
+
+// Hierarchical coverage: small triangles go straight to pixels; larger ones are walked in
+// 8×8 blocks and a block is skipped when one edge is negative at all four corner samples
+// (E is linear, so its maximum over the block is at a corner).
+template <int W>
+void raster_triangle(const SetupTriangle& t, const ClipMap* map, int tx0, int ty0, int tx1,
+                     int ty1, TileScratch& s) {
+  const int x0 = std::max(t.px0, tx0), x1 = std::min(t.px1, tx1);
+  const int y0 = std::max(t.py0, ty0), y1 = std::min(t.py1, ty1);
+  if (x0 > x1 || y0 > y1) return;
+  const Edges e = make_edges(t);
+  if (x1 - x0 < kBlock && y1 - y0 < kBlock) {
+    raster_rect<W>(e, t, map, x0, y0, x1, y1, tx0, ty0, s);
+    return;
+  }
+  for (int by = y0; by <= y1; by += kBlock) {
+    const int by1 = std::min(by + kBlock - 1, y1);
+    for (int bx = x0; bx <= x1; bx += kBlock) {
+      const int bx1 = std::min(bx + kBlock - 1, x1);
+      bool rejected = false;
+      for (int i = 0; i < 3 && !rejected; ++i) {
+        const std::int64_t m =
+            std::max({edge_at(e, i, bx, by), edge_at(e, i, bx1, by), edge_at(e, i, bx, by1),
+                      edge_at(e, i, bx1, by1)});
+        rejected = m < e.threshold[i];
+      }
+      if (!rejected) raster_rect<W>(e, t, map, bx, by, bx1, by1, tx0, ty0, s);
+    }
+  }
+}
+
+template <int W>
+void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
+                      const std::vector<BinnedChunk>& chunks,
+                      const std::vector<std::uint32_t>& triangle_object, VisibilityBuffer& out) {
+  thread_local TileScratch scratch;  // fully re-initialized below: no state crosses tiles
+  TileScratch& s = scratch;
+  const int tx0 = (tile % grid.tiles_x) * kTileSize, ty0 = (tile / grid.tiles_x) * kTileSize;
+  const int tx1 = std::min(tx0 + kTileSize, vp.width) - 1;
+  const int ty1 = std::min(ty0 + kTileSize, vp.height) - 1;
+  std::fill(std::begin(s.inv_w), std::end(s.inv_w), 0.0f);
+  std::fill(std::begin(s.triangle), std::end(s.triangle), kNoId);
+  std::fill(std::begin(s.setup), std::end(s.setup), nullptr);
+  s.count_coverage = !out.coverage.empty();
+  if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
+
+  for (const BinnedChunk& chunk : chunks) {
+    const std::uint32_t begin = chunk.tile_offsets[tile], end = chunk.tile_offsets[tile + 1];
+    for (std::uint32_t k = begin; k < end; ++k) {
+      const SetupTriangle& t = chunk.triangles[chunk.tile_list[k]];
+      const ClipMap* map = t.clip_map >= 0 ? &chunk.clip_maps[t.clip_map] : nullptr;
+      raster_triangle<W>(t, map, tx0, ty0, tx1, ty1, s);
+    }
+  }
+
+  // Resolve: barycentrics only for the winners (deferred, like a visibility buffer).
+  for (int y = ty0; y <= ty1; ++y) {
+    for (int x = tx0; x <= tx1; ++x) {
+      const int idx = (y - ty0) * kTileSize + (x - tx0);
+      const SetupTriangle* t = s.setup[idx];
+      const std::size_t o = static_cast<std::size_t>(y) * vp.width + x;
+      if (s.count_coverage) out.coverage.pixels[o] = s.coverage[idx];
+      if (!t) {
+        out.triangle.pixels[o] = kNoId;
+        out.object.pixels[o] = kNoId;
+        out.depth.pixels[o] = std::numeric_limits<float>::infinity();
+        out.bary.pixels[o] = glm::vec2(0.0f);
+        continue;
+      }
+      const Edges e = make_edges(*t);
+      const Weights w = weights(e, edge_at(e, 0, x, y), edge_at(e, 1, x, y), edge_at(e, 2, x, y));
+      float b0 = w.p0 / w.inv_w, b1 = w.p1 / w.inv_w, b2 = w.p2 / w.inv_w;
+      if (t->swapped) std::swap(b1, b2);
+      if (const ClipMap* m = s.clip_map[idx]) {
+        const glm::vec3 b = b0 * m->bary[0] + b1 * m->bary[1] + b2 * m->bary[2];
+        b1 = b.y, b2 = b.z;
+      }
+      out.triangle.pixels[o] = t->triangle;
+      out.object.pixels[o] = triangle_object[t->triangle];
+      out.depth.pixels[o] = 1.0f / w.inv_w;
+      out.bary.pixels[o] = glm::vec2(b1, b2);
+    }
+  }
+}
+
+}  // namespace
+
+void rasterize_tile(int tile, int lanes, const TileGrid& grid, const Viewport& viewport,
+                    const std::vector<BinnedChunk>& chunks,
+                    const std::vector<std::uint32_t>& triangle_object, VisibilityBuffer& out) {
+  par::dispatch_lanes(lanes, [&](auto w) {
+    rasterize_tile_w<decltype(w)::value>(tile, grid, viewport, chunks, triangle_object, out);
+  });
+}
+
+}  // namespace speculum::raster
