@@ -1,0 +1,494 @@
+// glTF 2.0 → Scene (see gltf_loader.h). The container is checked before tinygltf sees it,
+// every reference and accessor is checked before it is followed (glTF 2.0 §3, §5).
+#include "core/gltf_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <utility>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "core/error.h"
+#include "core/gltf_accessors.h"
+#include "core/gltf_material.h"
+#include "core/mesh_normals.h"
+
+namespace speculum {
+namespace {
+
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{2} << 30;  // tinygltf takes 32-bit sizes
+constexpr std::size_t kMaxTriangles = std::size_t{1} << 27;         // 134M: absurd beyond
+
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  if (s.size() > 300) s = s.substr(0, 300) + "...";
+  return s;
+}
+
+std::vector<unsigned char> read_file_bytes(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path, "cannot read file size: " + ec.message());
+  if (size == 0) throw InputError(path, "file is empty");
+  if (size >= kMaxFileBytes) throw InputError(path, "file is too large (over 2 GiB)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open file");
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+  if (!in) throw InputError(path, "could not read the whole file");
+  return bytes;
+}
+
+std::uint32_t le32(const unsigned char* p) {
+  return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 |
+         std::uint32_t(p[3]) << 24;
+}
+
+// The GLB header and chunk table (glTF 2.0 §4.4), checked so a truncated or lying
+// container is rejected here rather than read out of bounds.
+void check_glb_container(const std::string& path, const std::vector<unsigned char>& b) {
+  if (b.size() < 20) throw InputError(path, "truncated .glb: shorter than its 20-byte header");
+  if (le32(&b[0]) != 0x46546C67u) throw InputError(path, "not a .glb file (bad magic)");
+  if (le32(&b[4]) != 2) throw InputError(path, "unsupported .glb version " + std::to_string(le32(&b[4])));
+  const std::uint64_t total = le32(&b[8]);
+  if (total > b.size())
+    throw InputError(path, "truncated .glb: header says " + std::to_string(total) +
+                               " bytes, file has " + std::to_string(b.size()));
+  const std::uint64_t json_len = le32(&b[12]);
+  if (le32(&b[16]) != 0x4E4F534Au) throw InputError(path, "first .glb chunk is not JSON");
+  if (20 + json_len > total) throw InputError(path, "truncated .glb: JSON chunk runs past the end");
+  std::uint64_t at = 20 + ((json_len + 3) & ~std::uint64_t{3});
+  if (at + 8 <= total) {
+    const std::uint64_t bin_len = le32(&b[at]);
+    if (at + 8 + bin_len > total)
+      throw InputError(path, "truncated .glb: BIN chunk runs past the end");
+  }
+}
+
+struct Loader {
+  const std::string& path;
+  const tinygltf::Model& model;
+  Scene& scene;
+  LoadReport* report;
+  gltf::MaterialTable materials;
+  std::vector<std::pair<int, glm::mat4>> camera_nodes;  // (camera index, world)
+  std::vector<std::pair<int, glm::mat4>> light_nodes;   // (light index, world)
+  std::size_t skipped_ortho = 0;
+
+  void warn(const std::string& message) {
+    if (report) report->warn(message);
+  }
+
+  glm::mat4 local_transform(const tinygltf::Node& node, std::size_t index) const {
+    auto finite_all = [](const std::vector<double>& v) {
+      return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+    };
+    const std::string what = "node " + std::to_string(index);
+    if (!finite_all(node.matrix) || !finite_all(node.translation) ||
+        !finite_all(node.rotation) || !finite_all(node.scale))
+      throw InputError(path, what + " has a NaN or infinite transform");
+    if (!node.matrix.empty()) {
+      if (node.matrix.size() != 16) throw InputError(path, what + " matrix must have 16 numbers");
+      glm::mat4 m;
+      for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = static_cast<float>(node.matrix[i]);
+      return m;  // glTF stores column-major, as glm does
+    }
+    glm::mat4 m(1.0f);
+    if (!node.translation.empty()) {
+      if (node.translation.size() != 3) throw InputError(path, what + " translation needs 3 numbers");
+      m[3] = glm::vec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+    }
+    if (!node.rotation.empty()) {
+      if (node.rotation.size() != 4) throw InputError(path, what + " rotation needs 4 numbers");
+      glm::quat q(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                  static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]));
+      const float len = glm::length(q);
+      if (!(len > 1e-12f)) throw InputError(path, what + " has a zero rotation quaternion");
+      m = m * glm::mat4_cast(q / len);
+    }
+    if (!node.scale.empty()) {
+      if (node.scale.size() != 3) throw InputError(path, what + " scale needs 3 numbers");
+      m = m * glm::mat4(glm::vec4(node.scale[0], 0, 0, 0), glm::vec4(0, node.scale[1], 0, 0),
+                        glm::vec4(0, 0, node.scale[2], 0), glm::vec4(0, 0, 0, 1));
+    }
+    return m;
+  }
+
+  // Converts one primitive instance; returns false when it was skipped.
+  void add_primitive(std::size_t mesh_index, std::size_t prim_index, const glm::mat4& world,
+                     const std::string& node_name) {
+    const tinygltf::Mesh& gmesh = model.meshes[mesh_index];
+    const tinygltf::Primitive& prim = gmesh.primitives[prim_index];
+    const std::string what = "mesh " + std::to_string(mesh_index) +
+                             (gmesh.name.empty() ? "" : " '" + gmesh.name + "'") +
+                             " primitive " + std::to_string(prim_index);
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      if (mode < 0 || mode > 6) throw InputError(path, what + " has invalid mode " + std::to_string(mode));
+      if (report) ++report->skipped_primitives;
+      warn(what + ": points/lines primitive skipped");
+      return;
+    }
+    auto attr = [&](const char* name) {
+      auto it = prim.attributes.find(name);
+      return it == prim.attributes.end() ? -1 : it->second;
+    };
+    const int pos_acc = attr("POSITION");
+    if (pos_acc < 0) throw InputError(path, what + " has no POSITION attribute");
+    const auto pos_view = gltf::checked_accessor(model, pos_acc, path, what + " POSITION",
+                                                 {TINYGLTF_TYPE_VEC3},
+                                                 {TINYGLTF_COMPONENT_TYPE_FLOAT});
+    const std::size_t nv = pos_view.count;
+    const std::vector<float> pos = gltf::read_floats(pos_view);
+    for (std::size_t i = 0; i < pos.size(); ++i)
+      if (!std::isfinite(pos[i]))
+        throw InputError(path, what + " vertex " + std::to_string(i / 3) +
+                                   " has a NaN or infinite position");
+
+    // Indices, then strips and fans unrolled into triangle lists (glTF §3.7.2.1).
+    std::vector<std::uint32_t> idx;
+    if (prim.indices >= 0) {
+      const auto iv = gltf::checked_accessor(
+          model, prim.indices, path, what + " indices", {TINYGLTF_TYPE_SCALAR},
+          {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+           TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+      idx = gltf::read_indices(iv);
+      for (std::size_t i = 0; i < idx.size(); ++i)
+        if (idx[i] >= nv)
+          throw InputError(path, what + " index " + std::to_string(i) + " = " +
+                                     std::to_string(idx[i]) + " is out of range (" +
+                                     std::to_string(nv) + " vertices)");
+    } else {
+      idx.resize(nv);
+      for (std::size_t i = 0; i < nv; ++i) idx[i] = static_cast<std::uint32_t>(i);
+    }
+    std::vector<std::uint32_t> tris;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (idx.size() % 3 != 0)
+        warn(what + ": index count not a multiple of 3, trailing indices ignored");
+      tris.assign(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(idx.size() / 3 * 3));
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      for (std::size_t i = 2; i < idx.size(); ++i) {
+        // Odd triangles swap two vertices to keep the winding consistent.
+        if (i % 2 == 0) tris.insert(tris.end(), {idx[i - 2], idx[i - 1], idx[i]});
+        else tris.insert(tris.end(), {idx[i - 1], idx[i - 2], idx[i]});
+      }
+    } else {
+      for (std::size_t i = 2; i < idx.size(); ++i) tris.insert(tris.end(), {idx[0], idx[i - 1], idx[i]});
+    }
+    if (tris.empty()) {
+      warn(what + ": no triangles");
+      return;
+    }
+    if (scene.mesh.triangle_count() + tris.size() / 3 > kMaxTriangles)
+      throw InputError(path, "more than " + std::to_string(kMaxTriangles) + " triangles");
+
+    // Local positions first; attributes are transformed to world space below.
+    std::vector<glm::vec3> p(nv);
+    for (std::size_t i = 0; i < nv; ++i) p[i] = {pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
+
+    std::vector<glm::vec3> n;
+    if (int a = attr("NORMAL"); a >= 0) {
+      const auto v = gltf::checked_accessor(model, a, path, what + " NORMAL", {TINYGLTF_TYPE_VEC3},
+                                            {TINYGLTF_COMPONENT_TYPE_FLOAT});
+      if (v.count != nv) throw InputError(path, what + " NORMAL count differs from POSITION count");
+      const auto f = gltf::read_floats(v);
+      n.resize(nv);
+      std::size_t bad = 0;
+      for (std::size_t i = 0; i < nv; ++i) {
+        n[i] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
+        const float len = glm::length(n[i]);
+        if (!std::isfinite(len) || len < 1e-6f) ++bad;
+      }
+      if (bad) {
+        warn(what + ": " + std::to_string(bad) + " zero or non-finite normals, recomputed");
+        n.clear();
+      }
+    }
+    if (n.empty()) n = area_weighted_normals(p, tris);
+
+    auto read_uv = [&](const char* name) {
+      std::vector<glm::vec2> uv;
+      const int a = attr(name);
+      if (a < 0) return uv;
+      const auto v = gltf::checked_accessor(
+          model, a, path, what + " " + name, {TINYGLTF_TYPE_VEC2},
+          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+      if (v.count != nv) throw InputError(path, what + " " + name + " count differs from POSITION count");
+      const auto f = gltf::read_floats(v);
+      uv.resize(nv);
+      for (std::size_t i = 0; i < nv; ++i) {
+        uv[i] = {f[2 * i], f[2 * i + 1]};
+        if (!std::isfinite(uv[i].x) || !std::isfinite(uv[i].y))
+          throw InputError(path, what + " " + name + " has a NaN or infinite value");
+      }
+      return uv;
+    };
+    std::vector<glm::vec2> uv0 = read_uv("TEXCOORD_0");
+    std::vector<glm::vec2> uv1 = read_uv("TEXCOORD_1");
+
+    const std::uint32_t material = materials.scene_material(prim.material);
+    std::vector<glm::vec4> t;
+    if (int a = attr("TANGENT"); a >= 0) {
+      const auto v = gltf::checked_accessor(model, a, path, what + " TANGENT", {TINYGLTF_TYPE_VEC4},
+                                            {TINYGLTF_COMPONENT_TYPE_FLOAT});
+      if (v.count != nv) throw InputError(path, what + " TANGENT count differs from POSITION count");
+      const auto f = gltf::read_floats(v);
+      t.resize(nv);
+      for (std::size_t i = 0; i < nv; ++i) {
+        t[i] = {f[4 * i], f[4 * i + 1], f[4 * i + 2], f[4 * i + 3] < 0.0f ? -1.0f : 1.0f};
+        if (!std::isfinite(glm::length(glm::vec3(t[i])))) throw InputError(path, what + " TANGENT has a NaN or infinite value");
+      }
+    } else if (scene.materials[material].normal_texture.valid()) {
+      const int set = scene.materials[material].normal_texture.texcoord;
+      const auto& uv = set == 1 && !uv1.empty() ? uv1 : uv0;
+      if (!uv.empty()) t = uv_tangents(p, n, uv, tris);
+    }
+
+    // World transform: positions by M, normals by the inverse transpose, tangents by M.
+    const glm::mat3 m3(world);
+    const float det = glm::determinant(m3);
+    if (!std::isfinite(det) || std::fabs(det) < 1e-30f)
+      throw InputError(path, what + " is instanced with a singular transform");
+    const glm::mat3 nm = glm::transpose(glm::inverse(m3));
+    auto& mesh = scene.mesh;
+    const std::uint32_t base = static_cast<std::uint32_t>(mesh.positions.size());
+    if (mesh.positions.size() + nv > std::size_t{0xfffffff0u})
+      throw InputError(path, "too many vertices for 32-bit indices");
+    // Scenes may lack tangents or TEXCOORD_1 for earlier objects: keep streams aligned.
+    if (!t.empty() && mesh.tangents.size() < base)
+      mesh.tangents.resize(base, glm::vec4(1, 0, 0, 1));
+    if (!uv1.empty() && mesh.uvs1.size() < base) mesh.uvs1.resize(base, glm::vec2(0.0f));
+    for (std::size_t i = 0; i < nv; ++i) {
+      mesh.positions.push_back(glm::vec3(world * glm::vec4(p[i], 1.0f)));
+      glm::vec3 wn = nm * n[i];
+      const float len = glm::length(wn);
+      wn = (len > 0.0f && std::isfinite(len)) ? wn / len : glm::vec3(0, 0, 1);
+      mesh.normals.push_back(wn);
+      mesh.uvs.push_back(uv0.empty() ? glm::vec2(0.0f) : uv0[i]);
+      if (!uv1.empty()) mesh.uvs1.push_back(uv1[i]);
+      if (!t.empty()) {
+        glm::vec3 wt = m3 * glm::vec3(t[i]);
+        wt -= wn * glm::dot(wn, wt);
+        const float tl = glm::length(wt);
+        wt = (tl > 1e-12f && std::isfinite(tl)) ? wt / tl : any_perpendicular(wn);
+        // A mirroring transform flips the bitangent's handedness.
+        mesh.tangents.push_back(glm::vec4(wt, det < 0.0f ? -t[i].w : t[i].w));
+      }
+    }
+    if (!mesh.tangents.empty()) mesh.tangents.resize(mesh.positions.size(), glm::vec4(1, 0, 0, 1));
+    if (!mesh.uvs1.empty()) mesh.uvs1.resize(mesh.positions.size(), glm::vec2(0.0f));
+
+    const std::uint32_t object = static_cast<std::uint32_t>(scene.objects.size());
+    Object obj;
+    obj.name = node_name.empty() ? (gmesh.name.empty() ? what : gmesh.name) : node_name;
+    if (gmesh.primitives.size() > 1) obj.name += "#" + std::to_string(prim_index);
+    obj.first_triangle = static_cast<std::uint32_t>(mesh.triangle_count());
+    obj.triangle_count = static_cast<std::uint32_t>(tris.size() / 3);
+    obj.material = material;
+    scene.objects.push_back(obj);
+    for (std::size_t i = 0; i < tris.size(); i += 3) {
+      // A mirroring transform (det < 0) reverses the winding: swap to keep it CCW.
+      if (det < 0.0f) mesh.indices.insert(mesh.indices.end(), {base + tris[i], base + tris[i + 2], base + tris[i + 1]});
+      else mesh.indices.insert(mesh.indices.end(), {base + tris[i], base + tris[i + 1], base + tris[i + 2]});
+      mesh.triangle_material.push_back(material);
+      mesh.triangle_object.push_back(object);
+    }
+  }
+
+  // Depth-first flattening with an explicit stack; a node met again on the current
+  // path is a cycle, a node met twice overall has two parents — both invalid glTF.
+  void flatten(const std::vector<int>& roots) {
+    const std::size_t nn = model.nodes.size();
+    std::vector<std::uint8_t> state(nn, 0);  // 0 unseen, 1 on path, 2 done
+    struct Frame { std::size_t node; glm::mat4 world; std::size_t next_child; };
+    for (int root : roots) {
+      if (root < 0 || static_cast<std::size_t>(root) >= nn)
+        throw InputError(path, "scene names node " + std::to_string(root) + " which does not exist");
+      if (state[static_cast<std::size_t>(root)] != 0)
+        throw InputError(path, "node " + std::to_string(root) + " is listed as a root twice or also has a parent");
+      std::vector<Frame> stack;
+      auto enter = [&](std::size_t n, const glm::mat4& parent) {
+        state[n] = 1;
+        const glm::mat4 world = parent * local_transform(model.nodes[n], n);
+        visit(n, world);
+        stack.push_back({n, world, 0});
+      };
+      enter(static_cast<std::size_t>(root), glm::mat4(1.0f));
+      while (!stack.empty()) {
+        Frame& f = stack.back();
+        const auto& children = model.nodes[f.node].children;
+        if (f.next_child == children.size()) {
+          state[f.node] = 2;
+          stack.pop_back();
+          continue;
+        }
+        const int c = children[f.next_child++];
+        if (c < 0 || static_cast<std::size_t>(c) >= nn)
+          throw InputError(path, "node " + std::to_string(f.node) + " has child " +
+                                     std::to_string(c) + " which does not exist");
+        const std::size_t child = static_cast<std::size_t>(c);
+        if (state[child] == 1)
+          throw InputError(path, "node graph has a cycle: node " + std::to_string(f.node) +
+                                     " has ancestor node " + std::to_string(child) + " as a child");
+        if (state[child] == 2)
+          throw InputError(path, "node " + std::to_string(child) + " has more than one parent");
+        const glm::mat4 world = f.world;  // copy: enter() may reallocate the stack
+        enter(child, world);
+      }
+    }
+  }
+
+  void visit(std::size_t n, const glm::mat4& world) {
+    const tinygltf::Node& node = model.nodes[n];
+    if (node.mesh >= 0) {
+      if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
+        throw InputError(path, "node " + std::to_string(n) + " names mesh " +
+                                   std::to_string(node.mesh) + " which does not exist");
+      const auto& gm = model.meshes[static_cast<std::size_t>(node.mesh)];
+      for (std::size_t p = 0; p < gm.primitives.size(); ++p)
+        add_primitive(static_cast<std::size_t>(node.mesh), p, world, node.name);
+    }
+    if (node.camera >= 0) {
+      if (static_cast<std::size_t>(node.camera) >= model.cameras.size())
+        throw InputError(path, "node " + std::to_string(n) + " names camera " +
+                                   std::to_string(node.camera) + " which does not exist");
+      camera_nodes.emplace_back(node.camera, world);
+    }
+    if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
+      const tinygltf::Value& v = it->second;
+      if (!v.IsObject() || !v.Has("light") || !v.Get("light").IsNumber())
+        throw InputError(path, "node " + std::to_string(n) + " has a malformed KHR_lights_punctual");
+      const int light = v.Get("light").GetNumberAsInt();
+      if (light < 0 || static_cast<std::size_t>(light) >= model.lights.size())
+        throw InputError(path, "node " + std::to_string(n) + " names light " +
+                                   std::to_string(light) + " which does not exist");
+      light_nodes.emplace_back(light, world);
+    }
+  }
+
+  void add_cameras() {
+    for (const auto& [index, world] : camera_nodes) {
+      const tinygltf::Camera& gc = model.cameras[static_cast<std::size_t>(index)];
+      if (gc.type != "perspective") {
+        ++skipped_ortho;
+        continue;
+      }
+      Camera cam;
+      cam.name = gc.name.empty() ? "camera " + std::to_string(index) : gc.name;
+      cam.eye = glm::vec3(world[3]);
+      const glm::vec3 fwd = glm::normalize(glm::mat3(world) * glm::vec3(0, 0, -1));
+      cam.target = cam.eye + fwd;
+      cam.up = glm::normalize(glm::mat3(world) * glm::vec3(0, 1, 0));
+      cam.vfov_degrees = static_cast<float>(glm::degrees(gc.perspective.yfov));
+      cam.znear = static_cast<float>(gc.perspective.znear);
+      cam.zfar = static_cast<float>(gc.perspective.zfar);
+      if (!(cam.zfar > cam.znear)) {
+        // Infinite far plane: reach past everything in the scene.
+        const Bounds b = scene.bounds();
+        const float reach = b.valid() ? glm::length(b.center() - cam.eye) + glm::length(b.extent()) : 1000.0f;
+        cam.zfar = std::max(cam.znear * 2.0f, reach * 1.5f);
+      }
+      scene.cameras.push_back(cam);
+    }
+    if (skipped_ortho) warn(std::to_string(skipped_ortho) + " orthographic cameras skipped");
+  }
+
+  void add_lights() {
+    for (const auto& [index, world] : light_nodes) {
+      const tinygltf::Light& gl = model.lights[static_cast<std::size_t>(index)];
+      Light l;
+      l.name = gl.name.empty() ? "light " + std::to_string(index) : gl.name;
+      if (gl.type == "point") l.type = LightType::Point;
+      else if (gl.type == "spot") l.type = LightType::Spot;
+      else if (gl.type == "directional") l.type = LightType::Directional;
+      else throw InputError(path, "light " + std::to_string(index) + " has unknown type '" + gl.type + "'");
+      if (gl.color.size() == 3) l.color = glm::vec3(gl.color[0], gl.color[1], gl.color[2]);
+      l.intensity = static_cast<float>(gl.intensity);
+      l.range = static_cast<float>(gl.range);
+      l.inner_cone = static_cast<float>(gl.spot.innerConeAngle);
+      l.outer_cone = static_cast<float>(gl.spot.outerConeAngle);
+      l.position = glm::vec3(world[3]);
+      l.direction = glm::normalize(glm::mat3(world) * glm::vec3(0, 0, -1));
+      const float check = l.color.x + l.color.y + l.color.z + l.intensity + l.range +
+                          l.position.x + l.position.y + l.position.z + l.direction.x +
+                          l.direction.y + l.direction.z + l.inner_cone + l.outer_cone;
+      if (!std::isfinite(check) || l.intensity < 0.0f)
+        throw InputError(path, "light " + std::to_string(index) + " has non-finite or negative values");
+      scene.lights.push_back(l);
+    }
+  }
+};
+
+}  // namespace
+
+Scene load_gltf(const std::string& path, LoadReport* report) {
+  const std::vector<unsigned char> bytes = read_file_bytes(path);
+  const bool is_glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".glb" || ext == ".GLB" || is_glb) check_glb_container(path, bytes);
+
+  tinygltf::TinyGLTF parser;
+  tinygltf::Model model;
+  std::string err, warn;
+  const std::string base_dir = std::filesystem::path(path).parent_path().string();
+  const bool ok =
+      is_glb ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                           static_cast<unsigned>(bytes.size()), base_dir)
+             : parser.LoadASCIIFromString(&model, &err, &warn,
+                                          reinterpret_cast<const char*>(bytes.data()),
+                                          static_cast<unsigned>(bytes.size()), base_dir);
+  if (!ok) throw InputError(path, one_line(err.empty() ? "tinygltf could not parse the file" : err));
+  if (report && !warn.empty()) report->warn(one_line(warn));
+
+  for (const std::string& e : model.extensionsRequired)
+    if (!gltf::extension_supported(e))
+      throw InputError(path, "requires unsupported extension " + e);
+
+  Scene scene;
+  scene.name = path;
+  Loader loader{path, model, scene, report, gltf::MaterialTable(path, model, scene), {}, {}, 0};
+
+  std::vector<int> roots;
+  if (!model.scenes.empty()) {
+    int s = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (static_cast<std::size_t>(s) >= model.scenes.size())
+      throw InputError(path, "default scene " + std::to_string(s) + " does not exist");
+    roots = model.scenes[static_cast<std::size_t>(s)].nodes;
+  } else {
+    // No scene: every node without a parent is a root (the spec leaves this open).
+    std::vector<char> has_parent(model.nodes.size(), 0);
+    for (const auto& node : model.nodes)
+      for (int c : node.children)
+        if (c >= 0 && static_cast<std::size_t>(c) < model.nodes.size()) has_parent[static_cast<std::size_t>(c)] = 1;
+    for (std::size_t i = 0; i < model.nodes.size(); ++i)
+      if (!has_parent[i]) roots.push_back(static_cast<int>(i));
+  }
+  loader.flatten(roots);
+  if (scene.mesh.triangle_count() == 0)
+    throw InputError(path, "contains no triangles to render" +
+                               std::string(report && report->skipped_primitives
+                                               ? " (points/lines primitives are skipped)"
+                                               : ""));
+  loader.add_cameras();
+  loader.add_lights();
+  loader.materials.finish();
+  finish_scene(scene);
+  return scene;
+}
+
+}  // namespace speculum

@@ -1,0 +1,308 @@
+// glTF export (see gltf_writer.h).
+#include "core/gltf_writer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <unordered_map>
+
+#include <tiny_gltf.h>
+#include <stb/stb_image_write.h>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "core/error.h"
+
+namespace speculum {
+namespace {
+
+using tinygltf::Value;
+
+struct Writer {
+  const Scene& scene;
+  tinygltf::Model model;
+  std::vector<unsigned char>& bin() { return model.buffers[0].data; }
+
+  int add_view(const void* data, std::size_t bytes, int target) {
+    auto& b = bin();
+    while (b.size() % 4) b.push_back(0);
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = b.size();
+    v.byteLength = bytes;
+    v.target = target;
+    const auto* p = static_cast<const unsigned char*>(data);
+    b.insert(b.end(), p, p + bytes);
+    model.bufferViews.push_back(v);
+    return static_cast<int>(model.bufferViews.size() - 1);
+  }
+
+  template <class T>
+  int add_accessor(const std::vector<T>& items, int type, int component_type, int target) {
+    tinygltf::Accessor a;
+    a.bufferView = add_view(items.data(), items.size() * sizeof(T), target);
+    a.componentType = component_type;
+    a.type = type;
+    a.count = items.size();
+    model.accessors.push_back(a);
+    return static_cast<int>(model.accessors.size() - 1);
+  }
+
+  void add_image(const ImageRGBA& img, bool srgb) {
+    std::vector<unsigned char> px(img.pixels.size() * 4);
+    auto q = [](float v) {
+      return static_cast<unsigned char>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+    };
+    for (std::size_t i = 0; i < img.pixels.size(); ++i) {
+      const glm::vec4 c = img.pixels[i];
+      px[4 * i + 0] = q(srgb ? linear_to_srgb(c.x) : c.x);
+      px[4 * i + 1] = q(srgb ? linear_to_srgb(c.y) : c.y);
+      px[4 * i + 2] = q(srgb ? linear_to_srgb(c.z) : c.z);
+      px[4 * i + 3] = q(c.w);
+    }
+    std::vector<unsigned char> png;
+    stbi_write_png_to_func(
+        [](void* ctx, void* data, int size) {
+          auto* out = static_cast<std::vector<unsigned char>*>(ctx);
+          const auto* p = static_cast<const unsigned char*>(data);
+          out->insert(out->end(), p, p + size);
+        },
+        &png, img.width, img.height, 4, px.data(), img.width * 4);
+    tinygltf::Image image;
+    image.mimeType = "image/png";
+    image.bufferView = add_view(png.data(), png.size(), 0);
+    model.images.push_back(image);
+    tinygltf::Texture tex;
+    tex.source = static_cast<int>(model.images.size() - 1);
+    tex.sampler = 0;
+    model.textures.push_back(tex);
+  }
+
+  static void set_transform_ext(const TextureRef& ref, tinygltf::ExtensionMap& ext) {
+    const glm::mat3& m = ref.uv_transform;
+    if (m == glm::mat3(1.0f)) return;
+    // uv_transform = T R S: column 0 = sx (cos, sin), column 1 = sy (-sin, cos).
+    Value::Object t;
+    t["offset"] = Value(Value::Array{Value(double(m[2][0])), Value(double(m[2][1]))});
+    t["rotation"] = Value(double(std::atan2(m[0][1], m[0][0])));
+    t["scale"] = Value(Value::Array{Value(double(glm::length(glm::vec2(m[0])))),
+                                    Value(double(glm::length(glm::vec2(m[1]))))});
+    ext["KHR_texture_transform"] = Value(t);
+  }
+
+  template <class Info>
+  static void bind(const TextureRef& ref, Info& info) {
+    if (!ref.valid()) return;
+    info.index = ref.texture;
+    info.texCoord = ref.texcoord;
+    set_transform_ext(ref, info.extensions);
+  }
+
+  void add_material(const Material& m) {
+    tinygltf::Material g;
+    g.name = m.name;
+    auto& pbr = g.pbrMetallicRoughness;
+    pbr.baseColorFactor = {m.base_color.x, m.base_color.y, m.base_color.z, m.base_color.w};
+    pbr.metallicFactor = m.metallic;
+    pbr.roughnessFactor = m.roughness;
+    bind(m.base_color_texture, pbr.baseColorTexture);
+    bind(m.metallic_roughness_texture, pbr.metallicRoughnessTexture);
+    bind(m.normal_texture, g.normalTexture);
+    if (m.normal_texture.valid()) g.normalTexture.scale = m.normal_scale;
+    bind(m.emissive_texture, g.emissiveTexture);
+    g.doubleSided = m.double_sided;
+    const float peak = std::max({m.emissive.x, m.emissive.y, m.emissive.z});
+    if (peak > 1.0f) {
+      // emissiveFactor is limited to [0,1]: carry the rest as KHR_materials_emissive_strength.
+      g.emissiveFactor = {m.emissive.x / peak, m.emissive.y / peak, m.emissive.z / peak};
+      Value::Object e;
+      e["emissiveStrength"] = Value(double(peak));
+      g.extensions["KHR_materials_emissive_strength"] = Value(e);
+    } else {
+      g.emissiveFactor = {m.emissive.x, m.emissive.y, m.emissive.z};
+    }
+    if (m.transmission > 0.0f || m.transmission_texture.valid()) {
+      Value::Object t;
+      t["transmissionFactor"] = Value(double(m.transmission));
+      if (m.transmission_texture.valid()) {
+        Value::Object ti;
+        ti["index"] = Value(m.transmission_texture.texture);
+        ti["texCoord"] = Value(m.transmission_texture.texcoord);
+        t["transmissionTexture"] = Value(ti);
+      }
+      g.extensions["KHR_materials_transmission"] = Value(t);
+    }
+    if (m.ior != 1.5f) {
+      Value::Object t;
+      t["ior"] = Value(double(m.ior));
+      g.extensions["KHR_materials_ior"] = Value(t);
+    }
+    model.materials.push_back(g);
+  }
+
+  void add_object(const Object& obj) {
+    const auto& mesh = scene.mesh;
+    // Each object gets its own vertex set: global vertices in order of first use.
+    std::unordered_map<std::uint32_t, std::uint32_t> local;
+    std::vector<std::uint32_t> order, indices;
+    const std::size_t first = obj.first_triangle, count = obj.triangle_count;
+    for (std::size_t t = first; t < first + count; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t g = mesh.indices[3 * t + static_cast<std::size_t>(k)];
+        auto [it, fresh] = local.emplace(g, static_cast<std::uint32_t>(order.size()));
+        if (fresh) order.push_back(g);
+        indices.push_back(it->second);
+      }
+    std::vector<glm::vec3> pos, nrm;
+    std::vector<glm::vec2> uv0, uv1;
+    std::vector<glm::vec4> tan;
+    for (std::uint32_t g : order) {
+      pos.push_back(mesh.positions[g]);
+      nrm.push_back(mesh.normals[g]);
+      uv0.push_back(mesh.uvs[g]);
+      if (!mesh.uvs1.empty()) uv1.push_back(mesh.uvs1[g]);
+      if (!mesh.tangents.empty()) tan.push_back(mesh.tangents[g]);
+    }
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.material = static_cast<int>(obj.material);
+    const int pa = add_accessor(pos, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    Bounds b;
+    for (const auto& p : pos) b.grow(p);
+    model.accessors[static_cast<std::size_t>(pa)].minValues = {b.lo.x, b.lo.y, b.lo.z};
+    model.accessors[static_cast<std::size_t>(pa)].maxValues = {b.hi.x, b.hi.y, b.hi.z};
+    prim.attributes["POSITION"] = pa;
+    prim.attributes["NORMAL"] = add_accessor(nrm, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["TEXCOORD_0"] = add_accessor(uv0, TINYGLTF_TYPE_VEC2, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    if (!uv1.empty())
+      prim.attributes["TEXCOORD_1"] = add_accessor(uv1, TINYGLTF_TYPE_VEC2, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    if (!tan.empty())
+      prim.attributes["TANGENT"] = add_accessor(tan, TINYGLTF_TYPE_VEC4, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.indices = add_accessor(indices, TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    tinygltf::Mesh m;
+    m.name = obj.name;
+    m.primitives.push_back(prim);
+    model.meshes.push_back(m);
+    tinygltf::Node node;
+    node.name = obj.name;
+    node.mesh = static_cast<int>(model.meshes.size() - 1);
+    add_root(node);
+  }
+
+  void add_root(const tinygltf::Node& node) {
+    model.nodes.push_back(node);
+    model.scenes[0].nodes.push_back(static_cast<int>(model.nodes.size() - 1));
+  }
+
+  // A node at `eye` whose -Z axis points along `forward` and +Y toward `up`.
+  static void place(tinygltf::Node& node, glm::vec3 eye, glm::vec3 forward, glm::vec3 up) {
+    const glm::vec3 z = -glm::normalize(forward);
+    if (glm::length(glm::cross(up, z)) < 1e-6f) up = std::fabs(z.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+    const glm::vec3 x = glm::normalize(glm::cross(up, z));
+    const glm::vec3 y = glm::cross(z, x);
+    const glm::quat q = glm::normalize(glm::quat_cast(glm::mat3(x, y, z)));
+    node.translation = {eye.x, eye.y, eye.z};
+    node.rotation = {q.x, q.y, q.z, q.w};
+  }
+
+  void add_camera(const Camera& c) {
+    tinygltf::Camera g;
+    g.name = c.name;
+    g.type = "perspective";
+    g.perspective.yfov = glm::radians(static_cast<double>(c.vfov_degrees));
+    g.perspective.znear = c.znear;
+    g.perspective.zfar = c.zfar;
+    model.cameras.push_back(g);
+    tinygltf::Node node;
+    node.name = c.name;
+    node.camera = static_cast<int>(model.cameras.size() - 1);
+    place(node, c.eye, c.target - c.eye, c.up);
+    add_root(node);
+  }
+
+  void add_light(const Light& l) {
+    tinygltf::Light g;
+    g.name = l.name;
+    g.type = l.type == LightType::Point ? "point" : l.type == LightType::Spot ? "spot" : "directional";
+    g.color = {l.color.x, l.color.y, l.color.z};
+    g.intensity = l.intensity;
+    g.range = l.range;
+    if (l.type == LightType::Spot) {
+      g.spot.innerConeAngle = l.inner_cone;
+      g.spot.outerConeAngle = l.outer_cone;
+    }
+    model.lights.push_back(g);
+    tinygltf::Node node;
+    node.name = l.name;
+    Value::Object ext;
+    ext["light"] = Value(static_cast<int>(model.lights.size() - 1));
+    node.extensions["KHR_lights_punctual"] = Value(ext);
+    place(node, l.position, l.direction, glm::vec3(0, 1, 0));
+    add_root(node);
+  }
+};
+
+std::vector<bool> srgb_textures(const Scene& scene) {
+  std::vector<bool> srgb(scene.textures.size(), false);
+  for (const auto& m : scene.materials)
+    for (const TextureRef* t : {&m.base_color_texture, &m.emissive_texture})
+      if (t->valid() && static_cast<std::size_t>(t->texture) < srgb.size())
+        srgb[static_cast<std::size_t>(t->texture)] = true;
+  return srgb;
+}
+
+}  // namespace
+
+void write_gltf(const Scene& scene, const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext != ".glb" && ext != ".gltf")
+    throw InputError(path, "export needs a .glb or .gltf file name");
+  Writer w{scene, {}};
+  auto& model = w.model;
+  model.asset.version = "2.0";
+  model.asset.generator = "speculum";
+  model.buffers.emplace_back();
+  model.scenes.emplace_back();
+  model.defaultScene = 0;
+  tinygltf::Sampler sampler;  // repeat wrapping, linear filtering
+  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+  model.samplers.push_back(sampler);
+  const auto srgb = srgb_textures(scene);
+  for (std::size_t i = 0; i < scene.textures.size(); ++i) w.add_image(scene.textures[i], srgb[i]);
+  for (const auto& m : scene.materials) w.add_material(m);
+  for (const auto& o : scene.objects) w.add_object(o);
+  for (const auto& c : scene.cameras) w.add_camera(c);
+  for (const auto& l : scene.lights) w.add_light(l);
+
+  auto use = [&](const char* name) {
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), name) == model.extensionsUsed.end())
+      model.extensionsUsed.push_back(name);
+  };
+  for (const auto& m : model.materials)
+    for (const auto& [name, v] : m.extensions) use(name.c_str());
+  for (const auto& m : model.materials)
+    for (const auto* info : {&m.pbrMetallicRoughness.baseColorTexture, &m.emissiveTexture})
+      if (info->extensions.count("KHR_texture_transform")) use("KHR_texture_transform");
+  if (!model.lights.empty()) use("KHR_lights_punctual");
+  if (model.textures.empty()) model.samplers.clear();
+
+  const std::string tmp = path + ".tmp-speculum";
+  tinygltf::TinyGLTF writer;
+  const bool ok = writer.WriteGltfSceneToFile(&model, tmp, true, true, ext == ".gltf", ext == ".glb");
+  std::error_code ec;
+  if (!ok) {
+    std::filesystem::remove(tmp, ec);
+    throw InputError(path, "could not write the glTF file");
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw InputError(path, "could not move the written file into place: " + ec.message());
+  }
+}
+
+}  // namespace speculum

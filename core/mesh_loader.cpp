@@ -1,0 +1,194 @@
+// OBJ/PLY/OFF/STL through OpenMesh (see mesh_loader.h). Headers with element counts are
+// checked against the file size first, so an absurd count cannot make OpenMesh reserve
+// gigabytes; OpenMesh's own stream logging is silenced (the CLI prints one line).
+#include "core/mesh_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <cstring>
+
+#include <glm/geometric.hpp>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include "core/error.h"
+#include "core/mesh_normals.h"
+
+namespace speculum {
+namespace {
+
+using OmMesh = OpenMesh::TriMesh_ArrayKernelT<>;
+
+std::string lower_ext(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
+
+// Rejects headers that promise more elements than the file could hold (each vertex or
+// face takes at least a few bytes in every encoding).
+void check_declared_counts(const std::string& path, const std::string& ext, std::uintmax_t size) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open file");
+  auto too_many = [&](unsigned long long n, const char* what, unsigned long long min_bytes) {
+    if (n > size / min_bytes)
+      throw InputError(path, std::string("header declares ") + std::to_string(n) + " " + what +
+                                 " but the file has only " + std::to_string(size) + " bytes");
+  };
+  if (ext == ".off") {
+    std::string magic;
+    in >> magic;
+    if (magic.find("OFF") == std::string::npos) throw InputError(path, "missing OFF header");
+    if (magic.find("ST") != std::string::npos || magic.find("n") != std::string::npos ||
+        magic.find("4") != std::string::npos) {
+      // Exotic OFF variants: let OpenMesh judge the header.
+    } else if (magic.find("BINARY") == std::string::npos) {
+      long long nv = -1, nf = -1, ne = -1;
+      in >> nv >> nf >> ne;
+      if (!in || nv < 0 || nf < 0) throw InputError(path, "malformed OFF counts line");
+      too_many(static_cast<unsigned long long>(nv), "vertices", 6);
+      too_many(static_cast<unsigned long long>(nf), "faces", 8);
+    }
+  } else if (ext == ".ply") {
+    std::string line;
+    bool binary = false;
+    std::getline(in, line);
+    if (line.rfind("ply", 0) != 0) throw InputError(path, "missing 'ply' magic line");
+    while (std::getline(in, line) && line.rfind("end_header", 0) != 0) {
+      std::istringstream ls(line);
+      std::string word, kind;
+      ls >> word;
+      if (word == "format") binary = line.find("binary") != std::string::npos;
+      if (word != "element") continue;
+      long long n = -1;
+      ls >> kind >> n;
+      if (!ls || n < 0) throw InputError(path, "malformed PLY element line: " + line);
+      too_many(static_cast<unsigned long long>(n), kind == "vertex" ? "vertices" : "elements", binary ? 1 : 2);
+    }
+  } else if (ext == ".stl") {
+    char head[84] = {};
+    in.read(head, 84);
+    const bool ascii = std::string(head, std::min<std::streamsize>(in.gcount(), 5)) == "solid";
+    if (!ascii) {
+      if (in.gcount() < 84) throw InputError(path, "truncated binary STL header");
+      std::uint32_t n = 0;
+      std::memcpy(&n, head + 80, 4);
+      if (84 + 50ull * n > size)
+        throw InputError(path, "binary STL declares " + std::to_string(n) +
+                                   " triangles but the file is truncated");
+    }
+  }
+}
+
+struct SilenceOpenMesh {
+  SilenceOpenMesh() {
+    omerr().disable();
+    omlog().disable();
+    omout().disable();
+  }
+};
+
+}  // namespace
+
+Scene load_mesh_file(const std::string& path, LoadReport* report) {
+  static const SilenceOpenMesh silence;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path, "cannot read file size");
+  if (size == 0) throw InputError(path, "file is empty");
+  const std::string ext = lower_ext(path);
+  check_declared_counts(path, ext, size);
+
+  OmMesh om;
+  om.request_vertex_normals();
+  om.request_vertex_texcoords2D();
+  OpenMesh::IO::Options opt = OpenMesh::IO::Options::VertexNormal | OpenMesh::IO::Options::VertexTexCoord;
+  bool ok = false;
+  try {
+    ok = OpenMesh::IO::read_mesh(om, path, opt);
+  } catch (const std::bad_alloc&) {
+    throw InputError(path, "out of memory while reading (absurd counts?)");
+  } catch (const std::exception& e) {
+    throw InputError(path, std::string("OpenMesh failed: ") + e.what());
+  }
+  if (!ok) throw InputError(path, "OpenMesh could not read the file (malformed or truncated)");
+  if (om.n_faces() == 0) throw InputError(path, "contains no faces");
+  if (om.n_vertices() >= 0xfffffff0u) throw InputError(path, "too many vertices");
+
+  Scene scene;
+  scene.name = path;
+  auto& mesh = scene.mesh;
+  mesh.positions.reserve(om.n_vertices());
+  for (auto vh : om.vertices()) {
+    const auto& p = om.point(vh);
+    const glm::vec3 q(p[0], p[1], p[2]);
+    if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z))
+      throw InputError(path, "vertex " + std::to_string(vh.idx()) + " has a NaN or infinite position");
+    mesh.positions.push_back(q);
+  }
+  for (auto fh : om.faces()) {
+    std::uint32_t tri[3];
+    int k = 0;
+    for (auto vh : om.fv_range(fh)) {
+      if (k == 3) break;
+      const int idx = vh.idx();
+      if (idx < 0 || static_cast<std::size_t>(idx) >= mesh.positions.size())
+        throw InputError(path, "face " + std::to_string(fh.idx()) + " indexes a missing vertex");
+      tri[k++] = static_cast<std::uint32_t>(idx);
+    }
+    if (k != 3) continue;
+    mesh.indices.insert(mesh.indices.end(), tri, tri + 3);
+  }
+  if (mesh.indices.empty()) throw InputError(path, "contains no triangles");
+
+  // Normals: the file's when present and sane, else area-weighted from the triangles.
+  bool file_normals = opt.check(OpenMesh::IO::Options::VertexNormal);
+  if (file_normals) {
+    mesh.normals.reserve(mesh.positions.size());
+    for (auto vh : om.vertices()) {
+      const auto& n = om.normal(vh);
+      glm::vec3 q(n[0], n[1], n[2]);
+      const float len = glm::length(q);
+      if (!(len > 1e-6f) || !std::isfinite(len)) {
+        file_normals = false;
+        break;
+      }
+      mesh.normals.push_back(q / len);
+    }
+    if (!file_normals && report) report->warn(path + ": bad normals in file, recomputed");
+  }
+  if (!file_normals) mesh.normals = area_weighted_normals(mesh.positions, mesh.indices);
+  if (opt.check(OpenMesh::IO::Options::VertexTexCoord)) {
+    for (auto vh : om.vertices()) {
+      const auto& t = om.texcoord2D(vh);
+      glm::vec2 uv(t[0], t[1]);
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
+      mesh.uvs.push_back(uv);
+    }
+  } else {
+    mesh.uvs.assign(mesh.positions.size(), glm::vec2(0.0f));
+  }
+  const std::size_t nt = mesh.triangle_count();
+  mesh.triangle_material.assign(nt, 0);
+  mesh.triangle_object.assign(nt, 0);
+  Material m;
+  m.name = "default";
+  m.metallic = 0.0f;
+  m.roughness = 0.5f;
+  scene.materials.push_back(m);
+  Object obj;
+  obj.name = std::filesystem::path(path).stem().string();
+  obj.triangle_count = static_cast<std::uint32_t>(nt);
+  scene.objects.push_back(obj);
+  finish_scene(scene);
+  return scene;
+}
+
+}  // namespace speculum

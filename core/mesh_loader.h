@@ -1,0 +1,15 @@
+// OBJ / PLY / OFF / STL meshes through OpenMesh: one object, one default material,
+// normals from the file or computed (OpenMesh face/vertex normals).
+#pragma once
+
+#include <string>
+
+#include "core/scene.h"
+#include "core/scene_loader.h"
+
+namespace speculum {
+
+// Throws InputError(path, problem) for missing, empty, truncated or malformed files.
+Scene load_mesh_file(const std::string& path, LoadReport* report = nullptr);
+
+}  // namespace speculum

@@ -1,0 +1,280 @@
+// The seven built-in scenes (see procedural_scenes.h). Each divides its triangle budget
+// among its objects by fixed fractions, so triangle counts track the size parameter.
+#include "core/procedural_scenes.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "core/procedural_geometry.h"
+
+namespace speculum {
+namespace {
+
+using namespace procedural;
+
+std::uint64_t share(const BuiltinParams& p, double fraction) {
+  return static_cast<std::uint64_t>(static_cast<double>(p.size) * fraction);
+}
+
+Camera camera(const char* name, glm::vec3 eye, glm::vec3 target, float vfov, float zfar) {
+  Camera c;
+  c.name = name;
+  c.eye = eye;
+  c.target = target;
+  c.vfov_degrees = vfov;
+  c.znear = 0.05f;
+  c.zfar = zfar;
+  return c;
+}
+
+Light point_light(const char* name, glm::vec3 position, float intensity, glm::vec3 color = glm::vec3(1.0f)) {
+  Light l;
+  l.name = name;
+  l.type = LightType::Point;
+  l.position = position;
+  l.intensity = intensity;
+  l.color = color;
+  return l;
+}
+
+Light sun_light(glm::vec3 toward_sun, float lux) {
+  Light l;
+  l.name = "sun";
+  l.type = LightType::Directional;
+  l.direction = -glm::normalize(toward_sun);
+  l.intensity = lux;
+  l.color = glm::vec3(1.0f, 0.95f, 0.85f);
+  return l;
+}
+
+void set_sky(Scene& s, glm::vec3 sun) {
+  s.environment.equirect = sky_equirect(512, 256, sun);
+  s.environment.source = "procedural sky";
+  s.environment.intensity = 1.0f;
+}
+
+// A textured material whose base colour multiplies a checker texture.
+std::uint32_t checker_material(SceneBuilder& b, Material m, glm::vec3 a, glm::vec3 c, int cells) {
+  m.base_color_texture.texture =
+      b.add_texture(checker_texture(256, cells, a, c), "procedural checker " + m.name);
+  return b.add_material(std::move(m));
+}
+
+// A box room from inward quads: floor, ceiling and four walls as separate objects.
+void room(SceneBuilder& b, glm::vec3 lo, glm::vec3 hi, std::uint64_t budget,
+          std::uint32_t floor_mat, std::uint32_t wall_mat, std::uint32_t ceiling_mat) {
+  const int n = cells_for(budget / 6);
+  const glm::vec3 d = hi - lo;
+  b.add_object("floor", floor_mat, quad(lo, {0, 0, d.z}, {d.x, 0, 0}, n, n, d.x / 2.0f));
+  b.add_object("ceiling", ceiling_mat, quad({lo.x, hi.y, lo.z}, {d.x, 0, 0}, {0, 0, d.z}, n, n));
+  b.add_object("wall back", wall_mat, quad(lo, {d.x, 0, 0}, {0, d.y, 0}, n, n, 2.0f));
+  b.add_object("wall front", wall_mat, quad({hi.x, lo.y, hi.z}, {-d.x, 0, 0}, {0, d.y, 0}, n, n, 2.0f));
+  b.add_object("wall left", wall_mat, quad({lo.x, lo.y, hi.z}, {0, 0, -d.z}, {0, d.y, 0}, n, n, 2.0f));
+  b.add_object("wall right", wall_mat, quad({hi.x, lo.y, lo.z}, {0, 0, d.z}, {0, d.y, 0}, n, n, 2.0f));
+}
+
+// A square ground plane at height y facing +Y.
+MeshData ground(float half, float y, std::uint64_t budget, float uv_scale) {
+  const int n = cells_for(budget);
+  return quad({-half, y, half}, {2 * half, 0, 0}, {0, 0, -2 * half}, n, n, uv_scale);
+}
+
+glm::vec2 vase_profile(float t) {
+  // Radius along the height: a foot, a belly and a neck (t in [0,1] bottom to top).
+  const float r = 0.25f + 0.3f * std::sin(3.1415927f * std::min(t * 1.2f, 1.0f)) + 0.08f * t * t;
+  return {r, 1.6f * t};
+}
+
+Scene sphere_in_room(const BuiltinParams& p) {
+  SceneBuilder b("sphere-in-room");
+  const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
+                                      {0.8f, 0.8f, 0.8f}, {0.1f, 0.1f, 0.12f}, 8);
+  const auto walls = checker_material(b, diffuse("wall checker", glm::vec3(1.0f)),
+                                      {0.75f, 0.3f, 0.25f}, {0.9f, 0.85f, 0.7f}, 8);
+  const auto ceiling = b.add_material(diffuse("ceiling", glm::vec3(0.9f)));
+  const auto chrome = b.add_material(mirror("mirror sphere"));
+  const auto gold = b.add_material(glossy("glossy gold", {1.0f, 0.78f, 0.34f}, 0.3f));
+  const auto blue = b.add_material(diffuse("blue box", {0.2f, 0.3f, 0.8f}));
+  room(b, {-5, 0, -5}, {5, 6, 5}, share(p, 0.25), floor, walls, ceiling);
+  b.add_object("mirror sphere", chrome, sphere({0, 1.5f, 0}, 1.5f, rings_for(share(p, 0.6))));
+  b.add_object("glossy sphere", gold, sphere({2.6f, 0.6f, 1.6f}, 0.6f, rings_for(share(p, 0.1))));
+  b.add_object("box", blue, box({-3.2f, 0, -2.0f}, {-2.0f, 1.2f, -0.8f}, cells_for(share(p, 0.05) / 6), false));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {3.8f, 3.0f, 4.6f}, {0, 1.3f, 0}, 60.0f, 30.0f));
+  s.lights.push_back(point_light("ceiling light", {0, 5.5f, 0}, 60.0f));
+  s.environment.constant = glm::vec3(0.05f);
+  return s;
+}
+
+Scene glossy_plane(const BuiltinParams& p) {
+  SceneBuilder b("glossy-plane");
+  Material plane_m = glossy("glossy floor", glm::vec3(1.0f), 0.25f);
+  const auto plane = checker_material(b, plane_m, {0.7f, 0.7f, 0.72f}, {0.25f, 0.25f, 0.28f}, 16);
+  const auto vase_m = b.add_material(diffuse("terracotta vase", {0.7f, 0.3f, 0.15f}));
+  const auto red = b.add_material(diffuse("red sphere", {0.8f, 0.1f, 0.1f}));
+  const auto gold = b.add_material(glossy("gold torus", {1.0f, 0.8f, 0.35f}, 0.1f));
+  b.add_object("plane", plane, ground(20.0f, 0.0f, share(p, 0.1), 20.0f));
+  b.add_object("vase", vase_m, lathe({0, 0, 0}, vase_profile, rings_for(share(p, 0.5))));
+  b.add_object("sphere", red, sphere({-1.6f, 0.6f, 0.5f}, 0.6f, rings_for(share(p, 0.2))));
+  b.add_object("torus", gold, torus({1.7f, 0.3f, 0.4f}, 0.6f, 0.3f, rings_for(share(p, 0.2) * 2)));
+  Scene s = b.take();
+  const glm::vec3 sun{0.4f, 0.8f, 0.3f};
+  s.cameras.push_back(camera("main", {0, 2.2f, 6.5f}, {0, 0.7f, 0}, 45.0f, 100.0f));
+  s.lights.push_back(sun_light(sun, 3.0f));
+  set_sky(s, sun);
+  return s;
+}
+
+Scene mirror_corridor(const BuiltinParams& p) {
+  SceneBuilder b("mirror-corridor");
+  const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
+                                      {0.85f, 0.85f, 0.85f}, {0.1f, 0.1f, 0.1f}, 12);
+  const auto glass_m = b.add_material(mirror("planar mirror", glm::vec3(0.92f)));
+  const auto red = b.add_material(diffuse("red sphere", {0.8f, 0.15f, 0.1f}));
+  const auto green = b.add_material(glossy("green torus", {0.2f, 0.8f, 0.3f}, 0.2f));
+  const auto box_m = b.add_material(diffuse("yellow box", {0.9f, 0.8f, 0.2f}));
+  const int mn = cells_for(share(p, 0.05));
+  b.add_object("mirror left", glass_m, quad({-2, 0, 6}, {0, 0, -12}, {0, 3, 0}, mn, mn));
+  b.add_object("mirror right", glass_m, quad({2, 0, -6}, {0, 0, 12}, {0, 3, 0}, mn, mn));
+  b.add_object("floor", floor, quad({-2, 0, 6}, {4, 0, 0}, {0, 0, -12}, cells_for(share(p, 0.1)),
+                                    cells_for(share(p, 0.1)), 4.0f));
+  b.add_object("sphere", red, sphere({-0.6f, 0.5f, 0.0f}, 0.5f, rings_for(share(p, 0.4))));
+  b.add_object("torus", green, torus({0.7f, 0.35f, -1.5f}, 0.45f, 0.2f, rings_for(share(p, 0.3) * 2)));
+  b.add_object("box", box_m, box({0.3f, 0, 1.0f}, {1.0f, 0.7f, 1.7f}, cells_for(share(p, 0.1) / 6), false));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {-1.2f, 1.5f, 5.0f}, {1.2f, 1.0f, -2.0f}, 55.0f, 60.0f));
+  s.lights.push_back(point_light("light", {0, 2.8f, 0.5f}, 30.0f));
+  s.environment.constant = glm::vec3(0.02f);
+  return s;
+}
+
+Scene living_room(const BuiltinParams& p) {
+  SceneBuilder b("living-room");
+  Material floor_m = glossy("glossy wood floor", glm::vec3(1.0f), 0.35f);
+  const auto floor = checker_material(b, floor_m, {0.55f, 0.35f, 0.2f}, {0.4f, 0.24f, 0.12f}, 10);
+  const auto walls = checker_material(b, diffuse("wallpaper", glm::vec3(1.0f)),
+                                      {0.85f, 0.82f, 0.75f}, {0.75f, 0.72f, 0.65f}, 20);
+  const auto ceiling = b.add_material(diffuse("ceiling", glm::vec3(0.9f)));
+  const auto wall_mirror = b.add_material(mirror("wall mirror"));
+  const auto wood = b.add_material(diffuse("table wood", {0.45f, 0.28f, 0.15f}));
+  const auto chrome = b.add_material(mirror("chrome ball"));
+  const auto glass_m = b.add_material(glass("glass ball"));
+  const auto copper = b.add_material(glossy("copper torus", {0.95f, 0.64f, 0.54f}, 0.15f));
+  const auto silver = b.add_material(mirror("silver bowl", {0.97f, 0.96f, 0.91f}));
+  const auto satin = b.add_material(glossy("satin vase", {0.6f, 0.6f, 0.65f}, 0.45f));
+  const auto bumpy = b.add_material(glossy("bumpy steel", {0.8f, 0.8f, 0.8f}, 0.05f));
+  room(b, {-4, 0, -3}, {4, 3, 3}, share(p, 0.15), floor, walls, ceiling);
+  const int mn = cells_for(share(p, 0.02));
+  b.add_object("wall mirror", wall_mirror, quad({-1.5f, 0.8f, -2.98f}, {3, 0, 0}, {0, 1.6f, 0}, mn, mn));
+  const int bn = cells_for(share(p, 0.01) / 6);
+  b.add_object("table top", wood, box({-1.0f, 0.7f, -0.6f}, {1.0f, 0.78f, 0.6f}, bn, false));
+  for (int i = 0; i < 4; ++i) {
+    const float x = i % 2 ? 0.85f : -0.95f, z = i / 2 ? 0.45f : -0.55f;
+    b.add_object("table leg " + std::to_string(i), wood, box({x, 0, z}, {x + 0.1f, 0.7f, z + 0.1f}, bn, false));
+  }
+  b.add_object("chrome ball", chrome, sphere({-0.4f, 1.08f, 0.0f}, 0.3f, rings_for(share(p, 0.15))));
+  b.add_object("glass ball", glass_m, sphere({0.45f, 0.98f, 0.1f}, 0.2f, rings_for(share(p, 0.15))));
+  b.add_object("copper torus", copper, torus({2.4f, 0.25f, 1.0f}, 0.5f, 0.25f, rings_for(share(p, 0.12) * 2)));
+  b.add_object("silver bowl", silver, bowl({-2.5f, 0.6f, 1.2f}, 0.6f, 70.0f, rings_for(share(p, 0.12))));
+  b.add_object("vase", satin, lathe({2.8f, 0, -2.2f}, vase_profile, rings_for(share(p, 0.13))));
+  b.add_object("bumpy ball", bumpy, bumpy_sphere({-2.8f, 0.5f, -2.0f}, 0.45f, 0.06f, 10.0f, rings_for(share(p, 0.15))));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {3.3f, 1.8f, 2.7f}, {-0.6f, 0.9f, -1.0f}, 60.0f, 30.0f));
+  s.cameras.push_back(camera("mirror view", {0.0f, 1.5f, 2.8f}, {0.0f, 1.4f, -3.0f}, 50.0f, 30.0f));
+  s.lights.push_back(point_light("lamp", {0.0f, 2.7f, 0.0f}, 25.0f, {1.0f, 0.9f, 0.75f}));
+  s.lights.push_back(point_light("corner lamp", {-3.5f, 2.2f, 2.5f}, 10.0f));
+  Light spot;
+  spot.name = "spot on table";
+  spot.type = LightType::Spot;
+  spot.position = {2.0f, 2.9f, 1.5f};
+  spot.direction = glm::normalize(glm::vec3(0.0f, 0.9f, 0.0f) - spot.position);
+  spot.intensity = 40.0f;
+  spot.inner_cone = 0.25f;
+  spot.outer_cone = 0.5f;
+  s.lights.push_back(spot);
+  s.environment.constant = glm::vec3(0.03f);
+  return s;
+}
+
+Scene glass_sphere(const BuiltinParams& p) {
+  SceneBuilder b("glass-sphere");
+  const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
+                                      {0.9f, 0.9f, 0.9f}, {0.2f, 0.25f, 0.4f}, 20);
+  const auto glass_m = b.add_material(glass("glass", 1.5f));
+  b.add_object("plane", floor, ground(10.0f, 0.0f, share(p, 0.2), 10.0f));
+  b.add_object("glass sphere", glass_m, sphere({0, 1.2f, 0}, 1.0f, rings_for(share(p, 0.8))));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {0, 2.6f, 5.0f}, {0, 0.8f, 0}, 45.0f, 50.0f));
+  s.lights.push_back(point_light("point light", {1.5f, 5.0f, 1.0f}, 120.0f));
+  set_sky(s, {0.3f, 0.9f, -0.4f});
+  s.environment.intensity = 0.3f;
+  return s;
+}
+
+Scene bowl_scene(const BuiltinParams& p) {
+  SceneBuilder b("bowl");
+  const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
+                                      {0.8f, 0.8f, 0.8f}, {0.3f, 0.1f, 0.1f}, 16);
+  Material bowl_m = mirror("concave mirror");
+  bowl_m.double_sided = true;
+  const auto reflector = b.add_material(bowl_m);
+  const auto ball = b.add_material(diffuse("ball", {0.1f, 0.5f, 0.9f}));
+  b.add_object("plane", floor, ground(10.0f, 0.0f, share(p, 0.15), 10.0f));
+  b.add_object("bowl", reflector, bowl({0, 2.0f, 0}, 2.0f, 75.0f, rings_for(share(p, 0.7))));
+  b.add_object("ball", ball, sphere({0.4f, 0.45f, 0.2f}, 0.4f, rings_for(share(p, 0.15))));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {0, 4.2f, 4.5f}, {0, 0.8f, 0}, 50.0f, 50.0f));
+  s.lights.push_back(point_light("light", {0.5f, 5.0f, 2.0f}, 80.0f));
+  set_sky(s, {-0.5f, 0.7f, 0.5f});
+  s.environment.intensity = 0.5f;
+  return s;
+}
+
+Scene bumpy_sphere_scene(const BuiltinParams& p) {
+  SceneBuilder b("bumpy-sphere");
+  const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
+                                      {0.85f, 0.85f, 0.85f}, {0.15f, 0.15f, 0.15f}, 16);
+  const auto steel = b.add_material(mirror("bumpy mirror", {0.9f, 0.9f, 0.92f}));
+  const float n = static_cast<float>(p.get("n", 8.0));
+  const float amplitude = static_cast<float>(p.get("amplitude", 0.06));
+  b.add_object("plane", floor, ground(10.0f, 0.0f, share(p, 0.15), 10.0f));
+  b.add_object("bumpy sphere", steel,
+               bumpy_sphere({0, 1.2f, 0}, 1.0f, amplitude, n, rings_for(share(p, 0.85))));
+  Scene s = b.take();
+  const glm::vec3 sun{0.5f, 0.7f, 0.4f};
+  s.cameras.push_back(camera("main", {0, 1.9f, 4.2f}, {0, 1.1f, 0}, 45.0f, 50.0f));
+  s.lights.push_back(sun_light(sun, 3.0f));
+  s.lights.push_back(point_light("fill", {-2.0f, 3.0f, 2.0f}, 20.0f));
+  set_sky(s, sun);
+  return s;
+}
+
+constexpr BuiltinScene kScenes[] = {
+    {"sphere-in-room", "mirror sphere in a textured box room (SURVEY's classic set-up)", 20000, "",
+     sphere_in_room},
+    {"glossy-plane", "a vase, a ball and a torus standing on a glossy textured plane", 20000, "",
+     glossy_plane},
+    {"mirror-corridor", "two facing planar mirrors with objects between (inter-reflections)",
+     20000, "", mirror_corridor},
+    {"living-room", "a room with many reflectors: wall mirror, chrome, glass, copper, bowl", 50000,
+     "", living_room},
+    {"glass-sphere", "a refracting glass sphere (ior 1.5) over a plane, lit by a point light",
+     20000, "", glass_sphere},
+    {"bowl", "a concave spherical mirror bowl with a ball inside", 20000, "", bowl_scene},
+    {"bumpy-sphere", "a mirror sphere displaced by cos(n x) cos(n y)", 40000,
+     "n=8 (bump frequency), amplitude=0.06 (relative to the radius)", bumpy_sphere_scene},
+};
+
+}  // namespace
+
+std::span<const BuiltinScene> builtin_scenes() { return kScenes; }
+
+const BuiltinScene* find_builtin_scene(std::string_view name) {
+  for (const auto& s : kScenes)
+    if (name == s.name) return &s;
+  return nullptr;
+}
+
+}  // namespace speculum

@@ -1,0 +1,38 @@
+// The built-in procedural scenes, named after the documents' set-ups (issue 2 "core/:
+// scenes"): each scales from ~1K to ~10M triangles with its size parameter.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "core/scene.h"
+
+namespace speculum {
+
+constexpr std::uint64_t kMinSceneSize = 1000;
+constexpr std::uint64_t kMaxSceneSize = 10'000'000;
+
+struct BuiltinParams {
+  std::uint64_t size = 0;                // requested triangles (already range-checked)
+  std::map<std::string, double> extra;   // scene-specific, e.g. bumpy-sphere's n
+  double get(const std::string& key, double fallback) const {
+    auto it = extra.find(key);
+    return it == extra.end() ? fallback : it->second;
+  }
+};
+
+struct BuiltinScene {
+  const char* name;
+  const char* description;
+  std::uint64_t default_size;
+  const char* extra_params;  // "" or e.g. "n=8 (bump frequency), amplitude=0.06"
+  Scene (*build)(const BuiltinParams&);
+};
+
+std::span<const BuiltinScene> builtin_scenes();
+const BuiltinScene* find_builtin_scene(std::string_view name);
+
+}  // namespace speculum

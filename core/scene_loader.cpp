@@ -1,0 +1,127 @@
+// load_scene: dispatch by extension or built-in name, then finish_scene (see scene_loader.h).
+#include "core/scene_loader.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include "core/camera_rays.h"
+#include "core/error.h"
+#include "core/gltf_loader.h"
+#include "core/mesh_loader.h"
+#include "core/procedural_scenes.h"
+
+namespace speculum {
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// "12000", "20k", "1.5M" → a number; throws on anything else.
+double parse_number(const std::string& source, const std::string& key, const std::string& text) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    throw InputError(source, "option " + key + "='" + text + "' is not a number");
+  }
+  const std::string rest = text.substr(used);
+  if (rest == "k" || rest == "K") v *= 1e3;
+  else if (rest == "m" || rest == "M") v *= 1e6;
+  else if (!rest.empty()) throw InputError(source, "option " + key + "='" + text + "' is not a number");
+  if (!std::isfinite(v)) throw InputError(source, "option " + key + " is not finite");
+  return v;
+}
+
+Scene build_builtin(const std::string& spec, const SceneOptions& options) {
+  const std::size_t colon = spec.find(':');
+  const std::string name = spec.substr(0, colon);
+  const BuiltinScene* def = find_builtin_scene(name);
+  if (!def) throw InputError(spec, "no such built-in scene (see `speculum scenes list`)");
+  BuiltinParams params;
+  params.size = options.size ? options.size : def->default_size;
+  if (colon != std::string::npos) {
+    std::string rest = spec.substr(colon + 1);
+    std::replace(rest.begin(), rest.end(), ':', ',');
+    std::size_t at = 0;
+    while (at <= rest.size()) {
+      const std::size_t end = std::min(rest.find(',', at), rest.size());
+      const std::string item = rest.substr(at, end - at);
+      at = end + 1;
+      if (item.empty()) continue;
+      const std::size_t eq = item.find('=');
+      if (eq == std::string::npos) throw InputError(spec, "expected key=value, got '" + item + "'");
+      const std::string key = item.substr(0, eq);
+      const double value = parse_number(spec, key, item.substr(eq + 1));
+      if (key == "size") {
+        if (value < 0 || value > 1e12) throw InputError(spec, "size out of range");
+        params.size = static_cast<std::uint64_t>(value);
+      } else if (std::string(def->extra_params).find(key + "=") != std::string::npos) {
+        params.extra[key] = value;
+      } else {
+        throw InputError(spec, "unknown option '" + key + "' (scene takes size=N" +
+                                   (*def->extra_params ? std::string(", ") + def->extra_params : "") + ")");
+      }
+    }
+  }
+  if (params.size < kMinSceneSize || params.size > kMaxSceneSize)
+    throw InputError(spec, "size " + std::to_string(params.size) + " outside [" +
+                               std::to_string(kMinSceneSize) + ", " + std::to_string(kMaxSceneSize) + "]");
+  if (const double n = params.get("n", 8.0); !(n >= 0.0 && n <= 1000.0))
+    throw InputError(spec, "n must be in [0, 1000]");
+  if (const double a = params.get("amplitude", 0.06); !(a >= 0.0 && a <= 0.5))
+    throw InputError(spec, "amplitude must be in [0, 0.5]");
+  Scene scene = def->build(params);
+  scene.name = spec;
+  return scene;
+}
+
+}  // namespace
+
+const char* default_scene_name() { return "sphere-in-room"; }
+
+bool is_builtin_scene_name(const std::string& file_or_name) {
+  return find_builtin_scene(file_or_name.substr(0, file_or_name.find(':'))) != nullptr;
+}
+
+void finish_scene(Scene& scene) {
+  if (scene.materials.empty()) {
+    Material m;
+    m.name = "default";
+    m.metallic = 0.0f;
+    m.roughness = 0.8f;
+    scene.materials.push_back(m);
+  }
+  if (scene.cameras.empty()) scene.cameras.push_back(framing_camera(scene.bounds()));
+  for (const Camera& c : scene.cameras) validate_camera(c, scene.name);
+  scene.validate();
+}
+
+Scene load_scene(const std::string& file_or_name, const SceneOptions& options) {
+  if (file_or_name.empty()) throw InputError("(empty)", "no scene file or name given");
+  const std::string ext = lower_extension(file_or_name);
+  Scene scene;
+  if (ext == ".gltf" || ext == ".glb") {
+    scene = load_gltf(file_or_name, options.report);
+  } else if (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl") {
+    scene = load_mesh_file(file_or_name, options.report);
+  } else if (is_builtin_scene_name(file_or_name)) {
+    scene = build_builtin(file_or_name, options);
+  } else {
+    std::error_code ec;
+    if (std::filesystem::exists(file_or_name, ec))
+      throw InputError(file_or_name, "unsupported file extension '" + ext +
+                                         "' (expected .gltf, .glb, .obj, .ply, .off or .stl)");
+    throw InputError(file_or_name, "no such file or built-in scene (see `speculum scenes list`)");
+  }
+  finish_scene(scene);
+  return scene;
+}
+
+}  // namespace speculum

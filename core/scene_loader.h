@@ -1,0 +1,42 @@
+// One entry point for every scene source: glTF 2.0 (.gltf/.glb), OBJ/PLY/OFF/STL meshes,
+// or a built-in procedural scene by name (DESIGN.md "Data and formats").
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/scene.h"
+
+namespace speculum {
+
+// What a loader skipped or repaired; never fatal (fatal problems throw InputError).
+struct LoadReport {
+  std::vector<std::string> warnings;
+  std::uint64_t skipped_primitives = 0;  // points/lines/unsupported primitives
+  void warn(std::string message) { warnings.push_back(std::move(message)); }
+};
+
+struct SceneOptions {
+  // Built-in scenes: approximate triangle count (0: the scene's default). A size given in
+  // the name ("bowl:size=20000") wins over this field. Ignored for files.
+  std::uint64_t size = 0;
+  LoadReport* report = nullptr;  // optional: receives warnings
+};
+
+// Loads `file_or_name`: a path ending in .gltf/.glb/.obj/.ply/.off/.stl, or a built-in
+// scene name with an optional ":size=N" suffix. The result has passed Scene::validate()
+// and has at least one material and one camera. Throws InputError naming the source.
+Scene load_scene(const std::string& file_or_name, const SceneOptions& options = {});
+
+// The scene `speculum render` uses when none is given.
+const char* default_scene_name();
+
+// True when `file_or_name` names a built-in scene (with or without ":size=N").
+bool is_builtin_scene_name(const std::string& file_or_name);
+
+// Adds what every loaded scene must have: a default material when there is none, a
+// framing camera when there is none; then validates. Used by all loaders.
+void finish_scene(Scene& scene);
+
+}  // namespace speculum
