@@ -1,0 +1,186 @@
+// The reference tracer (see reference_tracer.h): a recursive Whitted/Monte-Carlo radiance
+// estimate per path sample over the shared shading model of core/shading.h.
+#include "trace/reference_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "core/camera_rays.h"
+#include "core/error.h"
+#include "core/optics.h"
+#include "core/sampling.h"
+#include "core/shading.h"
+#include "trace/traversal.h"
+
+namespace speculum::trace {
+
+namespace {
+
+constexpr std::uint32_t kDimsPerBounce = 8;  // random dimensions reserved per depth level
+
+struct Tracer {
+  const Scene& scene;
+  const Bvh& bvh;
+  const ReferenceOptions& opt;
+  ReferenceStats stats;
+  TraversalCounters counters;
+  std::uint32_t pixel = 0, sample = 0;
+
+  float rnd(int depth, std::uint32_t k) const {
+    return random_float(pixel, sample, static_cast<std::uint32_t>(depth) * kDimsPerBounce + k, opt.seed);
+  }
+
+  // Offset along the geometric normal, scaled with the magnitude of the point so it stays
+  // above float resolution far from the origin.
+  static glm::vec3 offset(const glm::vec3& p, const glm::vec3& ng) {
+    const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    return p + ng * (1e-4f * m);
+  }
+
+  bool occluded(const glm::vec3& origin, const glm::vec3& dir, float distance) {
+    ++stats.shadow_rays;
+    Ray r;
+    r.origin = origin;
+    r.direction = dir;
+    r.tmax = std::isfinite(distance) ? distance * (1.0f - 1e-4f) : 3.0e38f;
+    return any_hit(bvh, r, &counters);
+  }
+
+  glm::vec3 radiance(const Ray& ray, int depth) {
+    const Hit h = closest_hit(bvh, ray, &counters);
+    const glm::vec3 dir = glm::normalize(ray.direction);
+    if (!h.hit()) return environment_radiance(scene.environment, dir);
+
+    const TriangleMesh& m = scene.mesh;
+    const std::uint32_t t = h.triangle;
+    const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+    const float w0 = 1.0f - h.u - h.v;
+    const glm::vec3 p = ray.origin + ray.direction * h.t;
+    glm::vec3 ng = glm::cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]);
+    const float ng_len = glm::length(ng);
+    ng = ng_len > 0.0f ? ng / ng_len : -dir;
+    glm::vec3 n = ng;
+    if (m.normals.size() == m.positions.size()) {
+      const glm::vec3 s = m.normals[i0] * w0 + m.normals[i1] * h.u + m.normals[i2] * h.v;
+      if (glm::length(s) > 0.0f) n = glm::normalize(s);
+    }
+    glm::vec2 uv(0.0f), uv1(0.0f);
+    if (m.uvs.size() == m.positions.size()) uv = m.uvs[i0] * w0 + m.uvs[i1] * h.u + m.uvs[i2] * h.v;
+    if (m.uvs1.size() == m.positions.size()) uv1 = m.uvs1[i0] * w0 + m.uvs1[i1] * h.u + m.uvs1[i2] * h.v;
+    const std::uint32_t mat = t < m.triangle_material.size() ? m.triangle_material[t] : 0u;
+    const SurfaceParams s = surface_params(scene, mat, uv, uv1);
+
+    // Face the viewer: both normals on the incident side.
+    const bool entering = glm::dot(ng, dir) < 0.0f;
+    if (!entering) ng = -ng;
+    if (glm::dot(n, ng) < 0.0f) n = -n;
+    const glm::vec3 v = -dir;
+    const float cos_nv = std::max(glm::dot(n, v), 0.0f);
+    const glm::vec3 above = offset(p, ng);
+
+    glm::vec3 L = s.emissive;
+    // Direct light with traced shadows.
+    for (const Light& light : scene.lights) {
+      const LightSample ls = sample_light(light, p);
+      if (ls.irradiance == glm::vec3(0.0f) || glm::dot(ng, ls.direction) <= 0.0f) continue;
+      const glm::vec3 c = shade_light(s, n, v, ls);
+      if (c == glm::vec3(0.0f)) continue;
+      if (!occluded(above, ls.direction, ls.distance)) L += c;
+    }
+    // Environment light on the diffuse part: f_d L cos / (cos/π) = π f_d L.
+    if (opt.environment_lighting) {
+      const glm::vec3 fd = diffuse_albedo_over_pi(s, cos_nv);
+      if (fd != glm::vec3(0.0f)) {
+        const glm::vec3 wi = Onb(n).to_world(sample_cosine_hemisphere({rnd(depth, 0), rnd(depth, 1)}));
+        if (glm::dot(wi, ng) > 0.0f && !occluded(above, wi, std::numeric_limits<float>::infinity()))
+          L += kPi * fd * environment_radiance(scene.environment, wi);
+      }
+    }
+    if (depth >= opt.max_depth) {
+      if (s.is_refractor() || s.is_mirror_lobe() || s.is_glossy_lobe()) ++stats.depth_limited;
+      return L;
+    }
+    auto trace_dir = [&](const glm::vec3& origin, const glm::vec3& d) {
+      ++stats.specular_rays;
+      Ray r;
+      r.origin = origin;
+      r.direction = d;
+      return radiance(r, depth + 1);
+    };
+    if (s.is_refractor()) {
+      const float nu = entering ? s.ior : 1.0f / s.ior;
+      glm::vec3 tdir;
+      const bool ok = refract(dir, n, nu, tdir);
+      const float F = ok ? fresnel_dielectric(cos_nv, nu) : 1.0f;
+      glm::vec3 Ls = F * trace_dir(above, reflect(dir, n));
+      if (ok && F < 1.0f) Ls += (1.0f - F) * s.base_color * trace_dir(offset(p, -ng), glm::normalize(tdir));
+      L += s.transmission * Ls;
+    } else if (s.is_mirror_lobe()) {
+      L += specular_fresnel(s, cos_nv) * trace_dir(above, reflect(dir, n));
+    } else if (s.is_glossy_lobe()) {
+      const glm::vec3 r = reflect(dir, n);
+      const glm::vec3 wi = Onb(r).to_world(sample_phong_lobe({rnd(depth, 2), rnd(depth, 3)}, s.phong_exponent));
+      if (glm::dot(wi, n) <= 0.0f || glm::dot(wi, ng) <= 0.0f) ++stats.below_horizon;
+      else L += specular_fresnel(s, cos_nv) * trace_dir(above, wi);
+    }
+    return L;
+  }
+};
+
+}  // namespace
+
+ImageRGBA render_reference(const Scene& scene, const Camera& camera, const ReferenceOptions& options,
+                           par::Executor& executor, ReferenceStats* stats) {
+  const Bvh bvh = Bvh::build(scene.mesh, executor);
+  return render_reference(scene, bvh, camera, options, executor, stats);
+}
+
+ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& camera,
+                           const ReferenceOptions& opt, par::Executor& ex, ReferenceStats* stats) {
+  validate_camera(camera, "reference camera");
+  if (opt.width <= 0 || opt.height <= 0 || opt.width > 32768 || opt.height > 32768)
+    throw InputError("reference", "image size out of range (1..32768)");
+  if (opt.spp <= 0 || opt.spp > (1 << 20)) throw InputError("reference", "spp out of range (1..2^20)");
+  ImageRGBA image(opt.width, opt.height, glm::vec4(0.0f));
+  const std::size_t pixels = static_cast<std::size_t>(opt.width) * opt.height;
+  constexpr std::size_t kChunk = 64;
+  std::vector<ReferenceStats> per_chunk((pixels + kChunk - 1) / kChunk);
+  ex.parallel_for("reference_render", pixels, kChunk, [&](std::size_t b, std::size_t e) {
+    Tracer tr{scene, bvh, opt, {}, {}, 0, 0};
+    for (std::size_t i = b; i < e; ++i) {
+      const int x = static_cast<int>(i % opt.width), y = static_cast<int>(i / opt.width);
+      tr.pixel = static_cast<std::uint32_t>(i);
+      glm::vec3 sum(0.0f);
+      for (int k = 0; k < opt.spp; ++k) {
+        tr.sample = static_cast<std::uint32_t>(k);
+        float jx = 0.5f, jy = 0.5f;
+        if (opt.pixel_jitter) {
+          jx = random_float(tr.pixel, tr.sample, 0xfffffff0u, opt.seed);
+          jy = random_float(tr.pixel, tr.sample, 0xfffffff1u, opt.seed);
+        }
+        const Ray r = primary_ray(camera, opt.width, opt.height, static_cast<float>(x) + jx, static_cast<float>(y) + jy);
+        ++tr.stats.camera_rays;
+        sum += tr.radiance(r, 0);
+      }
+      image.pixels[i] = glm::vec4(sum / static_cast<float>(opt.spp), 1.0f);
+    }
+    tr.stats.stack_overflows = tr.counters.stack_overflows;
+    per_chunk[b / kChunk] = tr.stats;
+  });
+  if (stats) {
+    for (const ReferenceStats& s : per_chunk) {
+      stats->camera_rays += s.camera_rays;
+      stats->shadow_rays += s.shadow_rays;
+      stats->specular_rays += s.specular_rays;
+      stats->below_horizon += s.below_horizon;
+      stats->depth_limited += s.depth_limited;
+      stats->stack_overflows += s.stack_overflows;
+    }
+  }
+  return image;
+}
+
+}  // namespace speculum::trace

@@ -1,0 +1,49 @@
+// The reference tracer: the ground truth every technique is compared with (issue 5,
+// DESIGN.md "Correctness strategy"). Primary visibility; direct light from every punctual
+// light with traced shadow rays; Whitted recursion for mirrors and smooth refractors
+// (exact dielectric Fresnel, total internal reflection) to a depth limit; glossy
+// reflection by importance sampling the normalized Phong lobe (YU eq.4, one lobe sample
+// per path sample); environment on miss; optionally environment light on diffuse surfaces
+// (cosine samples, occluded by geometry, no interreflection). Shading follows
+// core/shading.h. Random numbers are keyed by (pixel, sample, dimension, seed), so the
+// image is bit-identical for any thread count; the error falls like 1/sqrt(spp).
+#pragma once
+
+#include <cstdint>
+
+#include "core/image.h"
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "trace/bvh.h"
+
+namespace speculum::trace {
+
+struct ReferenceOptions {
+  int width = 512;
+  int height = 512;
+  int spp = 64;                     // path samples per pixel
+  int max_depth = 8;                // specular bounces (mirror, glossy, refraction)
+  std::uint32_t seed = 1;
+  bool pixel_jitter = false;        // false: every sample through the pixel centre, as the
+                                    // rasterizer samples; true: box-filtered pixel area
+  bool environment_lighting = true; // diffuse surfaces lit by the (occluded) environment
+};
+
+// Counters of one render (integers, summed in chunk order).
+struct ReferenceStats {
+  std::uint64_t camera_rays = 0, shadow_rays = 0, specular_rays = 0;
+  std::uint64_t below_horizon = 0;   // glossy lobe samples under the surface: contribute 0
+  std::uint64_t depth_limited = 0;   // specular paths cut by max_depth
+  std::uint64_t stack_overflows = 0;
+};
+
+// Renders with a BVH built from scene.mesh on the executor (kernel "reference_render").
+// Throws InputError for a degenerate camera or size.
+ImageRGBA render_reference(const Scene& scene, const Camera& camera, const ReferenceOptions& options,
+                           par::Executor& executor, ReferenceStats* stats = nullptr);
+// The same with a prebuilt BVH over scene.mesh.
+ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& camera,
+                           const ReferenceOptions& options, par::Executor& executor,
+                           ReferenceStats* stats = nullptr);
+
+}  // namespace speculum::trace

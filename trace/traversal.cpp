@@ -1,0 +1,330 @@
+// Closest-hit / any-hit traversal of the 4-wide and threaded BVH layouts, the all-pairs
+// oracle and the chunked stream kernels (see traversal.h). Box tests are the slab test
+// with the far distance widened by a few ulps (Ize, "Robust BVH ray traversal", 2013) so a
+// rounding error never culls a box the watertight triangle test would hit.
+#include "trace/traversal.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "parallel/lanes.h"
+#include "trace/ray_triangle.h"
+
+namespace speculum::trace {
+
+namespace {
+
+constexpr float kFarWiden = 1.0f + 8.0f * 5.96e-8f;   // > 1 + 2 gamma(3)
+constexpr float kNearShrink = 1.0f - 8.0f * 5.96e-8f;  // the same margin on the entry side
+
+struct RayPrep {
+  glm::vec3 o, d, inv;
+  float tmin, tmax;
+  RayShear shear;
+  explicit RayPrep(const Ray& r) : o(r.origin), d(r.direction), tmin(r.tmin), tmax(r.tmax), shear(r.origin, r.direction) {
+    // A zero direction component becomes a huge reciprocal instead of inf, so (lo-o)*inv
+    // is never 0*inf = NaN; the slab then spans everything or nothing, as it should.
+    for (int a = 0; a < 3; ++a) {
+      const float c = std::fabs(d[a]) < 1e-30f ? std::copysign(1e-30f, d[a]) : d[a];
+      inv[a] = 1.0f / c;
+    }
+  }
+};
+
+inline bool valid_ray(const Ray& r) {
+  const glm::vec3& d = r.direction;
+  return (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f) && std::isfinite(d.x) && std::isfinite(d.y) &&
+         std::isfinite(d.z) && std::isfinite(r.origin.x) && std::isfinite(r.origin.y) &&
+         std::isfinite(r.origin.z) && !(r.tmin > r.tmax);
+}
+
+inline bool box_hit(const RayPrep& r, const Aabb& b, float tmax, float& tnear) {
+  float t0 = r.tmin, t1 = tmax;
+  for (int a = 0; a < 3; ++a) {
+    float lo = (b.lo[a] - r.o[a]) * r.inv[a];
+    float hi = (b.hi[a] - r.o[a]) * r.inv[a];
+    if (lo > hi) std::swap(lo, hi);
+    lo = lo > 0.0f ? lo * kNearShrink : lo * kFarWiden;
+    t0 = lo > t0 ? lo : t0;
+    t1 = hi * kFarWiden < t1 ? hi * kFarWiden : t1;
+  }
+  tnear = t0;
+  return t0 <= t1 && !b.empty();
+}
+
+// Closest-hit update with the lower-index tie rule.
+inline void test_leaf_closest(const Bvh& bvh, const RayPrep& r, std::uint32_t first, std::uint32_t count,
+                              Hit& best, TraversalCounters& c) {
+  const auto& tris = bvh.leaf_triangles();
+  const auto& ids = bvh.triangle_ids();
+  for (std::uint32_t k = first; k < first + count; ++k) {
+    ++c.triangle_tests;
+    TriangleHit h;
+    if (!intersect_triangle_watertight(r.shear, tris[k].a, tris[k].b, tris[k].c, r.tmin, best.t, h)) continue;
+    const std::uint32_t id = ids[k];
+    if (h.t < best.t || id < best.triangle) best = {h.t, h.u, h.v, id};
+  }
+}
+
+inline bool test_leaf_any(const Bvh& bvh, const RayPrep& r, std::uint32_t first, std::uint32_t count,
+                          TraversalCounters& c) {
+  const auto& tris = bvh.leaf_triangles();
+  for (std::uint32_t k = first; k < first + count; ++k) {
+    ++c.triangle_tests;
+    TriangleHit h;
+    if (intersect_triangle_watertight(r.shear, tris[k].a, tris[k].b, tris[k].c, r.tmin, r.tmax, h)) return true;
+  }
+  return false;
+}
+
+// Tests the 4 child boxes of a wide node together; returns a bit mask of hit children and
+// their entry distances.
+inline unsigned wide_box_hits(const Wide4Node& n, const RayPrep& r, float tmax, float (&tnear)[4]) {
+  using L = par::Lanes<4>;
+  const L::f32 ox(r.o.x), oy(r.o.y), oz(r.o.z), ix(r.inv.x), iy(r.inv.y), iz(r.inv.z);
+  const L::f32 x0 = (L::load(n.lo_x) - ox) * ix, x1 = (L::load(n.hi_x) - ox) * ix;
+  const L::f32 y0 = (L::load(n.lo_y) - oy) * iy, y1 = (L::load(n.hi_y) - oy) * iy;
+  const L::f32 z0 = (L::load(n.lo_z) - oz) * iz, z1 = (L::load(n.hi_z) - oz) * iz;
+  const L::f32 widen(kFarWiden), shrink(kNearShrink);
+  const L::f32 entry = L::max(L::max(L::min(x0, x1), L::min(y0, y1)), L::min(z0, z1));
+  const L::f32 near = L::max(L::select(entry > L::f32(0.0f), entry * shrink, entry * widen), L::f32(r.tmin));
+  const L::f32 far = L::min(L::min(L::max(x0, x1), L::max(y0, y1)) * widen,
+                            L::min(L::max(z0, z1) * widen, L::f32(tmax)));
+  const auto m = near <= far;
+  L::store(near, tnear);
+  unsigned bits = 0;
+  for (int k = 0; k < 4; ++k)
+    if (m[k] && n.child[k] != kEmptyChild) bits |= 1u << k;
+  return bits;
+}
+
+struct StackEntry {
+  std::uint32_t ref;
+  float tnear;
+};
+
+}  // namespace
+
+Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
+  TraversalCounters c;
+  c.rays = 1;
+  Hit best;
+  best.t = ray.tmax;
+  if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
+    const RayPrep r(ray);
+    const auto& nodes = bvh.wide_nodes();
+    StackEntry stack[kTraversalStackSize];
+    int sp = 0;
+    stack[sp++] = {bvh.wide_root(), ray.tmin};
+    while (sp > 0) {
+      const StackEntry e = stack[--sp];
+      if (e.tnear > best.t) continue;
+      if (e.ref & kLeafBit) {
+        test_leaf_closest(bvh, r, (e.ref & ~kLeafBit) >> 4, e.ref & 15u, best, c);
+        continue;
+      }
+      ++c.nodes_visited;
+      const Wide4Node& n = nodes[e.ref];
+      float tn[4];
+      unsigned bits = wide_box_hits(n, r, best.t, tn);
+      // Push far-to-near so the nearest child is popped first.
+      StackEntry hits[4];
+      int count = 0;
+      while (bits) {
+        const int k = __builtin_ctz(bits);
+        bits &= bits - 1;
+        StackEntry s{n.child[k], tn[k]};
+        int j = count++;
+        while (j > 0 && hits[j - 1].tnear < s.tnear) {
+          hits[j] = hits[j - 1];
+          --j;
+        }
+        hits[j] = s;
+      }
+      for (int k = 0; k < count; ++k) {
+        if (sp == kTraversalStackSize) {
+          ++c.stack_overflows;
+          continue;
+        }
+        stack[sp++] = hits[k];
+      }
+    }
+  }
+  if (!best.hit()) best = Hit{};
+  if (counters) counters->add(c);
+  return best;
+}
+
+bool any_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
+  TraversalCounters c;
+  c.rays = 1;
+  bool found = false;
+  if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
+    const RayPrep r(ray);
+    const auto& nodes = bvh.wide_nodes();
+    std::uint32_t stack[kTraversalStackSize];
+    int sp = 0;
+    stack[sp++] = bvh.wide_root();
+    while (sp > 0 && !found) {
+      const std::uint32_t ref = stack[--sp];
+      if (ref & kLeafBit) {
+        found = test_leaf_any(bvh, r, (ref & ~kLeafBit) >> 4, ref & 15u, c);
+        continue;
+      }
+      ++c.nodes_visited;
+      float tn[4];
+      unsigned bits = wide_box_hits(nodes[ref], r, r.tmax, tn);
+      while (bits) {
+        const int k = __builtin_ctz(bits);
+        bits &= bits - 1;
+        if (sp == kTraversalStackSize) {
+          ++c.stack_overflows;
+          continue;
+        }
+        stack[sp++] = nodes[ref].child[k];
+      }
+    }
+  }
+  if (counters) counters->add(c);
+  return found;
+}
+
+Hit closest_hit_threaded(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
+  TraversalCounters c;
+  c.rays = 1;
+  Hit best;
+  best.t = ray.tmax;
+  const auto& nodes = bvh.threaded_nodes();
+  if (valid_ray(ray) && !nodes.empty()) {
+    const RayPrep r(ray);
+    std::uint32_t i = 0;
+    while (i != kThreadEnd) {
+      const ThreadedNode& n = nodes[i];
+      ++c.nodes_visited;
+      float tnear;
+      if (!box_hit(r, n.box, best.t, tnear)) {
+        i = n.miss;
+        continue;
+      }
+      if (n.count) test_leaf_closest(bvh, r, n.first, n.count, best, c);
+      i = n.hit;
+    }
+  }
+  if (!best.hit()) best = Hit{};
+  if (counters) counters->add(c);
+  return best;
+}
+
+bool any_hit_threaded(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
+  TraversalCounters c;
+  c.rays = 1;
+  bool found = false;
+  const auto& nodes = bvh.threaded_nodes();
+  if (valid_ray(ray) && !nodes.empty()) {
+    const RayPrep r(ray);
+    std::uint32_t i = 0;
+    while (i != kThreadEnd && !found) {
+      const ThreadedNode& n = nodes[i];
+      ++c.nodes_visited;
+      float tnear;
+      if (!box_hit(r, n.box, r.tmax, tnear)) {
+        i = n.miss;
+        continue;
+      }
+      if (n.count) found = test_leaf_any(bvh, r, n.first, n.count, c);
+      i = n.hit;
+    }
+  }
+  if (counters) counters->add(c);
+  return found;
+}
+
+Hit closest_hit_oracle(const std::vector<glm::vec3>& p, const std::vector<std::uint32_t>& idx, const Ray& ray) {
+  Hit best;
+  best.t = ray.tmax;
+  if (!valid_ray(ray)) return Hit{};
+  const RayShear shear(ray.origin, ray.direction);
+  for (std::size_t t = 0; t < idx.size() / 3; ++t) {
+    TriangleHit h;
+    if (!intersect_triangle_watertight(shear, p[idx[3 * t]], p[idx[3 * t + 1]], p[idx[3 * t + 2]], ray.tmin,
+                                       best.t, h))
+      continue;
+    const auto id = static_cast<std::uint32_t>(t);
+    if (h.t < best.t || id < best.triangle) best = {h.t, h.u, h.v, id};
+  }
+  if (!best.hit()) best = Hit{};
+  return best;
+}
+
+bool any_hit_oracle(const std::vector<glm::vec3>& p, const std::vector<std::uint32_t>& idx, const Ray& ray) {
+  if (!valid_ray(ray)) return false;
+  const RayShear shear(ray.origin, ray.direction);
+  for (std::size_t t = 0; t < idx.size() / 3; ++t) {
+    TriangleHit h;
+    if (intersect_triangle_watertight(shear, p[idx[3 * t]], p[idx[3 * t + 1]], p[idx[3 * t + 2]], ray.tmin,
+                                      ray.tmax, h))
+      return true;
+  }
+  return false;
+}
+
+void RayStream::resize(std::size_t n) {
+  for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax}) v->resize(n);
+}
+void RayStream::set(std::size_t i, const Ray& r) {
+  ox[i] = r.origin.x; oy[i] = r.origin.y; oz[i] = r.origin.z;
+  dx[i] = r.direction.x; dy[i] = r.direction.y; dz[i] = r.direction.z;
+  tmin[i] = r.tmin; tmax[i] = r.tmax;
+}
+Ray RayStream::get(std::size_t i) const {
+  Ray r;
+  r.origin = {ox[i], oy[i], oz[i]};
+  r.direction = {dx[i], dy[i], dz[i]};
+  r.tmin = tmin[i];
+  r.tmax = tmax[i];
+  return r;
+}
+void HitStream::resize(std::size_t n) {
+  t.resize(n);
+  u.resize(n);
+  v.resize(n);
+  triangle.resize(n);
+}
+
+void closest_hit_stream(const Bvh& bvh, const RayStream& rays, HitStream& hits, par::Executor& ex,
+                        TraversalCounters* counters) {
+  const std::size_t n = rays.size();
+  hits.resize(n);
+  const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
+  std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
+  ex.parallel_for("trace_closest", n, kRayChunk, [&](std::size_t b, std::size_t e) {
+    TraversalCounters c;
+    for (std::size_t i = b; i < e; ++i) {
+      const Hit h = closest_hit(bvh, rays.get(i), &c);
+      hits.t[i] = h.t;
+      hits.u[i] = h.u;
+      hits.v[i] = h.v;
+      hits.triangle[i] = h.triangle;
+    }
+    if (counters) per_chunk[b / kRayChunk] = c;
+  });
+  if (counters)
+    for (const auto& c : per_chunk) counters->add(c);
+}
+
+void any_hit_stream(const Bvh& bvh, const RayStream& rays, std::vector<std::uint8_t>& occluded,
+                    par::Executor& ex, TraversalCounters* counters) {
+  const std::size_t n = rays.size();
+  occluded.resize(n);
+  const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
+  std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
+  ex.parallel_for("trace_any", n, kRayChunk, [&](std::size_t b, std::size_t e) {
+    TraversalCounters c;
+    for (std::size_t i = b; i < e; ++i) occluded[i] = any_hit(bvh, rays.get(i), &c) ? 1 : 0;
+    if (counters) per_chunk[b / kRayChunk] = c;
+  });
+  if (counters)
+    for (const auto& c : per_chunk) counters->add(c);
+}
+
+}  // namespace speculum::trace
