@@ -100,12 +100,13 @@ class Executor {
   T parallel_reduce(std::string_view name, std::size_t n, std::size_t chunk, T identity,
                     ChunkFn&& chunk_fn, Combine&& combine) {
     if (chunk == 0) chunk = 1;
-    std::vector<T> partial(chunk_count(n, chunk), identity);
+    struct Slot { T value; };  // not std::vector<bool>: chunks write their slots concurrently
+    std::vector<Slot> partial(chunk_count(n, chunk), Slot{identity});
     parallel_for(name, n, chunk, [&](std::size_t begin, std::size_t end) {
-      partial[begin / chunk] = chunk_fn(begin, end);
+      partial[begin / chunk].value = chunk_fn(begin, end);
     });
     T result = std::move(identity);
-    for (auto& p : partial) result = combine(std::move(result), std::move(p));
+    for (auto& p : partial) result = combine(std::move(result), std::move(p.value));
     return result;
   }
 

@@ -1,0 +1,46 @@
+// Stream compaction in two forms: scan + scatter, and the gather-only hierarchical block
+// algorithm of ROGER ch.4 (TECHNIQUES.md §4.3; ROGER §4.3.2 Fig.4.7, §4.3.3 Fig.4.8).
+// Both are stable (order-preserving) and return the indices of the kept elements; gather
+// the payload streams with those indices (SoaStream::gather / par::gather).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "parallel/stream.h"
+
+namespace speculum::par {
+
+// Counters of one hierarchical compaction (bounded-loop accounting, DESIGN.md).
+struct HierarchicalCompactStats {
+  std::uint64_t blocks = 0;
+  std::uint64_t search_steps = 0;  // iterations of the Fig.4.7 loop, summed over outputs
+};
+
+// out[0, count) = indices i with keep[i] != 0, ascending; returns count. out.size() >= the
+// number kept (n is always enough). Phases: per-chunk counts, serial chunk offsets, per-chunk
+// scatter.
+std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const std::uint8_t> keep,
+                            std::span<std::uint32_t> out, std::size_t chunk = kStreamChunk);
+
+// Same result, computed gather-only: blocks of `block_size` elements (s in ROGER; any s >= 1)
+// get an inclusive count of empty elements pSum; output slot i of a block gathers the unique
+// kept j with j - pSum[j] = i by the tightened dichotomic search of Fig.4.7; the block counts
+// are scanned into block displacements and every output slot gathers from its block
+// (concatenation, Fig.4.8). `scratch` holds the block-local results (resized to n rounded
+// up to s); pass one in to avoid reallocating it each call.
+std::size_t compact_hierarchical(Executor& ex, std::string_view name,
+                                 std::span<const std::uint8_t> keep, std::span<std::uint32_t> out,
+                                 std::size_t block_size, std::vector<std::uint32_t>* scratch = nullptr,
+                                 HierarchicalCompactStats* stats = nullptr);
+
+// The within-block step alone (exposed for tests and teaching): for one block of flags,
+// writes the kept positions (block-local) to out[0, count) by the Fig.4.7 search and
+// returns count; `psum` receives the inclusive empty counts. `steps` accumulates loop
+// iterations.
+std::size_t compact_block_gather(std::span<const std::uint8_t> block, std::span<std::uint32_t> psum,
+                                 std::span<std::uint32_t> out, std::uint64_t& steps);
+
+}  // namespace speculum::par

@@ -1,0 +1,45 @@
+// Stable partition into p buckets (ROGER §4.5 bucket sort = p compactions computed
+// together) and stable LSD radix sort of 32/64-bit keys with a payload, both built on one
+// counting scatter: per-chunk bucket counts, offsets laid out bucket-major then chunk order
+// (a serial pass), then each chunk writes its elements in order — deterministic and stable.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "parallel/stream.h"
+
+namespace speculum::par {
+
+// Radix sort and partition chunks are larger than kStreamChunk: each chunk carries a
+// per-bucket count table, and bigger chunks keep the scatter's write streams long.
+inline constexpr std::size_t kScatterChunk = 1 << 16;
+
+// out[0, n) = the element indices grouped by bucket[i] (0 <= bucket[i] < p), each bucket in
+// ascending index order; bucket_begin[0, p] receives the bucket boundaries (size p + 1).
+// A bucket id >= p throws std::invalid_argument.
+void partition_stable(Executor& ex, std::string_view name, std::span<const std::uint32_t> bucket,
+                      std::uint32_t p, std::span<std::uint32_t> out,
+                      std::span<std::uint32_t> bucket_begin, std::size_t chunk = kScatterChunk);
+
+// Reusable buffers for radix_sort (pass one in to keep 16M-element sorts allocation-free).
+template <class Key>
+struct RadixSortScratch {
+  std::vector<Key> keys;
+  std::vector<std::uint32_t> payload;
+  std::vector<std::uint32_t> counts;
+};
+
+// Sorts keys ascending, carrying payload[i] along; stable (equal keys keep their order).
+// 8-bit digits, least significant first; a digit that is equal for all keys is skipped.
+// payload may be empty (keys only); otherwise it must have keys.size() elements.
+void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
+                std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch = nullptr,
+                std::size_t chunk = kScatterChunk);
+void radix_sort(Executor& ex, std::string_view name, std::span<std::uint64_t> keys,
+                std::span<std::uint32_t> payload, RadixSortScratch<std::uint64_t>* scratch = nullptr,
+                std::size_t chunk = kScatterChunk);
+
+}  // namespace speculum::par

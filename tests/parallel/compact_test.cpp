@@ -1,0 +1,139 @@
+// Both compactions against a sequential filter: every size class, every ratio 0..100 %,
+// block sizes s, 1/2/8 threads, lane widths; and the ROGER Fig.4.8 golden vector (s=16).
+#include "parallel/compact.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "primitive_test_util.h"
+
+namespace speculum::par {
+namespace {
+using namespace test;
+
+std::vector<std::uint32_t> serial_filter(const std::vector<std::uint8_t>& keep) {
+  std::vector<std::uint32_t> out;
+  for (std::size_t i = 0; i < keep.size(); ++i)
+    if (keep[i]) out.push_back(std::uint32_t(i));
+  return out;
+}
+
+std::vector<std::uint32_t> run_scatter(Executor& ex, const std::vector<std::uint8_t>& keep) {
+  std::vector<std::uint32_t> out(keep.size());
+  out.resize(compact_scatter(ex, "compact", keep, out));
+  return out;
+}
+std::vector<std::uint32_t> run_hier(Executor& ex, const std::vector<std::uint8_t>& keep, std::size_t s) {
+  std::vector<std::uint32_t> out(keep.size());
+  out.resize(compact_hierarchical(ex, "compact_h", keep, out, s));
+  return out;
+}
+
+TEST(Compact, RogerFig48GoldenVector) {
+  const std::string blocks = "43X192XX7X6X58X5" "431X2X6XX7X98XX5" "X87XX235XXX6XX1X" "1XXX45X7X6X8329X";
+  std::vector<std::uint8_t> keep;
+  for (char c : blocks) keep.push_back(c != 'X');
+  // Within-block step: the figure's prefix sums and reduced blocks.
+  const char* psums[] = {"0011112334455566", "0001122344555677", "1112333345667889", "0123334455666667"};
+  const char* reduced[] = {"4319276585", "431267985", "8723561", "145768329"};
+  for (int b = 0; b < 4; ++b) {
+    std::vector<std::uint32_t> psum(16), out(16);
+    std::uint64_t steps = 0;
+    const auto c = compact_block_gather(std::span(keep).subspan(b * 16, 16), psum, out, steps);
+    std::string p, r;
+    for (auto v : psum) p += char('0' + v);
+    for (std::size_t k = 0; k < c; ++k) r += blocks[b * 16 + out[k]];
+    EXPECT_EQ(p, psums[b]);
+    EXPECT_EQ(r, reduced[b]);
+  }
+  for (int t : kThreadCounts) {
+    std::vector<std::uint32_t> out(64);
+    HierarchicalCompactStats stats;
+    const auto n = compact_hierarchical(executor(t), "fig48", keep, out, 16, nullptr, &stats);
+    std::string joined;
+    for (std::size_t k = 0; k < n; ++k) {
+      // Block displacements in output order: 0, 10, 19, 26.
+      if (k == 10 || k == 19 || k == 26) joined += '|';
+      joined += blocks[out[k]];
+    }
+    EXPECT_EQ(joined, "4319276585|431267985|8723561|145768329");
+    EXPECT_EQ(stats.blocks, 4u);
+  }
+}
+
+TEST(Compact, BothFormsEqualSequentialFilterForEverySize) {
+  for (std::size_t n : sizes()) {
+    for (int percent : {0, 3, 50, 97, 100}) {
+      const auto keep = flags(n, percent, n);
+      const auto ref = serial_filter(keep);
+      for (int t : kThreadCounts) {
+        EXPECT_EQ(run_scatter(executor(t), keep), ref) << n << " " << percent << "% t=" << t;
+        for (std::size_t s : {1u, 16u, 64u, 1000u})
+          EXPECT_EQ(run_hier(executor(t), keep, s), ref) << n << " " << percent << "% s=" << s << " t=" << t;
+      }
+    }
+  }
+}
+
+TEST(Compact, EveryRatioFromZeroToHundredPercent) {
+  // Every integer percentage, for each block size of the sweep, at a size with a tail block.
+  const std::size_t n = 4099;
+  for (int percent = 0; percent <= 100; ++percent) {
+    const auto keep = flags(n, percent, 1000 + percent);
+    const auto ref = serial_filter(keep);
+    ASSERT_EQ(run_scatter(executor(2), keep), ref) << percent;
+    for (std::size_t s = 8; s <= 1024; s *= 2) ASSERT_EQ(run_hier(executor(2), keep, s), ref) << percent << "% s=" << s;
+  }
+}
+
+TEST(Compact, SixteenMillion) {
+  const std::size_t n = std::size_t(16) << 20;
+  const auto keep = flags(n, 37, 5);
+  const auto ref = serial_filter(keep);
+  EXPECT_EQ(run_scatter(executor(2), keep), ref);
+  std::vector<std::uint32_t> out(n), scratch;
+  const auto c = compact_hierarchical(executor(2), "h16M", keep, out, 64, &scratch);
+  out.resize(c);
+  EXPECT_EQ(out, ref);
+}
+
+// Flags made by a width-generic kernel, then compacted: identical for every W and thread
+// count (DESIGN.md: every W gives the same bits).
+template <int W>
+std::vector<std::uint32_t> cull_kernel(Executor& ex, const std::vector<float>& d) {
+  using L = Lanes<W>;
+  std::vector<std::uint8_t> keep(d.size());
+  map_lanes<W>(ex, "cull", d.size(), [&](std::size_t i, auto active) {
+    const int c = L::count(active);
+    const auto v = L::load_partial(d.data() + i, c);
+    const auto on = L::sqrt(v) * 0.5f + v < 0.6f;
+    for (int k = 0; k < c; ++k) keep[i + k] = on[k];
+  });
+  std::vector<std::uint32_t> out(d.size());
+  out.resize(compact_hierarchical(ex, "cull_compact", keep, out, 32));
+  return out;
+}
+
+TEST(Compact, LaneWidthsAndThreadsGiveIdenticalResults) {
+  std::vector<float> d(30001);
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = unit_float(i);
+  const auto ref = cull_kernel<1>(executor(1), d);
+  EXPECT_GT(ref.size(), 0u);
+  EXPECT_LT(ref.size(), d.size());
+  for (int t : kThreadCounts)
+    for (int w : {1, 4, 8, 16})
+      EXPECT_EQ(dispatch_lanes(w, [&](auto lw) { return cull_kernel<lw.value>(executor(t), d); }), ref)
+          << "W=" << w << " t=" << t;
+}
+
+TEST(Compact, RejectsBadArguments) {
+  std::vector<std::uint8_t> keep = {1, 1, 1};
+  std::vector<std::uint32_t> small(2);
+  EXPECT_THROW(compact_scatter(executor(1), "c", keep, small), std::invalid_argument);
+  EXPECT_THROW(compact_hierarchical(executor(1), "c", keep, small, 4), std::invalid_argument);
+  EXPECT_THROW(compact_hierarchical(executor(1), "c", keep, small, 0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace speculum::par

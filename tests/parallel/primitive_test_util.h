@@ -1,0 +1,41 @@
+// Shared fixtures for the stream-primitive tests: executors at 1, 2 and 8 threads, the
+// sizes every primitive is checked at, and a counter-based hash for reproducible data.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "parallel/executor.h"
+#include "parallel/partition.h"
+#include "parallel/stream.h"
+
+namespace speculum::par::test {
+
+inline Executor& executor(int threads) {
+  static Executor one(1), two(2), eight(8);
+  return threads == 1 ? one : threads == 2 ? two : eight;
+}
+inline constexpr int kThreadCounts[] = {1, 2, 8};
+
+// 0, 1, odd, just over a stream chunk, just over a scatter chunk (16M cases are separate).
+inline const std::vector<std::size_t>& sizes() {
+  static const std::vector<std::size_t> s = {0, 1, 7, 12345, kStreamChunk + 1, kScatterChunk + 3};
+  return s;
+}
+
+inline std::uint32_t hash32(std::uint64_t x) {  // splitmix64 finalizer
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return std::uint32_t((x ^ (x >> 31)) >> 16);
+}
+inline float unit_float(std::uint64_t i) { return float(hash32(i) >> 8) * (1.f / 16777216.f); }
+
+// keep[i] = 1 with probability percent/100 (exactly 0 % and 100 % at the ends).
+inline std::vector<std::uint8_t> flags(std::size_t n, int percent, std::uint64_t seed) {
+  std::vector<std::uint8_t> f(n);
+  for (std::size_t i = 0; i < n; ++i) f[i] = (hash32(seed * 0x100000001ull + i) % 100) < std::uint32_t(percent);
+  return f;
+}
+
+}  // namespace speculum::par::test
