@@ -15,5 +15,7 @@ struct GlobalOptions {
 // Each add_* adds one subcommand (with its own --help) to `app`.
 void add_scenes_command(CLI::App& app, GlobalOptions& global);
 void add_info_command(CLI::App& app, GlobalOptions& global);
+void add_render_command(CLI::App& app, GlobalOptions& global);
+void add_techniques_command(CLI::App& app, GlobalOptions& global);
 
 }  // namespace speculum::cli

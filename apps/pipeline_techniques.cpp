@@ -1,0 +1,31 @@
+// The technique table: see pipeline_techniques.h.
+#include "apps/pipeline_techniques.h"
+
+#include "core/error.h"
+
+namespace speculum::pipeline {
+
+const std::vector<Technique>& techniques() {
+  static const std::vector<Technique> table = {
+      {"envmap",
+       "environment mapping (SURVEY §3.1): reflect/refract into the prefiltered environment "
+       "cube, Schlick Fresnel; no parallax",
+       add_envmap_passes},
+      {"reference",
+       "reference tracer: BVH ray tracing, Whitted mirrors/refraction, Phong-lobe glossy "
+       "sampling (--spp path samples); the ground truth",
+       add_reference_passes},
+  };
+  return table;
+}
+
+const Technique& find_technique(const std::string& name) {
+  std::string known;
+  for (const Technique& t : techniques()) {
+    if (t.name == name) return t;
+    known += (known.empty() ? "" : ", ") + t.name;
+  }
+  throw InputError("--technique", "unknown technique '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace speculum::pipeline

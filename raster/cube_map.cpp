@@ -1,0 +1,112 @@
+// The `cube_map` node and cube conventions: see cube_map.h.
+#include "raster/cube_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "core/camera_rays.h"
+
+namespace speculum::raster {
+namespace {
+
+struct FaceBasis {
+  glm::vec3 forward, up;
+};
+// The up vectors only have to be fixed and non-parallel to the axis; right and the true
+// up are derived exactly as core/camera_rays.cpp derives them.
+constexpr FaceBasis kFaces[kCubeFaces] = {
+    {{1, 0, 0}, {0, 1, 0}},  {{-1, 0, 0}, {0, 1, 0}}, {{0, 1, 0}, {0, 0, -1}},
+    {{0, -1, 0}, {0, 0, 1}}, {{0, 0, 1}, {0, 1, 0}},  {{0, 0, -1}, {0, 1, 0}}};
+
+struct FaceFrame {
+  glm::vec3 forward, right, up;
+};
+FaceFrame frame(int face) {
+  const glm::vec3 f = kFaces[face].forward;
+  const glm::vec3 r = glm::normalize(glm::cross(f, kFaces[face].up));
+  return {f, r, glm::cross(r, f)};
+}
+
+}  // namespace
+
+Camera cube_face_camera(int face, const glm::vec3& centre, float znear, float zfar) {
+  Camera c;
+  c.name = "cube face " + std::to_string(face);
+  c.eye = centre;
+  c.target = centre + kFaces[face].forward;
+  c.up = kFaces[face].up;
+  c.vfov_degrees = 90.0f;
+  c.znear = znear;
+  c.zfar = zfar;
+  return c;
+}
+
+CubeCoord cube_coord(const glm::vec3& d, int size) {
+  const glm::vec3 a = glm::abs(d);
+  int face;
+  if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
+  else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
+  else face = d.z >= 0.0f ? 4 : 5;
+  const FaceFrame f = frame(face);
+  const float depth = glm::dot(d, f.forward);
+  const float ndc_x = glm::dot(d, f.right) / depth;
+  const float ndc_y = glm::dot(d, f.up) / depth;
+  const float s = static_cast<float>(size);
+  return {face, {std::clamp((ndc_x + 1.0f) * 0.5f * s, 0.0f, s),
+                 std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
+}
+
+glm::vec3 cube_direction(int face, glm::vec2 pixel, int size) {
+  const FaceFrame f = frame(face);
+  const float s = static_cast<float>(size);
+  const float ndc_x = 2.0f * pixel.x / s - 1.0f, ndc_y = 1.0f - 2.0f * pixel.y / s;
+  return glm::normalize(f.forward + f.right * ndc_x + f.up * ndc_y);
+}
+
+glm::vec4 CubeMap::colour_towards(const glm::vec3& d) const {
+  const CubeCoord c = cube_coord(d, size);
+  const ImageRGBA& img = colour[c.face];
+  const float fx = std::clamp(c.pixel.x - 0.5f, 0.0f, float(size - 1));
+  const float fy = std::clamp(c.pixel.y - 0.5f, 0.0f, float(size - 1));
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const int x1 = std::min(x0 + 1, size - 1), y1 = std::min(y0 + 1, size - 1);
+  const float tx = fx - x0, ty = fy - y0;
+  return (img.at(x0, y0) * (1 - tx) + img.at(x1, y0) * tx) * (1 - ty) +
+         (img.at(x0, y1) * (1 - tx) + img.at(x1, y1) * tx) * ty;
+}
+
+float CubeMap::distance_towards(const glm::vec3& d) const {
+  const CubeCoord c = cube_coord(d, size);
+  const int x = std::min(static_cast<int>(c.pixel.x), size - 1);
+  const int y = std::min(static_cast<int>(c.pixel.y), size - 1);
+  return distance[c.face].at(x, y);
+}
+
+CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
+                        const CubeMapOptions& options, const CubeFaceShader& shade) {
+  CubeMap cube;
+  cube.size = options.size;
+  cube.centre = centre;
+  for (int face = 0; face < kCubeFaces; ++face) {
+    const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
+    const VisibilityBuffer vis =
+        render_visibility(executor, scene, cam, options.size, options.size, options.raster);
+    const GBuffer g = resolve_gbuffer(executor, scene, vis, centre);
+    ImageF& dist = cube.distance[face];
+    dist = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
+    executor.parallel_for("cube_map.distance", dist.size(), 4096,
+                          [&](std::size_t begin, std::size_t end) {
+                            for (std::size_t i = begin; i < end; ++i)
+                              if (g.covered(i))
+                                dist.pixels[i] = glm::length(g.position.pixels[i] - centre);
+                          });
+    if (shade) cube.colour[face] = shade(g, cam);
+  }
+  return cube;
+}
+
+}  // namespace speculum::raster

@@ -1,0 +1,64 @@
+// The `cube_map` node: the scene rendered from a point into six 90° faces holding colour
+// and Euclidean distance |y − o| — the distance maps of SURVEY §4 — plus the face
+// conventions every cube lookup in speculum uses (environment, shadow and distance maps).
+#pragma once
+
+#include <array>
+#include <functional>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "core/image.h"
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "raster/gbuffer.h"
+#include "raster/visibility.h"
+
+namespace speculum::raster {
+
+constexpr int kCubeFaces = 6;  // +X, −X, +Y, −Y, +Z, −Z
+
+// The camera of face `face` at `centre`: a 90° square frustum along the face axis. Face
+// pixels follow core/camera_rays.h, so a face image is an ordinary render of this camera.
+Camera cube_face_camera(int face, const glm::vec3& centre, float znear, float zfar);
+
+// Where direction d (any length, non-zero) lands: its face and continuous pixel
+// coordinates in [0, size]² (pixel centres at +0.5).
+struct CubeCoord {
+  int face = 0;
+  glm::vec2 pixel{0.0f};
+};
+CubeCoord cube_coord(const glm::vec3& d, int size);
+// The direction through continuous pixel coordinates of a face (unit length).
+glm::vec3 cube_direction(int face, glm::vec2 pixel, int size);
+
+struct CubeMap {
+  int size = 0;
+  glm::vec3 centre{0.0f};
+  std::array<ImageRGBA, kCubeFaces> colour;   // may be empty (distance-only maps)
+  std::array<ImageF, kCubeFaces> distance;    // |y − o|, +inf where nothing was hit
+
+  // Bilinear colour towards d (clamped at face borders).
+  glm::vec4 colour_towards(const glm::vec3& d) const;
+  // Nearest-texel distance towards d.
+  float distance_towards(const glm::vec3& d) const;
+};
+
+// Colour of one face from its G-buffer; background samples (object == kNoId) too.
+using CubeFaceShader = std::function<ImageRGBA(const GBuffer&, const Camera&)>;
+
+struct CubeMapOptions {
+  int size = 256;
+  float znear = 0.01f;
+  float zfar = 1000.0f;
+  RasterOptions raster;  // e.g. excluded_objects: leave the reflector out of its own map
+};
+
+// Renders the six faces: visibility → G-buffer → `shade` (skipped when empty: a
+// distance-only map, as for shadow maps).
+CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
+                        const CubeMapOptions& options, const CubeFaceShader& shade = {});
+
+}  // namespace speculum::raster

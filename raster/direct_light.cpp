@@ -1,0 +1,41 @@
+// The `direct_light` node: see direct_light.h.
+#include "raster/direct_light.h"
+
+#include <glm/geometric.hpp>
+
+#include "core/camera_rays.h"
+
+namespace speculum::raster {
+
+ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,
+                       const Camera& camera, const std::vector<ShadowMap>& shadows,
+                       const EnvironmentMap& env) {
+  ImageRGBA out(g.width, g.height);
+  executor.parallel_for("direct_light.shade", out.size(), 4096,
+                        [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!g.covered(i)) {
+        const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
+        const Ray ray = primary_ray(camera, g.width, g.height, x + 0.5f, y + 0.5f);
+        out.pixels[i] = glm::vec4(env.radiance(ray.direction, 1e6f), 1.0f);
+        continue;
+      }
+      const SurfaceParams& s = g.surface.pixels[i];
+      const glm::vec3 p = g.position.pixels[i], v = g.view.pixels[i];
+      glm::vec3 n = g.normal.pixels[i];
+      if (glm::dot(n, v) < 0.0f) n = -n;  // refractors seen from inside: light the near side
+      glm::vec3 radiance = s.emissive;
+      for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+        const LightSample ls = sample_light(scene.lights[k], p);
+        if (ls.irradiance == glm::vec3(0.0f) || glm::dot(n, ls.direction) <= 0.0f) continue;
+        const float lit = k < shadows.size() ? shadows[k].visibility(p, n, ls.direction) : 1.0f;
+        if (lit > 0.0f) radiance += lit * shade_light(s, n, v, ls);
+      }
+      radiance += diffuse_albedo_over_pi(s, glm::dot(n, v)) * env.irradiance(n);
+      out.pixels[i] = glm::vec4(radiance, 1.0f);
+    }
+  });
+  return out;
+}
+
+}  // namespace speculum::raster

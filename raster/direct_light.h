@@ -1,0 +1,22 @@
+// The `direct_light` node: radiance of every G-buffer sample from the scene's punctual
+// lights (core/shading.h model, shadowed by filtered shadow maps), ambient light from the
+// environment's SH irradiance, emission, and the environment behind empty samples.
+#pragma once
+
+#include <vector>
+
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "raster/environment.h"
+#include "raster/gbuffer.h"
+#include "raster/shadow_map.h"
+
+namespace speculum::raster {
+
+// `camera` is the one the G-buffer was rendered with (for background directions).
+// `shadows` may be empty: lights are then unshadowed.
+ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,
+                       const Camera& camera, const std::vector<ShadowMap>& shadows,
+                       const EnvironmentMap& env);
+
+}  // namespace speculum::raster

@@ -1,0 +1,150 @@
+// The `environment` node: see environment.h. Prefiltering cascades: level l is level l−1
+// convolved with the lobe whose variance is the difference of the two levels' target
+// variances (lobes of small angle compose like Gaussians), so each level costs a fixed
+// number of lookups whatever its lobe width.
+#include "raster/environment.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "core/sampling.h"
+#include "core/shading.h"
+
+namespace speculum::raster {
+namespace {
+
+constexpr int kPrefilterSamples = 48;
+constexpr float kLn2 = 0.69314718f;
+
+// Half-power angle of a Phong lobe: cos^n θ = 1/2 → θ ≈ sqrt(2 ln 2 / n) for large n.
+float lobe_angle(float n) { return std::sqrt(2.0f * kLn2 / std::max(n, 1e-6f)); }
+float lobe_exponent(float angle) { return 2.0f * kLn2 / (angle * angle); }
+float texel_angle(int size) { return 0.5f * kPi / static_cast<float>(size); }
+
+glm::vec4 bilinear_face(const ImageRGBA& img, glm::vec2 pixel) {
+  const int s = img.width;
+  const float fx = std::clamp(pixel.x - 0.5f, 0.0f, float(s - 1));
+  const float fy = std::clamp(pixel.y - 0.5f, 0.0f, float(s - 1));
+  const int x0 = int(fx), y0 = int(fy), x1 = std::min(x0 + 1, s - 1), y1 = std::min(y0 + 1, s - 1);
+  const float tx = fx - x0, ty = fy - y0;
+  return (img.at(x0, y0) * (1 - tx) + img.at(x1, y0) * tx) * (1 - ty) +
+         (img.at(x0, y1) * (1 - tx) + img.at(x1, y1) * tx) * ty;
+}
+
+glm::vec3 lookup_level(const std::array<ImageRGBA, kCubeFaces>& level, const glm::vec3& d) {
+  const int s = level[0].width;
+  const CubeCoord c = cube_coord(d, s);
+  return glm::vec3(bilinear_face(level[c.face], c.pixel));
+}
+
+std::array<float, 9> sh_basis(const glm::vec3& d) {
+  const float x = d.x, y = d.y, z = d.z;
+  return {0.282095f,         0.488603f * y,       0.488603f * z,
+          0.488603f * x,     1.092548f * x * y,   1.092548f * y * z,
+          0.315392f * (3.0f * z * z - 1.0f), 1.092548f * x * z, 0.546274f * (x * x - y * y)};
+}
+
+}  // namespace
+
+EnvironmentMap build_environment(par::Executor& executor, const Environment& env, int size) {
+  if (size <= 0)
+    size = env.has_image() ? std::clamp(env.equirect.width / 4, 16, 512) : 8;
+  EnvironmentMap map;
+  map.size = size;
+  const int levels = static_cast<int>(std::log2(static_cast<float>(size))) + 1;
+  map.levels.resize(levels);
+  // Level 0: 2×2 supersampled resampling of the environment.
+  for (int face = 0; face < kCubeFaces; ++face) {
+    ImageRGBA& img = map.levels[0][face];
+    img = ImageRGBA(size, size);
+    executor.parallel_for("environment.resample", img.size(), 1024,
+                          [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const int x = int(i % size), y = int(i / size);
+        glm::vec3 sum(0.0f);
+        for (int sy = 0; sy < 2; ++sy)
+          for (int sx = 0; sx < 2; ++sx)
+            sum += environment_radiance(
+                env, cube_direction(face, {x + 0.25f + 0.5f * sx, y + 0.25f + 0.5f * sy}, size));
+        img.pixels[i] = glm::vec4(sum * 0.25f, 1.0f);
+      }
+    });
+  }
+  return environment_from_faces(executor, std::move(map.levels[0]), true);
+}
+
+EnvironmentMap environment_from_faces(par::Executor& executor,
+                                      std::array<ImageRGBA, kCubeFaces> faces, bool with_sh) {
+  EnvironmentMap map;
+  const int size = faces[0].width;
+  map.size = size;
+  const int levels = static_cast<int>(std::log2(static_cast<float>(size))) + 1;
+  map.levels.resize(levels);
+  map.levels[0] = std::move(faces);
+  // Coarser levels: glossy prefiltering of the previous level.
+  for (int l = 1; l < levels; ++l) {
+    const int s = std::max(1, size >> l);
+    const float target = texel_angle(s), previous = l == 1 ? 0.0f : texel_angle(size >> (l - 1));
+    const float step_exponent = lobe_exponent(std::sqrt(target * target - previous * previous));
+    for (int face = 0; face < kCubeFaces; ++face) {
+      ImageRGBA& img = map.levels[l][face];
+      img = ImageRGBA(s, s);
+      executor.parallel_for("environment.prefilter", img.size(), 256,
+                            [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const glm::vec3 axis = cube_direction(face, {i % s + 0.5f, i / s + 0.5f}, s);
+          const Onb onb(axis);
+          glm::vec3 sum(0.0f);
+          for (int k = 0; k < kPrefilterSamples; ++k) {
+            const glm::vec3 local =
+                sample_phong_lobe(hamersley(std::uint32_t(k), kPrefilterSamples), step_exponent);
+            sum += lookup_level(map.levels[l - 1], onb.to_world(local));
+          }
+          img.pixels[i] = glm::vec4(sum / float(kPrefilterSamples), 1.0f);
+        }
+      });
+    }
+  }
+  if (!with_sh) return map;
+  // SH projection of level 0, serial in texel order (a fixed-order sum).
+  std::array<glm::dvec3, 9> acc{};
+  for (int face = 0; face < kCubeFaces; ++face)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const float u = 2.0f * (x + 0.5f) / size - 1.0f, v = 2.0f * (y + 0.5f) / size - 1.0f;
+        const double solid_angle =
+            (4.0 / (double(size) * size)) / std::pow(1.0 + u * u + v * v, 1.5);
+        const glm::vec3 d = cube_direction(face, {x + 0.5f, y + 0.5f}, size);
+        const auto basis = sh_basis(d);
+        const glm::dvec3 L(glm::vec3(map.levels[0][face].at(x, y)));
+        for (int k = 0; k < 9; ++k) acc[k] += L * (double(basis[k]) * solid_angle);
+      }
+  for (int k = 0; k < 9; ++k) map.sh[k] = glm::vec3(acc[k]);
+  return map;
+}
+
+glm::vec3 EnvironmentMap::radiance(const glm::vec3& d, float phong_exponent) const {
+  const int last = static_cast<int>(levels.size()) - 1;
+  float level = 0.0f;
+  if (phong_exponent < 1e6f)
+    level = std::clamp(std::log2(lobe_angle(phong_exponent) / texel_angle(size)), 0.0f,
+                       float(last));
+  const int l0 = static_cast<int>(level), l1 = std::min(l0 + 1, last);
+  const float t = level - l0;
+  const glm::vec3 a = lookup_level(levels[l0], d);
+  return t > 0.0f ? a * (1.0f - t) + lookup_level(levels[l1], d) * t : a;
+}
+
+glm::vec3 EnvironmentMap::irradiance(const glm::vec3& n) const {
+  // Convolution with the clamped cosine: A0 = π, A1 = 2π/3, A2 = π/4.
+  constexpr float a[9] = {kPi, 2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
+                          kPi / 4, kPi / 4, kPi / 4, kPi / 4};
+  const auto basis = sh_basis(n);
+  glm::vec3 e(0.0f);
+  for (int k = 0; k < 9; ++k) e += sh[k] * (a[k] * basis[k]);
+  return glm::max(e, glm::vec3(0.0f));
+}
+
+}  // namespace speculum::raster

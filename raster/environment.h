@@ -1,0 +1,40 @@
+// The `environment` node: the scene's environment (equirect image or constant) resampled
+// into a mip-mapped cube map whose coarser levels are glossy-prefiltered with Phong lobes,
+// plus its 9 spherical-harmonic coefficients for diffuse ambient light (SURVEY §3.1;
+// irradiance from SH after Ramamoorthi & Hanrahan 2001).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "raster/cube_map.h"
+
+namespace speculum::raster {
+
+struct EnvironmentMap {
+  // levels[l][face]: (size >> l)² texels; level l is prefiltered with a lobe whose
+  // half-power angle is one level-l texel (level 0: unfiltered).
+  std::vector<std::array<ImageRGBA, kCubeFaces>> levels;
+  int size = 0;
+  std::array<glm::vec3, 9> sh{};  // radiance SH coefficients, bands 0..2
+
+  // Radiance arriving along -d (d: unit direction leaving the scene) through a Phong lobe of
+  // exponent n (≥ 1e6: mirror): trilinear across the levels matching the lobe width.
+  glm::vec3 radiance(const glm::vec3& d, float phong_exponent) const;
+  // Irradiance E(n) on a surface with unit normal n from the SH coefficients.
+  glm::vec3 irradiance(const glm::vec3& n) const;
+};
+
+// Mip levels and glossy prefiltering of given level-0 faces (e.g. a rendered cube map's
+// colour, for the dynamic environment maps of SURVEY §3.1); SH only when asked.
+EnvironmentMap environment_from_faces(par::Executor& executor,
+                                      std::array<ImageRGBA, kCubeFaces> faces, bool with_sh);
+
+// size 0: picks from the image (a quarter of the equirect width, 16..512; 8 for constants).
+EnvironmentMap build_environment(par::Executor& executor, const Environment& env, int size = 0);
+
+}  // namespace speculum::raster

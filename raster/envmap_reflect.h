@@ -1,0 +1,21 @@
+// The `envmap_reflect` node: SURVEY §3.1 environment mapping — each specular sample looks
+// up the environment cube along its mirror direction R (glossy: the prefiltered level of
+// its Phong lobe) and, for refractors, along the refracted direction T (single interface),
+// weighted by Schlick's Fresnel (SURVEY eq.2). No parallax: exact only for an environment
+// at infinity, which is the technique's known limitation.
+#pragma once
+
+#include "parallel/executor.h"
+#include "raster/environment.h"
+#include "raster/gbuffer.h"
+#include "raster/reflector_maps.h"
+
+namespace speculum::raster {
+
+// The specular layer: F·L(R) (+ (1−F)·base·L(T) for refractors); zero on diffuse samples.
+// A sample of a reflector with its own dynamic map in `reflectors` (may be null) looks up
+// that map, any other the environment.
+ImageRGBA envmap_reflect(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
+                         const ReflectorMaps* reflectors = nullptr);
+
+}  // namespace speculum::raster

@@ -1,0 +1,49 @@
+// The `gbuffer` node: resolves a visibility buffer into per-sample surface attributes —
+// world position, shading normal (normal maps applied), uv, material parameters and
+// reflector id (SOFF §3.1's G-buffer; issue 4 "Nodes").
+#pragma once
+
+#include <cstdint>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/image.h"
+#include "core/scene.h"
+#include "core/shading.h"
+#include "parallel/executor.h"
+#include "raster/visibility.h"
+
+namespace speculum::raster {
+
+struct GBuffer {
+  int width = 0;
+  int height = 0;
+  IdBuffer object;                  // kNoId: background (nothing else is valid there)
+  Buffer2D<glm::vec3> position;     // world space
+  Buffer2D<glm::vec3> normal;       // unit shading normal, facing the camera side for
+                                    // opaque surfaces; geometric orientation for refractors
+  Buffer2D<glm::vec3> view;         // unit direction from the sample towards the eye
+  Buffer2D<glm::vec2> uv;
+  Buffer2D<SurfaceParams> surface;  // diffuse colour, metallic, roughness, glossiness (Phong
+                                    // exponent), ior, transmission, emissive
+  IdBuffer reflector;               // object id of non-diffuse surfaces, kNoId otherwise
+
+  bool covered(std::size_t i) const { return object.pixels[i] != kNoId; }
+};
+
+GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
+                        const glm::vec3& eye);
+
+// The scalar views of the G-buffer for inspection: specular level (max of F0 for
+// non-diffuse surfaces, 0 otherwise) and glossiness (Phong exponent).
+ImageF specular_level_image(const GBuffer& g);
+ImageF glossiness_image(const GBuffer& g);
+
+// The material-kind test used by every reflection node: the surface reflects its
+// surroundings (mirror or glossy lobe) or refracts.
+inline bool is_specular(const SurfaceParams& s) {
+  return s.is_refractor() || s.roughness < kGlossyRoughness;
+}
+
+}  // namespace speculum::raster

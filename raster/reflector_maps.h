@@ -1,0 +1,32 @@
+// Dynamic environment maps (SURVEY §3.1): for every specular object, the scene without it
+// rendered into a cube map (colour = direct light + ambient, and distance) around the
+// centre of its bounding box, then mip-mapped with glossy prefiltering.
+#pragma once
+
+#include <vector>
+
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "raster/cube_map.h"
+#include "raster/environment.h"
+#include "raster/shadow_map.h"
+
+namespace speculum::raster {
+
+struct ReflectorMaps {
+  std::vector<int> map_of_object;     // per object: index into maps, -1 when not a reflector
+  std::vector<CubeMap> cubes;         // colour + distance, as rendered
+  std::vector<EnvironmentMap> maps;   // the same colour, prefiltered for lookups
+  const EnvironmentMap* for_object(std::uint32_t object) const {
+    if (object >= map_of_object.size() || map_of_object[object] < 0) return nullptr;
+    return &maps[map_of_object[object]];
+  }
+};
+
+// Specular objects: at least one triangle's material reflects or refracts
+// (is_specular(surface_params(material))).
+ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
+                                    const std::vector<ShadowMap>& shadows,
+                                    const EnvironmentMap& env, int size = 256);
+
+}  // namespace speculum::raster

@@ -1,0 +1,98 @@
+// The `shadow_map` node: see shadow_map.h. Directional lights use a perspective camera far
+// away with a narrow field of view (the rasterizer only has perspective cameras); at 50
+// scene radii its rays are parallel to within about one degree.
+#include "raster/shadow_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "core/camera_rays.h"
+
+namespace speculum::raster {
+namespace {
+
+constexpr float kDirectionalDistance = 50.0f;  // in scene radii
+
+float slope_bias(float texel_world, const glm::vec3& n, const glm::vec3& l) {
+  const float c = std::clamp(glm::dot(n, l), 0.05f, 1.0f);
+  const float tan_theta = std::sqrt(1.0f - c * c) / c;
+  return texel_world * (1.5f + std::min(tan_theta, 8.0f));
+}
+
+}  // namespace
+
+std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& scene, int size) {
+  std::vector<ShadowMap> maps;
+  const Bounds b = scene.bounds();
+  const glm::vec3 centre = b.valid() ? b.center() : glm::vec3(0.0f);
+  const float radius = b.valid() ? std::max(0.5f * glm::length(b.extent()), 1e-3f) : 1.0f;
+  for (const Light& light : scene.lights) {
+    ShadowMap m;
+    m.type = light.type;
+    m.size = size;
+    if (light.type == LightType::Directional) {
+      const glm::vec3 dir = glm::normalize(light.direction);
+      const float dist = kDirectionalDistance * radius;
+      m.camera.name = "shadow " + light.name;
+      m.camera.eye = centre - dir * dist;
+      m.camera.target = centre;
+      m.camera.up = std::abs(dir.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+      m.camera.vfov_degrees = 2.0f * glm::degrees(std::asin(std::min(1.0f, radius / dist))) * 1.02f;
+      m.camera.znear = std::max(dist - 1.5f * radius, 1e-3f);
+      m.camera.zfar = dist + 1.5f * radius;
+      m.view_projection = projection_matrix(m.camera, size, size) * view_matrix(m.camera);
+      const VisibilityBuffer vis = render_visibility(executor, scene, m.camera, size, size);
+      const GBuffer g = resolve_gbuffer(executor, scene, vis, m.camera.eye);
+      m.distance = ImageF(size, size, std::numeric_limits<float>::infinity());
+      for (std::size_t i = 0; i < m.distance.size(); ++i)
+        if (g.covered(i)) m.distance.pixels[i] = glm::length(g.position.pixels[i] - m.camera.eye);
+    } else {
+      CubeMapOptions opt;
+      opt.size = size;
+      opt.znear = 1e-3f * radius;
+      opt.zfar = 4.0f * radius + glm::length(light.position - centre);
+      m.cube = render_cube_map(executor, scene, light.position, opt);
+    }
+    maps.push_back(std::move(m));
+  }
+  return maps;
+}
+
+float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const {
+  const ImageF* img;
+  glm::vec2 pixel;
+  float dist, texel_world;
+  if (type == LightType::Directional) {
+    const glm::vec4 clip = view_projection * glm::vec4(p, 1.0f);
+    if (clip.w <= 0.0f) return 1.0f;
+    pixel = {(clip.x / clip.w * 0.5f + 0.5f) * size, (0.5f - clip.y / clip.w * 0.5f) * size};
+    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= size || pixel.y >= size) return 1.0f;
+    img = &distance;
+    dist = glm::length(p - camera.eye);
+    texel_world = dist * 2.0f * std::tan(glm::radians(camera.vfov_degrees) * 0.5f) / size;
+  } else {
+    const glm::vec3 d = p - cube.centre;
+    dist = glm::length(d);
+    if (dist <= 0.0f) return 1.0f;
+    const CubeCoord c = cube_coord(d, cube.size);
+    img = &cube.distance[c.face];
+    pixel = c.pixel;
+    texel_world = dist * 2.0f / cube.size;
+  }
+  const float biased = dist - slope_bias(texel_world, n, l);
+  const int cx = std::min(static_cast<int>(pixel.x), size - 1);
+  const int cy = std::min(static_cast<int>(pixel.y), size - 1);
+  int lit = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int x = std::clamp(cx + dx, 0, size - 1), y = std::clamp(cy + dy, 0, size - 1);
+      lit += img->at(x, y) >= biased;
+    }
+  return lit / 9.0f;
+}
+
+}  // namespace speculum::raster

@@ -1,0 +1,34 @@
+// The `shadow_map` node: one distance map per light — a distance cube around point and
+// spot lights, one far perspective face along a directional light — and the filtered
+// (3×3 percentage-closer) shadow test the `direct_light` node uses.
+#pragma once
+
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "raster/cube_map.h"
+
+namespace speculum::raster {
+
+struct ShadowMap {
+  LightType type = LightType::Point;
+  int size = 0;
+  CubeMap cube;               // point and spot lights: distance from the light position
+  Camera camera;              // directional lights: the far camera along the light
+  glm::mat4 view_projection{1.0f};
+  ImageF distance;            // directional: |y − camera.eye|
+
+  // Fraction of the 3×3 PCF taps that see point p (unit normal n, unit direction to the
+  // light l) lit, with a slope-scaled bias of about one texel.
+  float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
+};
+
+// One map per scene light, in light order.
+std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& scene,
+                                          int size = 512);
+
+}  // namespace speculum::raster
