@@ -325,6 +325,11 @@ struct Loader {
       auto enter = [&](std::size_t n, const glm::mat4& parent) {
         state[n] = 1;
         const glm::mat4 world = parent * local_transform(model.nodes[n], n);
+        for (int c = 0; c < 4; ++c)
+          for (int r = 0; r < 4; ++r)
+            if (!std::isfinite(world[c][r]))
+              throw InputError(path, "node " + std::to_string(n) +
+                                         " has a world transform that overflows single precision");
         visit(n, world);
         stack.push_back({n, world, 0});
       };

@@ -1,0 +1,91 @@
+// The bad-input corpus (tests/data/bad, made by tests/data/make_corpus.py): every file must
+// be rejected with InputError naming the file — never a crash or another exception.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/scene_loader.h"
+
+namespace speculum {
+namespace {
+
+std::vector<std::string> bad_files() {
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(SPECULUM_TEST_DATA "/bad"))
+    if (e.is_regular_file()) files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(BadInput, CorpusIsComplete) {
+  // Guards against the corpus silently shrinking (each category of the issue is present).
+  const auto files = bad_files();
+  EXPECT_GE(files.size(), 40u);
+  for (const char* needed :
+       {"empty.gltf", "truncated.glb", "invalid_json.gltf", "missing_bin.gltf",
+        "index_out_of_range.gltf", "nan_position.gltf", "inf_position.glb", "missing_texture.gltf",
+        "unsupported_extension.gltf", "unsupported_file_type.xyz", "node_cycle.gltf",
+        "absurd_count.gltf", "absurd_count.ply", "absurd_count.off", "absurd_count.stl",
+        "index_out_of_range.obj", "truncated.stl"})
+    EXPECT_TRUE(std::filesystem::exists(std::string(SPECULUM_TEST_DATA "/bad/") + needed)) << needed;
+}
+
+TEST(BadInput, EveryFileGivesInputErrorNamingIt) {
+  for (const std::string& file : bad_files()) {
+    SCOPED_TRACE(file);
+    try {
+      (void)load_scene(file);
+      ADD_FAILURE() << "loaded without error";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.source(), file);
+      EXPECT_NE(std::string(e.what()).find(file), std::string::npos);
+      EXPECT_FALSE(e.problem().empty());
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "one line";
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "threw a non-InputError: " << e.what();
+    }
+  }
+}
+
+TEST(BadInput, SpecificProblemsAreNamed) {
+  auto problem = [](const std::string& name) {
+    try {
+      (void)load_scene(std::string(SPECULUM_TEST_DATA "/bad/") + name);
+    } catch (const InputError& e) {
+      return e.problem();
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(problem("node_cycle.gltf").find("cycle"), std::string::npos);
+  EXPECT_NE(problem("index_out_of_range.gltf").find("out of range"), std::string::npos);
+  EXPECT_NE(problem("nan_position.gltf").find("NaN or infinite"), std::string::npos);
+  EXPECT_NE(problem("truncated.glb").find("truncated"), std::string::npos);
+  EXPECT_NE(problem("missing_texture.gltf").find("no_such_texture.png"), std::string::npos);
+  EXPECT_NE(problem("unsupported_extension.gltf").find("KHR_draco_mesh_compression"), std::string::npos);
+  EXPECT_NE(problem("absurd_count.gltf").find("absurd"), std::string::npos);
+  EXPECT_NE(problem("empty.glb").find("empty"), std::string::npos);
+}
+
+TEST(BadInput, MissingFileAndUnknownName) {
+  for (const std::string name : {std::string(SPECULUM_TEST_DATA "/bad/no_such_file.glb"),
+                                 std::string("/nonexistent/dir/scene.obj"),
+                                 std::string("no-such-builtin-scene"),
+                                 std::string("sphere-in-room:size=12"),
+                                 std::string("sphere-in-room:size=abc"),
+                                 std::string("sphere-in-room:colour=3"),
+                                 std::string("bumpy-sphere:n=-1")}) {
+    SCOPED_TRACE(name);
+    try {
+      (void)load_scene(name);
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.source(), name);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace speculum
