@@ -58,7 +58,9 @@ struct Tracer {
     const std::uint32_t t = h.triangle;
     const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
     const float w0 = 1.0f - h.u - h.v;
-    const glm::vec3 p = ray.origin + ray.direction * h.t;
+    // The hit point from the barycentrics: its error scales with the triangle's coordinates,
+    // not with the ray's origin (a far camera would otherwise put p on the wrong side).
+    const glm::vec3 p = m.positions[i0] * w0 + m.positions[i1] * h.u + m.positions[i2] * h.v;
     glm::vec3 ng = glm::cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]);
     const float ng_len = glm::length(ng);
     ng = ng_len > 0.0f ? ng / ng_len : -dir;
