@@ -1,0 +1,175 @@
+// Stream-primitive benchmarks (issue 3): scan, both compactions, partition, radix sort and
+// reduce at 1M and 16M elements on 1 and 2 threads, each reporting its GB/s beside a memcpy
+// of the same traffic measured in the same process; plus the ROGER ch.4 block-size sweep.
+// Traffic = bytes the primitive must read + write at minimum; memcpy traffic = 2 × copy size.
+// Counters: GBps (primitive), memcpy_GBps (same traffic, same thread count), Mkeys_s.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <numeric>
+#include <vector>
+
+#include "parallel/compact.h"
+#include "parallel/partition.h"
+#include "parallel/scan.h"
+#include "parallel/stream.h"
+
+namespace {
+using namespace speculum::par;
+
+Executor& executor(int threads) {
+  static Executor one(1), two(2);
+  return threads == 1 ? one : two;
+}
+
+std::uint32_t hash32(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return std::uint32_t((x ^ (x >> 31)) >> 16);
+}
+
+// Median-of-5 memcpy bandwidth (read + write bytes per second) for `traffic` bytes of
+// traffic, run with the same thread count as the primitive (memcpy split in fixed chunks).
+double memcpy_gbps(std::size_t traffic, int threads) {
+  const std::size_t bytes = std::max<std::size_t>(traffic / 2, 64);
+  static std::vector<char> src, dst;
+  if (src.size() < bytes) {
+    src.assign(bytes, 1);
+    dst.assign(bytes, 0);
+  }
+  std::vector<double> secs;
+  for (int r = 0; r < 5; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    executor(threads).parallel_for("memcpy", bytes, 1 << 20, [&](std::size_t b, std::size_t e) {
+      std::memcpy(dst.data() + b, src.data() + b, e - b);
+    });
+    secs.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::nth_element(secs.begin(), secs.begin() + 2, secs.end());
+  return 2.0 * double(bytes) / secs[2] * 1e-9;
+}
+
+void report(benchmark::State& state, std::size_t traffic, int threads, std::size_t keys = 0) {
+  state.SetBytesProcessed(std::int64_t(state.iterations() * traffic));
+  const double mgbps = memcpy_gbps(traffic, threads);
+  state.counters["memcpy_GBps"] = mgbps;
+  state.counters["GBps"] = benchmark::Counter(double(traffic) * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  if (keys) state.counters["Mkeys_s"] = benchmark::Counter(double(keys) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_Memcpy(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  std::vector<std::uint32_t> a(n, 1), b(n);
+  for (auto _ : state) {
+    executor(threads).parallel_for("memcpy", n, kStreamChunk, [&](std::size_t s, std::size_t e) {
+      std::memcpy(b.data() + s, a.data() + s, (e - s) * 4);
+    });
+    benchmark::DoNotOptimize(b.data());
+  }
+  state.counters["GBps"] = benchmark::Counter(double(n) * 8e-9, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_ExclusiveScan(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  std::vector<std::uint32_t> in(n), out(n);
+  for (std::size_t i = 0; i < n; ++i) in[i] = hash32(i) & 7;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(exclusive_scan(executor(threads), "scan", std::span<const std::uint32_t>(in), std::span(out)));
+  }
+  report(state, n * 8, threads);
+}
+
+void BM_Reduce(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  std::vector<float> in(n);
+  for (std::size_t i = 0; i < n; ++i) in[i] = float(hash32(i) & 255);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(reduce(executor(threads), "reduce", std::span<const float>(in), 0.f, std::plus<>()));
+  report(state, n * 4, threads);
+}
+
+std::vector<std::uint8_t> half_flags(std::size_t n) {
+  std::vector<std::uint8_t> f(n);
+  for (std::size_t i = 0; i < n; ++i) f[i] = hash32(i) & 1;
+  return f;
+}
+
+void BM_CompactScatter(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  const auto keep = half_flags(n);
+  std::vector<std::uint32_t> out(n);
+  std::size_t kept = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(kept = compact_scatter(executor(threads), "compact", keep, out));
+  report(state, n + kept * 4, threads);
+}
+
+void BM_CompactHierarchical(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  const std::size_t s = state.range(2);
+  const auto keep = half_flags(n);
+  std::vector<std::uint32_t> out(n), scratch;
+  std::size_t kept = 0;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(kept = compact_hierarchical(executor(threads), "compact_h", keep, out, s, &scratch));
+  report(state, n + kept * 4, threads);
+}
+
+void BM_Partition(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  const std::uint32_t p = 16;
+  std::vector<std::uint32_t> bucket(n), out(n), begin(p + 1);
+  for (std::size_t i = 0; i < n; ++i) bucket[i] = hash32(i) % p;
+  for (auto _ : state) {
+    partition_stable(executor(threads), "partition", bucket, p, out, begin);
+    benchmark::DoNotOptimize(out.data());
+  }
+  report(state, n * 8, threads);
+}
+
+void BM_RadixSort32(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  std::vector<std::uint32_t> original(n), keys(n), payload(n);
+  for (std::size_t i = 0; i < n; ++i) original[i] = hash32(i);
+  RadixSortScratch<std::uint32_t> scratch;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::copy(original.begin(), original.end(), keys.begin());
+    std::iota(payload.begin(), payload.end(), 0u);
+    state.ResumeTiming();
+    radix_sort(executor(threads), "radix", std::span(keys), std::span(payload), &scratch);
+    benchmark::DoNotOptimize(keys.data());
+  }
+  report(state, n * 16, threads, n);  // keys + payload read and written once (minimum)
+}
+
+void sizes_threads(benchmark::internal::Benchmark* b) {
+  for (long n : {1L << 20, 16L << 20})
+    for (long t : {1, 2}) b->Args({n, t});
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+BENCHMARK(BM_Memcpy)->Apply(sizes_threads);
+BENCHMARK(BM_ExclusiveScan)->Apply(sizes_threads);
+BENCHMARK(BM_Reduce)->Apply(sizes_threads);
+BENCHMARK(BM_CompactScatter)->Apply(sizes_threads);
+BENCHMARK(BM_CompactHierarchical)->Apply([](benchmark::internal::Benchmark* b) {
+  for (long n : {1L << 20, 16L << 20})
+    for (long t : {1, 2}) b->Args({n, t, 64});
+  // ROGER ch.4 block-size sweep s = 8 ... 1024 at 16M, 2 threads.
+  for (long s = 8; s <= 1024; s *= 2) b->Args({16L << 20, 2, s});
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+});
+BENCHMARK(BM_Partition)->Apply(sizes_threads);
+BENCHMARK(BM_RadixSort32)->Apply(sizes_threads);
+
+}  // namespace
