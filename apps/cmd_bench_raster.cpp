@@ -1,0 +1,112 @@
+// `speculum bench raster MESH|SCENE --json`: times `visibility` + `gbuffer` K times after a
+// warm-up and prints one JSON object (issue 4 "Benchmark"); per-kernel medians come from the
+// executor's launch records.
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/cli.h"
+#include "apps/pipeline_bench_workloads.h"
+#include "apps/pipeline_camera_options.h"
+#include "core/error.h"
+#include "core/scene_loader.h"
+#include "parallel/lanes.h"
+#include "raster/gbuffer.h"
+#include "raster/visibility.h"
+
+namespace speculum::cli {
+namespace {
+
+struct BenchRasterOptions {
+  std::string scene = "bench:spheres-room";
+  int width = 1920;
+  int height = 1080;
+  int repeat = 10;
+  bool json = false;
+  std::string write_ply;
+  pipeline::CameraOverrides camera;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) {
+  if (global.lanes != 0) par::set_default_lanes(global.lanes);
+  if (o.repeat < 1) throw InputError("--repeat", "must be at least 1");
+  const Scene scene = pipeline::is_bench_workload(o.scene) ? pipeline::make_bench_workload(o.scene)
+                                                           : load_scene(o.scene);
+  if (!o.write_ply.empty()) pipeline::write_ply(o.write_ply, scene);
+  const Camera camera = pipeline::resolve_camera(scene, o.camera);
+  par::Executor executor(global.threads);
+  std::vector<double> frame_ms;
+  std::map<std::string, std::vector<double>> kernel_ms;
+  std::size_t covered = 0;
+  for (int run = 0; run <= o.repeat; ++run) {  // run 0 is the warm-up
+    executor.clear_launches();
+    const auto t0 = executor.now_ns();
+    const raster::VisibilityBuffer vis =
+        raster::render_visibility(executor, scene, camera, o.width, o.height);
+    const raster::GBuffer g = raster::resolve_gbuffer(executor, scene, vis, camera.eye);
+    const auto t1 = executor.now_ns();
+    if (run == 0) {
+      for (std::size_t i = 0; i < g.object.size(); ++i) covered += g.covered(i);
+      continue;
+    }
+    frame_ms.push_back((t1 - t0) * 1e-6);
+    std::map<std::string, double> per_kernel;
+    for (const auto& l : executor.launches()) per_kernel[l.name] += l.duration_ns * 1e-6;
+    for (const auto& [name, ms] : per_kernel) kernel_ms[name].push_back(ms);
+  }
+  const double med = median(frame_ms);
+  const double lo = *std::min_element(frame_ms.begin(), frame_ms.end());
+  const double hi = *std::max_element(frame_ms.begin(), frame_ms.end());
+  const std::size_t triangles = scene.mesh.triangle_count();
+  if (o.json) {
+    std::printf("{\"scene\": \"%s\", \"triangles\": %zu, \"width\": %d, \"height\": %d, "
+                "\"threads\": %d, \"lanes\": %d, \"repeat\": %d, \"ms_median\": %.3f, "
+                "\"ms_min\": %.3f, \"ms_max\": %.3f, \"mtris_per_s\": %.3f, "
+                "\"covered_fraction\": %.4f, \"kernels_ms_median\": {",
+                scene.name.c_str(), triangles, o.width, o.height, executor.threads(),
+                par::default_lanes(), o.repeat, med, lo, hi, triangles / (med * 1e-3) / 1e6,
+                double(covered) / (double(o.width) * o.height));
+    bool first = true;
+    for (const auto& [name, v] : kernel_ms) {
+      std::printf("%s\"%s\": %.3f", first ? "" : ", ", name.c_str(), median(v));
+      first = false;
+    }
+    std::printf("}}\n");
+  } else {
+    std::printf("%s: %zu triangles at %dx%d, %d threads: median %.2f ms (min %.2f, max %.2f), "
+                "%.1f Mtris/s\n",
+                scene.name.c_str(), triangles, o.width, o.height, executor.threads(), med, lo, hi,
+                triangles / (med * 1e-3) / 1e6);
+    for (const auto& [name, v] : kernel_ms) std::printf("  %-22s %8.2f ms\n", name.c_str(), median(v));
+  }
+}
+
+}  // namespace
+
+void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global) {
+  auto o = std::make_shared<BenchRasterOptions>();
+  auto* cmd = bench.add_subcommand(
+      "raster", "Time visibility + gbuffer on a mesh, scene or yardstick workload "
+                "(bench:spheres-room, bench:random-triangles)");
+  cmd->fallthrough();
+  cmd->add_option("scene", o->scene, "PLY/OBJ/glTF file, built-in scene or bench:* workload")
+      ->capture_default_str();
+  cmd->add_option("--width", o->width, "Target width")->check(CLI::Range(1, 16384))->capture_default_str();
+  cmd->add_option("--height", o->height, "Target height")->check(CLI::Range(1, 16384))->capture_default_str();
+  cmd->add_option("--repeat", o->repeat, "Timed repetitions after one warm-up")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print one JSON object");
+  cmd->add_option("--write-ply", o->write_ply, "Also write the triangles as binary PLY");
+  pipeline::add_camera_options(*cmd, o->camera);
+  cmd->callback([o, &global] { run_bench_raster(*o, global); });
+}
+
+}  // namespace speculum::cli
