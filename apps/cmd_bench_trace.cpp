@@ -1,0 +1,337 @@
+// `speculum bench trace`: traces a SPRY ray file against a PLY mesh with our BVH (and with
+// Embree 3 when built with it, in the same run) and prints one JSON object (issue 5
+// "Benchmark against Embree"); `--emit-rays` writes ray files for a camera and
+// `--make-mesh spheres:N` writes the test mesh (N UV-spheres in a box room).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli.h"
+#include "core/error.h"
+#include "core/sampling.h"
+#include "core/scene_loader.h"
+#include "trace/bvh.h"
+#include "trace/ray_file.h"
+#include "trace/ray_generation.h"
+#include "trace/traversal.h"
+
+#ifdef SPECULUM_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+namespace speculum::cli {
+namespace {
+
+struct BenchTraceOptions {
+  std::string mesh;
+  std::string rays;
+  std::string emit;
+  std::string make_mesh;
+  std::string output;
+  int repeat = 5;
+  int width = 1024, height = 1024;
+  std::vector<float> eye, target, up;
+  float fov = 60.0f;
+  std::uint32_t seed = 1;
+  bool json = false;
+  bool no_embree = false;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// N UV-spheres (about 10.2K triangles each) on a grid inside an inward-facing box room,
+// written as binary little-endian PLY.
+void make_spheres_mesh(const std::string& spec, const std::string& path) {
+  const std::string prefix = "spheres:";
+  if (spec.rfind(prefix, 0) != 0) throw InputError("--make-mesh", "expected spheres:N, got '" + spec + "'");
+  int n = 0;
+  try {
+    n = std::stoi(spec.substr(prefix.size()));
+  } catch (...) {
+    throw InputError("--make-mesh", "bad sphere count in '" + spec + "'");
+  }
+  if (n < 1 || n > 10000) throw InputError("--make-mesh", "sphere count must be 1..10000");
+  const int rings = 51, segs = 102;
+  const int grid = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  const float half = 10.0f, spacing = 2.0f * half / grid, radius = 0.45f * spacing;
+  std::vector<glm::vec3> v;
+  std::vector<std::uint32_t> f;
+  for (int s = 0; s < n; ++s) {
+    const glm::vec3 c(-half + spacing * (s % grid + 0.5f), -1.0f, -half + spacing * (s / grid + 0.5f));
+    const auto base = static_cast<std::uint32_t>(v.size());
+    v.push_back(c + glm::vec3(0, radius, 0));
+    for (int r = 1; r < rings; ++r)
+      for (int k = 0; k < segs; ++k) {
+        const float th = kPi * r / rings, ph = 2 * kPi * k / segs;
+        v.push_back(c + radius * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+      }
+    v.push_back(c - glm::vec3(0, radius, 0));
+    auto ring = [&](int r, int k) { return base + 1 + static_cast<std::uint32_t>((r - 1) * segs + k % segs); };
+    const std::uint32_t south = base + 1 + static_cast<std::uint32_t>((rings - 1) * segs);
+    for (int k = 0; k < segs; ++k) {
+      f.insert(f.end(), {base, ring(1, k + 1), ring(1, k)});
+      f.insert(f.end(), {south, ring(rings - 1, k), ring(rings - 1, k + 1)});
+      for (int r = 1; r + 1 < rings; ++r) {
+        f.insert(f.end(), {ring(r, k), ring(r, k + 1), ring(r + 1, k)});
+        f.insert(f.end(), {ring(r, k + 1), ring(r + 1, k + 1), ring(r + 1, k)});
+      }
+    }
+  }
+  // The room: floor, ceiling and four walls, facing inwards.
+  const glm::vec3 lo(-half, -2.0f, -half), hi(half, 6.0f, half);
+  const auto b = static_cast<std::uint32_t>(v.size());
+  for (int i = 0; i < 8; ++i) v.emplace_back(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+  const std::uint32_t quads[6][4] = {{0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& q : quads) {
+    f.insert(f.end(), {b + q[0], b + q[1], b + q[2]});
+    f.insert(f.end(), {b + q[0], b + q[2], b + q[3]});
+  }
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(path, "cannot create mesh file");
+    out << "ply\nformat binary_little_endian 1.0\ncomment speculum bench trace --make-mesh " << spec
+        << "\nelement vertex " << v.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+        << "element face " << f.size() / 3 << "\nproperty list uchar int vertex_indices\nend_header\n";
+    out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(glm::vec3)));
+    for (std::size_t t = 0; t < f.size(); t += 3) {
+      const unsigned char three = 3;
+      out.write(reinterpret_cast<const char*>(&three), 1);
+      out.write(reinterpret_cast<const char*>(&f[t]), 12);
+    }
+    if (!out) throw InputError(path, "write failed");
+  }
+  std::rename(tmp.c_str(), path.c_str());
+  std::printf("%s: %zu vertices, %zu triangles\n", path.c_str(), v.size(), f.size() / 3);
+}
+
+struct Checksum {
+  std::uint64_t hits = 0, prim_sum = 0;
+  double t_sum = 0.0;
+};
+
+Checksum checksum(const trace::HitStream& h) {
+  Checksum c;
+  for (std::size_t i = 0; i < h.triangle.size(); ++i)
+    if (h.triangle[i] != trace::kNoHit) {
+      ++c.hits;
+      c.prim_sum += h.triangle[i];
+      c.t_sum += h.t[i];
+    }
+  return c;
+}
+
+#ifdef SPECULUM_HAVE_EMBREE
+struct EmbreeFigures {
+  double build_ms = 0, mrays1 = 0, mrays16 = 0;
+  Checksum sum;
+};
+
+EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int repeat, par::Executor& ex) {
+  EmbreeFigures fig;
+  const std::string config = "threads=" + std::to_string(ex.threads());
+  RTCDevice device = rtcNewDevice(config.c_str());
+  if (!device) throw std::runtime_error("embree: rtcNewDevice failed");
+  // Embree reads vertices as 16-byte loads: one float of padding after the last vertex.
+  std::vector<float> verts(scene.mesh.positions.size() * 3 + 4, 0.0f);
+  std::memcpy(verts.data(), scene.mesh.positions.data(), scene.mesh.positions.size() * sizeof(glm::vec3));
+  std::vector<double> build;
+  RTCScene rs = nullptr;
+  for (int k = 0; k < repeat; ++k) {
+    if (rs) rtcReleaseScene(rs);
+    rs = rtcNewScene(device);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, verts.data(), 0, 12,
+                               scene.mesh.positions.size());
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, scene.mesh.indices.data(), 0, 12,
+                               scene.mesh.indices.size() / 3);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(rs, g);
+    rtcReleaseGeometry(g);
+    const auto t0 = std::chrono::steady_clock::now();
+    ex.run([&] { rtcCommitScene(rs); });
+    build.push_back(ms_since(t0));
+  }
+  fig.build_ms = median(build);
+  const std::size_t n = rays.size();
+  trace::HitStream hits;
+  hits.resize(n);
+  auto fill = [&](RTCRayHit& rh, std::size_t i) {
+    rh.ray.org_x = rays.ox[i]; rh.ray.org_y = rays.oy[i]; rh.ray.org_z = rays.oz[i];
+    rh.ray.dir_x = rays.dx[i]; rh.ray.dir_y = rays.dy[i]; rh.ray.dir_z = rays.dz[i];
+    rh.ray.tnear = rays.tmin[i]; rh.ray.tfar = rays.tmax[i];
+    rh.ray.mask = 0xffffffffu; rh.ray.time = 0; rh.ray.flags = 0; rh.ray.id = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  };
+  std::vector<double> t1, t16;
+  for (int k = 0; k < repeat; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ex.parallel_for("embree_intersect1", n, trace::kRayChunk, [&](std::size_t b, std::size_t e) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      for (std::size_t i = b; i < e; ++i) {
+        RTCRayHit rh;
+        fill(rh, i);
+        rtcIntersect1(rs, &ctx, &rh);
+        const bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        hits.triangle[i] = hit ? rh.hit.primID : trace::kNoHit;
+        hits.t[i] = hit ? rh.ray.tfar : 0.0f;
+      }
+    });
+    t1.push_back(ms_since(t0));
+  }
+  fig.sum = checksum(hits);
+  for (int k = 0; k < repeat; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ex.parallel_for("embree_intersect16", n, trace::kRayChunk, [&](std::size_t b, std::size_t e) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      for (std::size_t p = b; p < e; p += 16) {
+        alignas(64) RTCRayHit16 rh;
+        alignas(64) int valid[16];
+        for (int l = 0; l < 16; ++l) {
+          const std::size_t i = std::min(p + l, e - 1);
+          valid[l] = p + l < e ? -1 : 0;
+          rh.ray.org_x[l] = rays.ox[i]; rh.ray.org_y[l] = rays.oy[i]; rh.ray.org_z[l] = rays.oz[i];
+          rh.ray.dir_x[l] = rays.dx[i]; rh.ray.dir_y[l] = rays.dy[i]; rh.ray.dir_z[l] = rays.dz[i];
+          rh.ray.tnear[l] = rays.tmin[i]; rh.ray.tfar[l] = rays.tmax[i];
+          rh.ray.mask[l] = 0xffffffffu; rh.ray.time[l] = 0; rh.ray.flags[l] = 0; rh.ray.id[l] = 0;
+          rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, rs, &ctx, &rh);
+        for (int l = 0; l < 16 && p + l < e; ++l) {
+          const bool hit = rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
+          hits.triangle[p + l] = hit ? rh.hit.primID[l] : trace::kNoHit;
+          hits.t[p + l] = hit ? rh.ray.tfar[l] : 0.0f;
+        }
+      }
+    });
+    t16.push_back(ms_since(t0));
+  }
+  fig.mrays1 = static_cast<double>(n) / (median(t1) * 1e3);
+  fig.mrays16 = static_cast<double>(n) / (median(t16) * 1e3);
+  rtcReleaseScene(rs);
+  rtcReleaseDevice(device);
+  return fig;
+}
+#endif
+
+Camera bench_camera(const BenchTraceOptions& o, const Scene& scene) {
+  const Bounds b = scene.bounds();
+  const glm::vec3 c = b.center(), e = b.extent();
+  Camera cam;
+  cam.eye = c + glm::vec3(0.0f, 0.25f * e.y, 0.475f * e.z);
+  cam.target = c + glm::vec3(0.0f, -0.125f * e.y, 0.0f);
+  if (o.eye.size() == 3) cam.eye = {o.eye[0], o.eye[1], o.eye[2]};
+  if (o.target.size() == 3) cam.target = {o.target[0], o.target[1], o.target[2]};
+  if (o.up.size() == 3) cam.up = {o.up[0], o.up[1], o.up[2]};
+  cam.vfov_degrees = o.fov;
+  return cam;
+}
+
+void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
+  if (!o.make_mesh.empty()) {
+    const std::string out = !o.output.empty() ? o.output : o.mesh;
+    if (out.empty()) throw InputError("--make-mesh", "give the output file with -o");
+    make_spheres_mesh(o.make_mesh, out);
+    return;
+  }
+  if (o.mesh.empty()) throw InputError("bench trace", "no MESH given");
+  par::Executor ex(global.threads);
+  const Scene scene = load_scene(o.mesh);
+  if (!o.emit.empty()) {
+    const trace::RaySetKind kind = trace::parse_ray_set_kind(o.emit);
+    if (o.output.empty()) throw InputError("--emit-rays", "give the output ray file with -o");
+    const trace::Bvh bvh = trace::Bvh::build(scene.mesh, ex);
+    const trace::RayStream rays = trace::generate_rays(kind, bvh, bench_camera(o, scene), o.width, o.height, o.seed, ex);
+    trace::write_ray_file(o.output, rays);
+    if (!global.quiet) std::fprintf(stderr, "%s: %zu %s rays\n", o.output.c_str(), rays.size(), o.emit.c_str());
+    return;
+  }
+  if (o.rays.empty()) throw InputError("bench trace", "no --rays FILE given (or use --emit-rays)");
+  const trace::RayStream rays = trace::read_ray_file(o.rays);
+  const int repeat = std::max(1, o.repeat);
+
+  std::vector<double> build_ms, trace_ms;
+  trace::Bvh bvh;
+  for (int k = 0; k < repeat; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    bvh = trace::Bvh::build(scene.mesh, ex);
+    build_ms.push_back(ms_since(t0));
+  }
+  trace::HitStream hits;
+  trace::TraversalCounters counters;
+  for (int k = 0; k < repeat; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    trace::closest_hit_stream(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
+    trace_ms.push_back(ms_since(t0));
+  }
+  const Checksum sum = checksum(hits);
+  const double mrays = static_cast<double>(rays.size()) / (median(trace_ms) * 1e3);
+  std::printf("{\"mesh\": \"%s\", \"rays_file\": \"%s\", \"triangles\": %zu, \"rays\": %zu, \"threads\": %d, "
+              "\"repeat\": %d, \"build_ms\": %.3f, \"mrays_per_s\": %.3f, \"hits\": %llu, \"prim_sum\": %llu, "
+              "\"t_sum\": %.6f, \"nodes_per_ray\": %.2f, \"triangle_tests_per_ray\": %.2f, \"stack_overflows\": %llu",
+              o.mesh.c_str(), o.rays.c_str(), scene.mesh.triangle_count(), rays.size(), ex.threads(), repeat,
+              median(build_ms), mrays, static_cast<unsigned long long>(sum.hits),
+              static_cast<unsigned long long>(sum.prim_sum), sum.t_sum,
+              static_cast<double>(counters.nodes_visited) / std::max<double>(1.0, rays.size()),
+              static_cast<double>(counters.triangle_tests) / std::max<double>(1.0, rays.size()),
+              static_cast<unsigned long long>(counters.stack_overflows));
+#ifdef SPECULUM_HAVE_EMBREE
+  if (!o.no_embree) {
+    const EmbreeFigures e = run_embree(scene, rays, repeat, ex);
+    std::printf(", \"embree\": {\"version\": \"%d.%d.%d\", \"build_ms\": %.3f, \"mrays_per_s_intersect1\": %.3f, "
+                "\"mrays_per_s_intersect16\": %.3f, \"hits\": %llu, \"prim_sum\": %llu, \"t_sum\": %.6f}, "
+                "\"ratio_vs_intersect1\": %.3f, \"ratio_vs_intersect16\": %.3f, \"build_ratio\": %.3f",
+                RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, e.build_ms, e.mrays1, e.mrays16,
+                static_cast<unsigned long long>(e.sum.hits), static_cast<unsigned long long>(e.sum.prim_sum),
+                e.sum.t_sum, mrays / e.mrays1, mrays / e.mrays16, median(build_ms) / e.build_ms);
+  }
+#endif
+  std::printf("}\n");
+}
+
+}  // namespace
+
+void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global) {
+  auto opt = std::make_shared<BenchTraceOptions>();
+  CLI::App* cmd = bench.add_subcommand(
+      "trace",
+      "Trace a SPRY ray file against a PLY mesh (ours, and Embree when built with it); print JSON.\n"
+      "  speculum bench trace --make-mesh spheres:100 -o spheres.ply\n"
+      "  speculum bench trace spheres.ply --emit-rays primary -o primary.spry\n"
+      "  speculum --threads 2 bench trace spheres.ply --rays primary.spry --repeat 5 --json");
+  cmd->add_option("mesh", opt->mesh, "Mesh file (PLY, OBJ, OFF, STL) or built-in scene");
+  cmd->add_option("--rays", opt->rays, "SPRY ray file to trace");
+  cmd->add_option("--repeat", opt->repeat, "Runs; medians are reported")->check(CLI::Range(1, 1000))->capture_default_str();
+  cmd->add_flag("--json", opt->json, "Print one JSON object (the only output format)");
+  cmd->add_option("--emit-rays", opt->emit, "Write a ray file instead: primary, reflect-cone30 or hemisphere");
+  cmd->add_option("--make-mesh", opt->make_mesh, "Write a test mesh instead: spheres:N (N UV-spheres in a box room)");
+  cmd->add_option("-o,--output", opt->output, "Output file of --emit-rays / --make-mesh");
+  cmd->add_option("--width", opt->width, "Image width for --emit-rays")->check(CLI::Range(1, 65536))->capture_default_str();
+  cmd->add_option("--height", opt->height, "Image height for --emit-rays")->check(CLI::Range(1, 65536))->capture_default_str();
+  cmd->add_option("--eye", opt->eye, "Camera eye x y z (default: inside the mesh bounds)")->expected(3);
+  cmd->add_option("--target", opt->target, "Camera target x y z")->expected(3);
+  cmd->add_option("--up", opt->up, "Camera up x y z")->expected(3);
+  cmd->add_option("--fov", opt->fov, "Vertical field of view, degrees")->check(CLI::Range(0.01, 179.0))->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Seed of the secondary ray directions")->capture_default_str();
+  cmd->add_flag("--no-embree", opt->no_embree, "Skip the Embree comparison");
+  cmd->callback([opt, &global] { run_bench_trace(*opt, global); });
+}
+
+}  // namespace speculum::cli
