@@ -1,9 +1,11 @@
 // speculum: render, inspect, profile and compare GPU reflection techniques on the CPU.
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "apps/cli.h"
 #include "core/error.h"
+#include "parallel/lanes.h"
 
 int main(int argc, char** argv) {
   using namespace speculum;
@@ -20,6 +22,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--lanes", global.lanes, "SIMD lane width 1, 4, 8 or 16 (0: widest built)")
       ->check(CLI::IsMember({0, 1, 4, 8, 16}))
+      ->each([](const std::string& w) { par::set_default_lanes(std::stoi(w)); })
       ->capture_default_str();
   app.add_flag("--quiet,-q", global.quiet, "No progress output on stderr");
 
