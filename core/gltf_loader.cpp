@@ -468,6 +468,8 @@ Scene load_gltf(const std::string& path, LoadReport* report) {
   scene.name = path;
   Loader loader{path, model, scene, report, gltf::MaterialTable(path, model, scene), {}, {}, 0};
 
+  // Materials in file order (not order of use), so indices match the file's.
+  for (std::size_t i = 0; i < model.materials.size(); ++i) loader.materials.scene_material(static_cast<int>(i));
   std::vector<int> roots;
   if (!model.scenes.empty()) {
     int s = model.defaultScene >= 0 ? model.defaultScene : 0;

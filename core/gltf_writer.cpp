@@ -144,17 +144,18 @@ struct Writer {
 
   void add_object(const Object& obj) {
     const auto& mesh = scene.mesh;
-    // Each object gets its own vertex set: global vertices in order of first use.
-    std::unordered_map<std::uint32_t, std::uint32_t> local;
-    std::vector<std::uint32_t> order, indices;
+    // Each object gets its own vertex set: the global vertices it uses, in their original
+    // order (so a scene whose objects own contiguous vertex ranges round-trips bit-exactly).
     const std::size_t first = obj.first_triangle, count = obj.triangle_count;
-    for (std::size_t t = first; t < first + count; ++t)
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t g = mesh.indices[3 * t + static_cast<std::size_t>(k)];
-        auto [it, fresh] = local.emplace(g, static_cast<std::uint32_t>(order.size()));
-        if (fresh) order.push_back(g);
-        indices.push_back(it->second);
-      }
+    std::vector<std::uint32_t> order(mesh.indices.begin() + static_cast<std::ptrdiff_t>(3 * first),
+                                     mesh.indices.begin() + static_cast<std::ptrdiff_t>(3 * (first + count)));
+    std::sort(order.begin(), order.end());
+    order.erase(std::unique(order.begin(), order.end()), order.end());
+    std::unordered_map<std::uint32_t, std::uint32_t> local;
+    for (std::size_t i = 0; i < order.size(); ++i) local.emplace(order[i], static_cast<std::uint32_t>(i));
+    std::vector<std::uint32_t> indices;
+    indices.reserve(3 * count);
+    for (std::size_t i = 3 * first; i < 3 * (first + count); ++i) indices.push_back(local.at(mesh.indices[i]));
     std::vector<glm::vec3> pos, nrm;
     std::vector<glm::vec2> uv0, uv1;
     std::vector<glm::vec4> tan;

@@ -29,6 +29,16 @@ void orient_outward(MeshData& m, const glm::vec3& center) {
   for (auto& n : m.normals) n = -n;
 }
 
+// Direction on the unit sphere for grid coordinates (u: longitude, v: 0 south to 1 north
+// pole). The poles are exact: float sin(pi) is not 0, which would leave the pole triangles
+// as slivers with random orientation instead of exactly degenerate.
+glm::vec3 unit_direction(float u, float v) {
+  const float phi = 2.0f * kPi * u, theta = kPi * (1.0f - v);
+  if (v <= 0.0f) return {0.0f, -1.0f, 0.0f};
+  if (v >= 1.0f) return {0.0f, 1.0f, 0.0f};
+  return {std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)};
+}
+
 }  // namespace
 
 MeshData parametric_grid(int nu, int nv, const std::function<glm::vec3(float, float)>& p) {
@@ -90,9 +100,7 @@ MeshData box(const glm::vec3& lo, const glm::vec3& hi, int n, bool inward, float
 
 MeshData sphere(const glm::vec3& center, float radius, int rings) {
   MeshData m = parametric_grid(2 * rings, rings, [&](float u, float v) {
-    const float phi = 2.0f * kPi * u, theta = kPi * (1.0f - v);
-    return center + radius * glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                       -std::sin(theta) * std::sin(phi));
+    return center + radius * unit_direction(u, v);
   });
   m.normals.reserve(m.positions.size());
   for (const auto& p : m.positions) m.normals.push_back(glm::normalize(p - center));
@@ -101,9 +109,7 @@ MeshData sphere(const glm::vec3& center, float radius, int rings) {
 
 MeshData bumpy_sphere(const glm::vec3& center, float radius, float amplitude, float n, int rings) {
   MeshData m = parametric_grid(2 * rings, rings, [&](float u, float v) {
-    const float phi = 2.0f * kPi * u, theta = kPi * (1.0f - v);
-    const glm::vec3 d(std::sin(theta) * std::cos(phi), std::cos(theta),
-                      -std::sin(theta) * std::sin(phi));
+    const glm::vec3 d = unit_direction(u, v);
     // Displacement as a function of the direction itself: continuous at poles and seam.
     const float r = radius * (1.0f + amplitude * std::cos(n * d.x) * std::cos(n * d.y));
     return center + r * d;
