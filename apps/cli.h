@@ -21,5 +21,6 @@ void add_techniques_command(CLI::App& app, GlobalOptions& global);
 // `bench` parent (apps/cmd_bench.cpp) and its children, one per cmd_bench_*.cpp.
 void add_bench_command(CLI::App& app, GlobalOptions& global);
 void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global);
+void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global);
 
 }  // namespace speculum::cli

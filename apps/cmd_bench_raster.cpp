@@ -97,7 +97,10 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global) {
   auto* cmd = bench.add_subcommand(
       "raster", "Time visibility + gbuffer on a mesh, scene or yardstick workload "
                 "(bench:spheres-room, bench:random-triangles)");
+  // Global options (--threads, --lanes) may follow the subcommand: let them fall through
+  // `raster` and `bench` to the top-level app.
   cmd->fallthrough();
+  bench.fallthrough();
   cmd->add_option("scene", o->scene, "PLY/OBJ/glTF file, built-in scene or bench:* workload")
       ->capture_default_str();
   cmd->add_option("--width", o->width, "Target width")->check(CLI::Range(1, 16384))->capture_default_str();
