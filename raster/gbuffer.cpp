@@ -35,20 +35,32 @@ glm::vec3 apply_normal_map(const Scene& scene, const Material& m, const glm::vec
   return ml > 1e-8f ? mapped / ml : n;
 }
 
+template <class T>
+void ensure_size(Buffer2D<T>& b, int width, int height) {
+  if (b.width != width || b.height != height) b = Buffer2D<T>(width, height);
+}
+
 }  // namespace
 
 GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
                         const glm::vec3& eye) {
   GBuffer g;
-  g.width = vis.width;
-  g.height = vis.height;
-  g.object = vis.object;
-  g.position = Buffer2D<glm::vec3>(vis.width, vis.height);
-  g.normal = Buffer2D<glm::vec3>(vis.width, vis.height);
-  g.view = Buffer2D<glm::vec3>(vis.width, vis.height);
-  g.uv = Buffer2D<glm::vec2>(vis.width, vis.height);
-  g.surface = Buffer2D<SurfaceParams>(vis.width, vis.height);
-  g.reflector = IdBuffer(vis.width, vis.height, kNoId);
+  resolve_gbuffer(executor, scene, vis, eye, g);
+  return g;
+}
+
+void resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
+                     const glm::vec3& eye, GBuffer& g) {
+  const int w = vis.width, h = vis.height;
+  g.width = w;
+  g.height = h;
+  ensure_size(g.object, w, h);
+  ensure_size(g.position, w, h);
+  ensure_size(g.normal, w, h);
+  ensure_size(g.view, w, h);
+  ensure_size(g.uv, w, h);
+  ensure_size(g.surface, w, h);
+  ensure_size(g.reflector, w, h);
   const TriangleMesh& m = scene.mesh;
   const bool has_uv1 = !m.uvs1.empty();
   const bool has_tangents = !m.tangents.empty();
@@ -56,7 +68,11 @@ GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visib
                         [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t t = vis.triangle.pixels[i];
-      if (t == kNoId) continue;
+      g.object.pixels[i] = vis.object.pixels[i];
+      if (t == kNoId) {
+        g.reflector.pixels[i] = kNoId;
+        continue;
+      }
       const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1],
                           i2 = m.indices[3 * t + 2];
       const glm::vec2 b = vis.bary.pixels[i];
@@ -89,7 +105,6 @@ GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visib
       g.reflector.pixels[i] = is_specular(s) ? vis.object.pixels[i] : kNoId;
     }
   });
-  return g;
 }
 
 ImageF specular_level_image(const GBuffer& g) {

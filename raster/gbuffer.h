@@ -34,6 +34,10 @@ struct GBuffer {
 
 GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
                         const glm::vec3& eye);
+// The same into `out`, reusing its memory when the size is unchanged (only covered samples
+// and the object/reflector ids are rewritten: other fields are undefined on background).
+void resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
+                     const glm::vec3& eye, GBuffer& out);
 
 // The scalar views of the G-buffer for inspection: specular level (max of F0 for
 // non-diffuse surfaces, 0 otherwise) and glossiness (Phong exponent).

@@ -18,6 +18,8 @@ constexpr int kTilePixels = kTileSize * kTileSize;
 // The winner so far of every sample of one tile (the early depth test's state).
 struct TileScratch {
   float inv_w[kTilePixels];
+  float p1[kTilePixels], p2[kTilePixels];  // the winner's perspective weights (eager, so the
+                                           // resolve needs no edge functions)
   std::uint32_t triangle[kTilePixels];
   const SetupTriangle* setup[kTilePixels];
   const ClipMap* clip_map[kTilePixels];
@@ -96,13 +98,16 @@ void raster_rect(const Edges& e, const SetupTriangle& t, const ClipMap* map, int
       if (!any) continue;
       for (int l = 0; l < W; ++l) {
         if (!covered[l]) continue;
-        const float inv_w = weights(e, v0[l], v1[l], v2[l]).inv_w;
+        const Weights w = weights(e, v0[l], v1[l], v2[l]);
+        const float inv_w = w.inv_w;
         const int idx = (y - oy) * kTileSize + (x + l - ox);
         if (s.count_coverage) ++s.coverage[idx];
         // Nearer = larger 1/w; equal depth: the lower triangle index wins, so the result
         // does not depend on submission order.
         if (inv_w > s.inv_w[idx] || (inv_w == s.inv_w[idx] && t.triangle < s.triangle[idx])) {
           s.inv_w[idx] = inv_w;
+          s.p1[idx] = w.p1;
+          s.p2[idx] = w.p2;
           s.triangle[idx] = t.triangle;
           s.setup[idx] = &t;
           s.clip_map[idx] = map;
@@ -180,17 +185,17 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
         out.bary.pixels[o] = glm::vec2(0.0f);
         continue;
       }
-      const Edges e = make_edges(*t);
-      const Weights w = weights(e, edge_at(e, 0, x, y), edge_at(e, 1, x, y), edge_at(e, 2, x, y));
-      float b0 = w.p0 / w.inv_w, b1 = w.p1 / w.inv_w, b2 = w.p2 / w.inv_w;
+      const float inv_w = s.inv_w[idx];
+      float b1 = s.p1[idx] / inv_w, b2 = s.p2[idx] / inv_w;
       if (t->swapped) std::swap(b1, b2);
       if (const ClipMap* m = s.clip_map[idx]) {
+        const float b0 = 1.0f - b1 - b2;
         const glm::vec3 b = b0 * m->bary[0] + b1 * m->bary[1] + b2 * m->bary[2];
         b1 = b.y, b2 = b.z;
       }
       out.triangle.pixels[o] = t->triangle;
       out.object.pixels[o] = triangle_object[t->triangle];
-      out.depth.pixels[o] = 1.0f / w.inv_w;
+      out.depth.pixels[o] = 1.0f / inv_w;
       out.bary.pixels[o] = glm::vec2(b1, b2);
     }
   }

@@ -30,25 +30,31 @@ int cull_sign(CullMode mode) {
   return mode == CullMode::Back ? 1 : mode == CullMode::Front ? -1 : 0;
 }
 
+template <class T>
+void ensure_size(Buffer2D<T>& b, int width, int height) {
+  if (b.width != width || b.height != height) b = Buffer2D<T>(width, height);
+}
+
 }  // namespace
 
-VisibilityBuffer rasterize_screen_vertices(par::Executor& executor,
-                                           const std::vector<ScreenVertex>& vertices,
-                                           const std::vector<std::uint32_t>& indices,
-                                           const std::vector<std::uint32_t>& triangle_object,
-                                           int width, int height,
-                                           const RasterOptions& options) {
+void rasterize_screen_vertices(par::Executor& executor, const std::vector<ScreenVertex>& vertices,
+                               const std::vector<std::uint32_t>& indices,
+                               const std::vector<std::uint32_t>& triangle_object, int width,
+                               int height, const RasterOptions& options,
+                               std::vector<BinnedChunk>& chunks, VisibilityBuffer& out) {
   check_target_size(width, height);
   const int lanes = options.lanes == 0 ? par::default_lanes() : options.lanes;
   const Viewport vp{width, height};
   const TileGrid grid = make_tile_grid(width, height);
   const std::size_t triangles = indices.size() / 3;
-  std::vector<BinnedChunk> chunks((triangles + kTriangleChunk - 1) / kTriangleChunk);
+  chunks.resize((triangles + kTriangleChunk - 1) / kTriangleChunk);
   const auto& excluded = options.excluded_objects;
   const int cull = cull_sign(options.cull);
   executor.parallel_for(
       "raster.setup_bin", triangles, kTriangleChunk, [&](std::size_t begin, std::size_t end) {
         BinnedChunk& chunk = chunks[begin / kTriangleChunk];
+        chunk.triangles.clear();
+        chunk.clip_maps.clear();
         chunk.triangles.reserve(end - begin);
         for (std::size_t t = begin; t < end; ++t) {
           if (!excluded.empty()) {
@@ -63,41 +69,63 @@ VisibilityBuffer rasterize_screen_vertices(par::Executor& executor,
         bin_chunk(chunk, grid);
       });
 
-  VisibilityBuffer out;
   out.width = width;
   out.height = height;
-  out.triangle = IdBuffer(width, height, kNoId);
-  out.object = IdBuffer(width, height, kNoId);
-  out.depth = ImageF(width, height);
-  out.bary = Buffer2D<glm::vec2>(width, height);
-  if (options.count_coverage) out.coverage = IdBuffer(width, height, 0u);
+  ensure_size(out.triangle, width, height);
+  ensure_size(out.object, width, height);
+  ensure_size(out.depth, width, height);
+  ensure_size(out.bary, width, height);
+  if (options.count_coverage) ensure_size(out.coverage, width, height);
+  else out.coverage = IdBuffer();
   executor.parallel_for("raster.tiles", static_cast<std::size_t>(grid.count()), 1,
                         [&](std::size_t begin, std::size_t end) {
                           for (std::size_t tile = begin; tile < end; ++tile)
                             rasterize_tile(static_cast<int>(tile), lanes, grid, vp, chunks,
                                            triangle_object, out);
                         });
+}
+
+VisibilityBuffer rasterize_screen_vertices(par::Executor& executor,
+                                           const std::vector<ScreenVertex>& vertices,
+                                           const std::vector<std::uint32_t>& indices,
+                                           const std::vector<std::uint32_t>& triangle_object,
+                                           int width, int height,
+                                           const RasterOptions& options) {
+  std::vector<BinnedChunk> chunks;
+  VisibilityBuffer out;
+  rasterize_screen_vertices(executor, vertices, indices, triangle_object, width, height, options,
+                            chunks, out);
   return out;
 }
 
-VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,
-                                   const Camera& camera, int width, int height,
-                                   const RasterOptions& options) {
+void render_visibility(par::Executor& executor, const Scene& scene, const Camera& camera,
+                       int width, int height, const RasterOptions& options,
+                       RasterWorkspace& workspace, VisibilityBuffer& out) {
   check_target_size(width, height);
   validate_camera(camera, scene.name);
   const Viewport vp{width, height};
   const glm::mat4 view_projection =
       projection_matrix(camera, width, height) * view_matrix(camera);
   const TriangleMesh& mesh = scene.mesh;
-  std::vector<ScreenVertex> vertices(mesh.vertex_count());
+  auto& vertices = workspace.vertices;
+  vertices.resize(mesh.vertex_count());
   executor.parallel_for("raster.vertices", vertices.size(), kVertexChunk,
                         [&](std::size_t begin, std::size_t end) {
                           for (std::size_t i = begin; i < end; ++i)
                             vertices[i] = make_screen_vertex(
                                 view_projection * glm::vec4(mesh.positions[i], 1.0f), vp);
                         });
-  return rasterize_screen_vertices(executor, vertices, mesh.indices, mesh.triangle_object, width,
-                                   height, options);
+  rasterize_screen_vertices(executor, vertices, mesh.indices, mesh.triangle_object, width, height,
+                            options, workspace.chunks, out);
+}
+
+VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,
+                                   const Camera& camera, int width, int height,
+                                   const RasterOptions& options) {
+  RasterWorkspace workspace;
+  VisibilityBuffer out;
+  render_visibility(executor, scene, camera, width, height, options, workspace, out);
+  return out;
 }
 
 }  // namespace speculum::raster

@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "core/scene.h"
 #include "parallel/executor.h"
+#include "raster/tile_binning.h"
 #include "raster/triangle_setup.h"
 
 namespace speculum::raster {
@@ -52,6 +53,18 @@ VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,
                                    const Camera& camera, int width, int height,
                                    const RasterOptions& options = {});
 
+// Memory kept between frames (transformed vertices, per-chunk bins) so repeated renders
+// do not allocate and fault in fresh pages every frame.
+struct RasterWorkspace {
+  std::vector<ScreenVertex> vertices;
+  std::vector<BinnedChunk> chunks;
+};
+
+// As above, reusing `workspace` and `out` (resized only when the size changes).
+void render_visibility(par::Executor& executor, const Scene& scene, const Camera& camera,
+                       int width, int height, const RasterOptions& options,
+                       RasterWorkspace& workspace, VisibilityBuffer& out);
+
 // The same after the vertex stage: rasterizes triangles given by already transformed and
 // snapped vertices (tests use it to place vertices exactly on sample centres).
 VisibilityBuffer rasterize_screen_vertices(par::Executor& executor,
@@ -60,5 +73,10 @@ VisibilityBuffer rasterize_screen_vertices(par::Executor& executor,
                                            const std::vector<std::uint32_t>& triangle_object,
                                            int width, int height,
                                            const RasterOptions& options = {});
+void rasterize_screen_vertices(par::Executor& executor, const std::vector<ScreenVertex>& vertices,
+                               const std::vector<std::uint32_t>& indices,
+                               const std::vector<std::uint32_t>& triangle_object, int width,
+                               int height, const RasterOptions& options,
+                               std::vector<BinnedChunk>& chunks, VisibilityBuffer& out);
 
 }  // namespace speculum::raster
