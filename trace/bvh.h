@@ -1,7 +1,7 @@
 // The bounding volume hierarchy over the scene's triangle soup: a binned-SAH binary tree
 // built in parallel and deterministically (same bytes for any thread count), from which
-// two traversal layouts are derived: a 4-wide layout (children tested together in
-// Lanes<4>) and the threaded layout of YU §3 / [CHCH06] (hit and miss links, stackless
+// two traversal layouts are derived: an 8-wide layout (children tested together in
+// Lanes<8>, leaves of up to 4 triangles tested together in Lanes<4>) and the threaded layout of YU §3 / [CHCH06] (hit and miss links, stackless
 // traversal in a fixed order) that the LOD tracer extends. Refit keeps the topology and
 // recomputes the boxes for moved vertices.
 #pragma once
@@ -29,7 +29,7 @@ struct Aabb {
 
 struct BvhBuildOptions {
   int bins = 16;               // SAH bins per axis
-  int max_leaf_size = 4;       // a leaf never holds more (at most 15)
+  int max_leaf_size = 4;       // ranges this small become leaves (at most 16)
   float traversal_cost = 1.0f;  // SAH costs relative to one triangle test
   float triangle_cost = 1.0f;
 };
@@ -43,17 +43,28 @@ struct BinaryNode {
   bool is_leaf() const { return count != 0; }
 };
 
-// One node of the 4-wide layout: child boxes as structure of arrays, tested in lanes.
-// A child reference is an inner node index, a leaf (kLeafBit | first << 4 | count), or
-// kEmptyChild (its box is inverted so it never hits).
-struct alignas(64) Wide4Node {
-  float lo_x[4], lo_y[4], lo_z[4];
-  float hi_x[4], hi_y[4], hi_z[4];
-  std::uint32_t child[4];
+// One node of the 8-wide layout: child boxes as structure of arrays, tested in lanes.
+// A child reference is an inner node index, a leaf (kLeafBit | first_pack << 2 |
+// (pack_count - 1)), or kEmptyChild (its box is inverted, so the sign-selected slab test
+// always misses it).
+constexpr int kWideArity = 8;
+struct alignas(64) WideNode {
+  float lo_x[kWideArity], lo_y[kWideArity], lo_z[kWideArity];
+  float hi_x[kWideArity], hi_y[kWideArity], hi_z[kWideArity];
+  std::uint32_t child[kWideArity];
 };
 constexpr std::uint32_t kLeafBit = 0x80000000u;
 constexpr std::uint32_t kEmptyChild = 0xffffffffu;
-constexpr std::uint32_t kMaxTriangles = 1u << 27;  // leaf references keep 27 bits of `first`
+constexpr std::uint32_t kMaxTriangles = 1u << 28;  // leaf references keep 29 bits of the pack
+
+// Up to 4 leaf triangles as structure of arrays, intersected together; unused lanes hold
+// NaN vertices (never a hit) and id kEmptyChild.
+struct alignas(64) TrianglePack {
+  float ax[4], ay[4], az[4];
+  float bx[4], by[4], bz[4];
+  float cx[4], cy[4], cz[4];
+  std::uint32_t id[4];
+};
 
 // One node of the threaded layout (depth-first order): on a box hit continue at `hit`
 // (the left child of an inner node; for a leaf the same as `miss`), on a miss at `miss`
@@ -98,7 +109,8 @@ class Bvh {
 
   std::size_t triangle_count() const { return triangle_id_.size(); }
   const std::vector<BinaryNode>& binary_nodes() const { return binary_; }
-  const std::vector<Wide4Node>& wide_nodes() const { return wide_; }
+  const std::vector<WideNode>& wide_nodes() const { return wide_; }
+  const std::vector<TrianglePack>& triangle_packs() const { return packs_; }
   const std::vector<ThreadedNode>& threaded_nodes() const { return threaded_; }
   const std::vector<LeafTriangle>& leaf_triangles() const { return triangles_; }
   // Original triangle index of each leaf slot.
@@ -114,7 +126,8 @@ class Bvh {
   void derive_layouts();
 
   std::vector<BinaryNode> binary_;
-  std::vector<Wide4Node> wide_;
+  std::vector<WideNode> wide_;
+  std::vector<TrianglePack> packs_;
   std::vector<ThreadedNode> threaded_;
   std::vector<LeafTriangle> triangles_;
   std::vector<std::uint32_t> triangle_id_;

@@ -1,13 +1,13 @@
 // Binned-SAH BVH construction (the classic binned SAH sweep), parallel and deterministic:
 // large ranges are split one at a time with binning parallelized over fixed chunks (bins
-// combine by min/max/count, which are exact in any order), then the remaining subtrees are
-// built independently in a fixed task order and spliced depth-first, so node indices never
-// depend on the schedule. See bvh.h.
+// combine by min/max/count, exact in any order), then the remaining subtrees are built
+// independently in a fixed task order and spliced depth-first, so node indices never
+// depend on the schedule. Primitive references carry their boxes, so every pass streams
+// memory contiguously. See bvh.h.
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 
 #include "core/error.h"
 #include "trace/bvh.h"
@@ -30,15 +30,25 @@ float Aabb::half_area() const {
 
 namespace {
 
-constexpr int kMaxBins = 64;
-constexpr std::size_t kParallelRange = 1u << 14;  // ranges above this are split at top level
+constexpr int kMaxBins = 32;
+constexpr std::size_t kParallelRange = 1u << 15;  // ranges above this are split at top level
 constexpr std::size_t kBinChunk = 1u << 14;
 constexpr std::size_t kPrimChunk = 1u << 14;
 
+// A triangle's box and id; the centroid is taken as lo + hi (twice the centre: only its
+// order along an axis matters, and it saves a multiply).
+struct PrimRef {
+  glm::vec3 lo;
+  std::uint32_t id;
+  glm::vec3 hi;
+  std::uint32_t pad;
+  glm::vec3 centroid2() const { return lo + hi; }
+};
+
 struct TempNode {
   Aabb box;
-  std::uint32_t first = 0, count = 0;      // leaf range in the order array (count > 0)
-  std::int64_t left = -1, right = -1;      // children: >= 0 within the same node list;
+  std::uint32_t first = 0, count = 0;            // leaf range in the ref array (count > 0)
+  std::int64_t left = -1, right = -1;            // children within the same node list
   std::int64_t left_task = -1, right_task = -1;  // or the root of a subtree task's list
 };
 
@@ -46,134 +56,145 @@ struct Bin {
   Aabb box;
   std::uint32_t count = 0;
 };
+using Bins = std::array<std::array<Bin, kMaxBins>, 3>;
 
-struct BuildInput {
-  const std::vector<Aabb>* prim_box;
-  const std::vector<glm::vec3>* centroid;
-  BvhBuildOptions opt;
+struct Range {
+  std::uint32_t begin, end;
+  Aabb box, cbox;  // bounds of the triangles and of their (doubled) centroids
 };
 
-struct Split {
-  int axis = -1;
-  int bin = 0;  // left side: bins [0, bin]
-  float cost = 0;
-};
-
-inline int bin_of(float c, float lo, float scale, int bins) {
-  const int i = static_cast<int>((c - lo) * scale);
-  return std::clamp(i, 0, bins - 1);
-}
-
-// Centroid bounds and box of order[begin, end).
-void range_bounds(const BuildInput& in, const std::uint32_t* order, std::size_t n, Aabb& box, Aabb& cbox) {
-  for (std::size_t i = 0; i < n; ++i) {
-    box.grow((*in.prim_box)[order[i]]);
-    cbox.grow((*in.centroid)[order[i]]);
+struct Binner {
+  glm::vec3 lo, scale;
+  int bins;
+  Binner(const Aabb& cbox, int nbins) : lo(cbox.lo), bins(nbins) {
+    const glm::vec3 ext = cbox.hi - cbox.lo;
+    for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? static_cast<float>(nbins) * (1.0f - 1e-6f) / ext[a] : 0.0f;
   }
-}
+  int bin(const glm::vec3& c, int a) const {
+    return std::clamp(static_cast<int>((c[a] - lo[a]) * scale[a]), 0, bins - 1);
+  }
+};
 
-void bin_range(const BuildInput& in, const std::uint32_t* order, std::size_t n, const Aabb& cbox,
-               int bins, Bin (&out)[3][kMaxBins]) {
-  for (int a = 0; a < 3; ++a) {
-    const float ext = cbox.hi[a] - cbox.lo[a];
-    if (!(ext > 0.0f)) continue;
-    const float scale = static_cast<float>(bins) * (1.0f - 1e-6f) / ext;
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t p = order[i];
-      Bin& b = out[a][bin_of((*in.centroid)[p][a], cbox.lo[a], scale, bins)];
-      b.box.grow((*in.prim_box)[p]);
-      ++b.count;
+void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 c = refs[i].centroid2();
+    for (int a = 0; a < 3; ++a) {
+      Bin& bin = out[a][b.bin(c, a)];
+      bin.box.lo = glm::min(bin.box.lo, refs[i].lo);
+      bin.box.hi = glm::max(bin.box.hi, refs[i].hi);
+      ++bin.count;
     }
   }
 }
 
-Split best_split(const Bin (&bins)[3][kMaxBins], const Aabb& cbox, int nbins, std::size_t n,
-                 const BvhBuildOptions& opt, float parent_half_area) {
+struct Split {
+  int axis = -1;
+  int bin = 0;  // left side: bins [0, bin]
+  float cost = 3.0e38f;
+};
+
+Split best_split(const Bins& bins, const Aabb& cbox, std::size_t n, const BvhBuildOptions& opt) {
   Split best;
-  best.cost = 3.0e38f;
+  const int nb = opt.bins;
   for (int a = 0; a < 3; ++a) {
     if (!(cbox.hi[a] - cbox.lo[a] > 0.0f)) continue;
     float right_cost[kMaxBins];
     Aabb acc;
     std::uint32_t cnt = 0;
-    for (int i = nbins - 1; i > 0; --i) {
+    for (int i = nb - 1; i > 0; --i) {
       acc.grow(bins[a][i].box);
       cnt += bins[a][i].count;
       right_cost[i] = acc.half_area() * static_cast<float>(cnt);
     }
     acc = Aabb{};
     cnt = 0;
-    for (int i = 0; i < nbins - 1; ++i) {
+    for (int i = 0; i < nb - 1; ++i) {
       acc.grow(bins[a][i].box);
       cnt += bins[a][i].count;
       if (cnt == 0 || cnt == n) continue;
       const float cost = acc.half_area() * static_cast<float>(cnt) + right_cost[i + 1];
-      if (cost < best.cost) {
-        best.cost = cost;
-        best.axis = a;
-        best.bin = i;
-      }
+      if (cost < best.cost) best = {a, i, cost};
     }
   }
-  if (best.axis >= 0)
-    best.cost = opt.traversal_cost + opt.triangle_cost * best.cost / std::max(parent_half_area, 1e-30f);
   return best;
 }
 
-// Splits order[0, n): returns the size of the left part (0 < k < n), or 0 to make a leaf.
-std::size_t split_range(const BuildInput& in, std::uint32_t* order, std::size_t n, const Aabb& box,
-                        const Aabb& cbox, const Bin (&bins)[3][kMaxBins]) {
-  const BvhBuildOptions& opt = in.opt;
-  const std::size_t max_leaf = static_cast<std::size_t>(std::clamp(opt.max_leaf_size, 1, 15));
-  if (n <= 1) return 0;
-  const Split s = best_split(bins, cbox, opt.bins, n, opt, box.half_area());
-  const float leaf_cost = opt.triangle_cost * static_cast<float>(n);
+// Partitions refs[r.begin, r.end) by the split (or halves it when there is none) and
+// returns the two child ranges with their bounds, computed in the same pass.
+std::pair<Range, Range> partition(PrimRef* refs, const Range& r, const Split& s, const Binner& b) {
+  Range L{r.begin, r.begin, {}, {}}, R{r.end, r.end, {}, {}};
   if (s.axis < 0) {
-    // All centroids coincide: no spatial split exists; halve the range by index.
-    return n <= max_leaf ? 0 : n / 2;
+    const std::uint32_t mid = r.begin + (r.end - r.begin) / 2;
+    L.end = mid;
+    R.begin = mid;
+  } else {
+    PrimRef* lo = refs + r.begin;
+    PrimRef* hi = refs + r.end;
+    while (true) {
+      while (lo < hi && b.bin(lo->centroid2(), s.axis) <= s.bin) ++lo;
+      while (lo < hi && b.bin((hi - 1)->centroid2(), s.axis) > s.bin) --hi;
+      if (lo >= hi) break;
+      std::swap(*lo, *(hi - 1));
+    }
+    L.end = R.begin = static_cast<std::uint32_t>(lo - refs);
   }
-  if (n <= max_leaf && leaf_cost <= s.cost) return 0;
-  const int a = s.axis;
-  const float scale = static_cast<float>(opt.bins) * (1.0f - 1e-6f) / (cbox.hi[a] - cbox.lo[a]);
-  const float lo = cbox.lo[a];
-  const auto mid = std::partition(order, order + n, [&](std::uint32_t p) {
-    return bin_of((*in.centroid)[p][a], lo, scale, opt.bins) <= s.bin;
-  });
-  return static_cast<std::size_t>(mid - order);
+  for (std::uint32_t i = L.begin; i < L.end; ++i) {
+    L.box.lo = glm::min(L.box.lo, refs[i].lo);
+    L.box.hi = glm::max(L.box.hi, refs[i].hi);
+    L.cbox.grow(refs[i].centroid2());
+  }
+  for (std::uint32_t i = R.begin; i < R.end; ++i) {
+    R.box.lo = glm::min(R.box.lo, refs[i].lo);
+    R.box.hi = glm::max(R.box.hi, refs[i].hi);
+    R.cbox.grow(refs[i].centroid2());
+  }
+  return {L, R};
 }
 
-// Builds a subtree over order[begin, end) serially into `nodes` (root at nodes[0]).
-void build_subtree(const BuildInput& in, std::uint32_t* order, std::uint32_t begin, std::uint32_t end,
-                   std::vector<TempNode>& nodes) {
+// Decides leaf or split for a range given its bins: returns the split (axis -1 with
+// `leaf` false means "halve by index": all centroids coincide).
+bool make_leaf(const Range& r, const Bins& bins, const BvhBuildOptions& opt, Split& split) {
+  const std::size_t n = r.end - r.begin;
+  if (n <= static_cast<std::size_t>(opt.max_leaf_size)) return true;
+  split = best_split(bins, r.cbox, n, opt);
+  return false;
+}
+
+// Builds a subtree over one range serially into `nodes` (root at nodes[0]).
+void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt, std::vector<TempNode>& nodes) {
   struct Item {
-    std::uint32_t begin, end;
+    Range range;
     std::size_t node;
   };
   std::vector<Item> stack;
   nodes.push_back({});
-  stack.push_back({begin, end, 0});
+  stack.push_back({root, 0});
+  Bins bins;
   while (!stack.empty()) {
     const Item it = stack.back();
     stack.pop_back();
-    const std::size_t n = it.end - it.begin;
-    Aabb box, cbox;
-    range_bounds(in, order + it.begin, n, box, cbox);
-    nodes[it.node].box = box;
-    Bin bins[3][kMaxBins] = {};
-    bin_range(in, order + it.begin, n, cbox, in.opt.bins, bins);
-    const std::size_t k = split_range(in, order + it.begin, n, box, cbox, bins);
-    if (k == 0) {
-      nodes[it.node].first = it.begin;
-      nodes[it.node].count = static_cast<std::uint32_t>(n);
+    nodes[it.node].box = it.range.box;
+    Split split;
+    bool leaf = static_cast<int>(it.range.end - it.range.begin) <= opt.max_leaf_size;
+    const Binner binner(it.range.cbox, opt.bins);
+    if (!leaf) {
+      for (auto& axis : bins) axis.fill(Bin{});
+      bin_refs(refs + it.range.begin, it.range.end - it.range.begin, binner, bins);
+      leaf = make_leaf(it.range, bins, opt, split);
+    }
+    if (leaf) {
+      nodes[it.node].first = it.range.begin;
+      nodes[it.node].count = it.range.end - it.range.begin;
       continue;
     }
+    const auto [L, R] = partition(refs, it.range, split, binner);
     const std::size_t l = nodes.size();
     nodes.push_back({});
     nodes.push_back({});
     nodes[it.node].left = static_cast<std::int64_t>(l);
     nodes[it.node].right = static_cast<std::int64_t>(l + 1);
-    stack.push_back({it.begin + static_cast<std::uint32_t>(k), it.end, l + 1});
-    stack.push_back({it.begin, it.begin + static_cast<std::uint32_t>(k), l});
+    stack.push_back({R, l + 1});
+    stack.push_back({L, l});
   }
 }
 
@@ -188,118 +209,131 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
   const auto t0 = std::chrono::steady_clock::now();
   if (indices.size() % 3 != 0) throw InputError(source, "index count is not a multiple of 3");
   const std::size_t tri_count = indices.size() / 3;
-  if (tri_count >= kMaxTriangles) throw InputError(source, "too many triangles for the BVH (max 2^27)");
-  for (std::uint32_t i : indices)
-    if (i >= positions.size()) throw InputError(source, "triangle index out of range");
-  for (const glm::vec3& p : positions)
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw InputError(source, "non-finite vertex position");
-
+  if (tri_count >= kMaxTriangles) throw InputError(source, "too many triangles for the BVH (max 2^28)");
   BvhBuildOptions opt = options;
   opt.bins = std::clamp(opt.bins, 2, kMaxBins);
-  opt.max_leaf_size = std::clamp(opt.max_leaf_size, 1, 15);
+  opt.max_leaf_size = std::clamp(opt.max_leaf_size, 1, 16);
 
   Bvh bvh;
-  std::vector<Aabb> prim_box(tri_count);
-  std::vector<glm::vec3> centroid(tri_count);
-  std::vector<std::uint32_t> order(tri_count);
-  ex.parallel_for("bvh_prim_bounds", tri_count, kPrimChunk, [&](std::size_t b, std::size_t e) {
+  std::vector<PrimRef> refs(tri_count);
+  std::vector<std::uint8_t> bad((tri_count + kPrimChunk - 1) / kPrimChunk, 0);
+  ex.parallel_for("bvh_prim_refs", tri_count, kPrimChunk, [&](std::size_t b, std::size_t e) {
     for (std::size_t t = b; t < e; ++t) {
-      Aabb box;
-      box.grow(positions[indices[3 * t]]);
-      box.grow(positions[indices[3 * t + 1]]);
-      box.grow(positions[indices[3 * t + 2]]);
-      prim_box[t] = box;
-      centroid[t] = box.center();
-      order[t] = static_cast<std::uint32_t>(t);
+      PrimRef& r = refs[t];
+      r.lo = glm::vec3(3.0e38f);
+      r.hi = glm::vec3(-3.0e38f);
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = indices[3 * t + k];
+        if (v >= positions.size()) {
+          bad[b / kPrimChunk] |= 1;
+          continue;
+        }
+        const glm::vec3& p = positions[v];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) bad[b / kPrimChunk] |= 2;
+        r.lo = glm::min(r.lo, p);
+        r.hi = glm::max(r.hi, p);
+      }
+      r.id = static_cast<std::uint32_t>(t);
+      r.pad = 0;
     }
   });
-  const BuildInput in{&prim_box, &centroid, opt};
+  std::uint8_t any_bad = 0;
+  for (std::uint8_t b : bad) any_bad |= b;
+  if (any_bad & 1) throw InputError(source, "triangle index out of range");
+  if (any_bad & 2) throw InputError(source, "non-finite vertex position");
 
-  // Top phase: split large ranges one at a time, binning in parallel over fixed chunks.
+  // Top phase: split large ranges one at a time, bounds and bins in parallel over chunks.
   std::vector<TempNode> top;
-  struct Task {
-    std::uint32_t begin, end;
-  };
-  std::vector<Task> tasks;            // subtrees left for the parallel phase, in order
+  std::vector<Range> tasks;  // subtrees left for the parallel phase, in order
   if (tri_count > 0) {
+    auto bounds_of = [&](std::uint32_t begin, std::uint32_t end) {
+      const std::size_t n = end - begin;
+      const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
+      std::vector<Aabb> box(chunks), cbox(chunks);
+      ex.parallel_for("bvh_range_bounds", n, kBinChunk, [&](std::size_t b, std::size_t e) {
+        Aabb bx, cb;
+        for (std::size_t i = begin + b; i < begin + e; ++i) {
+          bx.lo = glm::min(bx.lo, refs[i].lo);
+          bx.hi = glm::max(bx.hi, refs[i].hi);
+          cb.grow(refs[i].centroid2());
+        }
+        box[b / kBinChunk] = bx;
+        cbox[b / kBinChunk] = cb;
+      });
+      Range r{begin, end, {}, {}};
+      for (std::size_t c = 0; c < chunks; ++c) {
+        r.box.grow(box[c]);
+        r.cbox.grow(cbox[c]);
+      }
+      return r;
+    };
     struct Item {
-      std::uint32_t begin, end;
+      Range range;
       std::size_t node;
       bool is_left;
       std::size_t parent;
     };
     std::vector<Item> fifo;
     top.push_back({});
-    fifo.push_back({0, static_cast<std::uint32_t>(tri_count), 0, false, 0});
-    std::size_t head = 0;
-    while (head < fifo.size()) {
-      const Item it = fifo[head++];
-      const std::size_t n = it.end - it.begin;
+    fifo.push_back({bounds_of(0, static_cast<std::uint32_t>(tri_count)), 0, false, 0});
+    for (std::size_t head = 0; head < fifo.size(); ++head) {
+      const Item it = fifo[head];
+      const std::size_t n = it.range.end - it.range.begin;
       if (n <= kParallelRange) {
-        // Becomes a task; the node slot is replaced by a task link in its parent.
         const auto task = static_cast<std::int64_t>(tasks.size());
-        tasks.push_back({it.begin, it.end});
+        tasks.push_back(it.range);
         if (it.node == 0) top[0].left_task = task;  // the whole tree is one task
         else if (it.is_left) top[it.parent].left_task = task;
         else top[it.parent].right_task = task;
         continue;
       }
+      const Binner binner(it.range.cbox, opt.bins);
       const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
-      std::vector<Aabb> cbox_part(chunks), box_part(chunks);
-      ex.parallel_for("bvh_range_bounds", n, kBinChunk, [&](std::size_t b, std::size_t e) {
-        range_bounds(in, order.data() + it.begin + b, e - b, box_part[b / kBinChunk], cbox_part[b / kBinChunk]);
-      });
-      Aabb box, cbox;
-      for (std::size_t c = 0; c < chunks; ++c) {
-        box.grow(box_part[c]);
-        cbox.grow(cbox_part[c]);
-      }
-      std::vector<std::array<std::array<Bin, kMaxBins>, 3>> bin_part(chunks);
+      std::vector<Bins> part(chunks);
       ex.parallel_for("bvh_bin", n, kBinChunk, [&](std::size_t b, std::size_t e) {
-        Bin local[3][kMaxBins] = {};
-        bin_range(in, order.data() + it.begin + b, e - b, cbox, opt.bins, local);
-        auto& dst = bin_part[b / kBinChunk];
-        for (int a = 0; a < 3; ++a)
-          for (int i = 0; i < opt.bins; ++i) dst[a][i] = local[a][i];
+        Bins& local = part[b / kBinChunk];
+        for (auto& axis : local) axis.fill(Bin{});
+        bin_refs(refs.data() + it.range.begin + b, e - b, binner, local);
       });
-      Bin bins[3][kMaxBins] = {};
+      Bins bins;
+      for (auto& axis : bins) axis.fill(Bin{});
       for (std::size_t c = 0; c < chunks; ++c)
         for (int a = 0; a < 3; ++a)
           for (int i = 0; i < opt.bins; ++i) {
-            bins[a][i].box.grow(bin_part[c][a][i].box);
-            bins[a][i].count += bin_part[c][a][i].count;
+            bins[a][i].box.grow(part[c][a][i].box);
+            bins[a][i].count += part[c][a][i].count;
           }
-      top[it.node].box = box;
-      std::size_t k = split_range(in, order.data() + it.begin, n, box, cbox, bins);
-      if (k == 0) k = n / 2;  // a large range always splits
+      top[it.node].box = it.range.box;
+      const Split split = best_split(bins, it.range.cbox, n, opt);
+      auto [L, R] = partition(refs.data(), it.range, split, binner);
       const std::size_t l = top.size();
       top.push_back({});
       top.push_back({});
       top[it.node].left = static_cast<std::int64_t>(l);
       top[it.node].right = static_cast<std::int64_t>(l + 1);
-      const auto mid = it.begin + static_cast<std::uint32_t>(k);
-      fifo.push_back({it.begin, mid, l, true, it.node});
-      fifo.push_back({mid, it.end, l + 1, false, it.node});
+      fifo.push_back({L, l, true, it.node});
+      fifo.push_back({R, l + 1, false, it.node});
     }
   }
 
   // Parallel phase: each task builds its subtree alone; chunk = 1 task.
   std::vector<std::vector<TempNode>> sub(tasks.size());
   ex.parallel_for("bvh_subtrees", tasks.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t t = b; t < e; ++t) build_subtree(in, order.data(), tasks[t].begin, tasks[t].end, sub[t]);
+    for (std::size_t t = b; t < e; ++t) build_subtree(refs.data(), tasks[t], opt, sub[t]);
   });
 
-  // Splice depth-first into the final binary layout and gather leaf triangles in order.
+  // Leaf triangles in ref order.
   bvh.triangles_.resize(tri_count);
   bvh.triangle_id_.resize(tri_count);
   ex.parallel_for("bvh_gather_triangles", tri_count, kPrimChunk, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      const std::uint32_t t = order[i];
+      const std::uint32_t t = refs[i].id;
       bvh.triangle_id_[i] = t;
       bvh.triangles_[i] = {positions[indices[3 * t]], positions[indices[3 * t + 1]], positions[indices[3 * t + 2]]};
     }
   });
+
+  // Splice depth-first into the final binary layout.
   if (tri_count > 0) {
     struct Ref {
       const std::vector<TempNode>* list;
@@ -307,17 +341,18 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
       std::uint32_t depth;
       std::int64_t fix_right_of;  // final node whose `right` must point here (-1: none)
     };
-    std::vector<Ref> stack;
     auto resolve = [&](const std::vector<TempNode>& list, std::int64_t idx, std::int64_t task) -> Ref {
       if (task >= 0) return {&sub[static_cast<std::size_t>(task)], 0, 0, -1};
       return {&list, idx, 0, -1};
     };
-    Ref root = top[0].left_task >= 0 && top[0].left < 0 ? Ref{&sub[static_cast<std::size_t>(top[0].left_task)], 0, 0, -1}
-                                                        : Ref{&top, 0, 0, -1};
-    stack.push_back(root);
-    bvh.binary_.reserve(top.size() + [&] { std::size_t s = 0; for (auto& v : sub) s += v.size(); return s; }());
+    std::size_t total = top.size();
+    for (const auto& v : sub) total += v.size();
+    bvh.binary_.reserve(total);
+    std::vector<Ref> stack{top[0].left_task >= 0 && top[0].left < 0
+                               ? Ref{&sub[static_cast<std::size_t>(top[0].left_task)], 0, 0, -1}
+                               : Ref{&top, 0, 0, -1}};
     while (!stack.empty()) {
-      Ref r = stack.back();
+      const Ref r = stack.back();
       stack.pop_back();
       const TempNode& n = (*r.list)[static_cast<std::size_t>(r.index)];
       const auto me = static_cast<std::uint32_t>(bvh.binary_.size());

@@ -1,7 +1,9 @@
-// Derives the traversal layouts from the binary BVH (bvh.h): the 4-wide collapse (each wide
-// node opens its largest-area inner children until it holds 4) and the threaded layout of
+// Derives the traversal layouts from the binary BVH (bvh.h): the 8-wide collapse (each wide
+// node opens its largest-area inner children until it holds 8) with triangle packs and the threaded layout of
 // YU §3 / [CHCH06] (depth-first order, hit link = left child, miss link = next subtree).
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "trace/bvh.h"
 
@@ -26,13 +28,37 @@ void Bvh::derive_layouts() {
     }
   }
 
+  // Triangle packs: each binary leaf's triangles in groups of 4, in depth-first order.
+  packs_.clear();
+  std::vector<std::uint32_t> leaf_ref(binary_.size(), kEmptyChild);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < binary_.size(); ++i) {
+    const BinaryNode& b = binary_[i];
+    if (!b.is_leaf()) continue;
+    const auto first_pack = static_cast<std::uint32_t>(packs_.size());
+    const std::uint32_t npacks = (b.count + 3) / 4;
+    leaf_ref[i] = kLeafBit | (first_pack << 2) | (npacks - 1);
+    for (std::uint32_t p = 0; p < npacks; ++p) {
+      TrianglePack pack;
+      for (int l = 0; l < 4; ++l) {
+        const std::uint32_t k = p * 4 + static_cast<std::uint32_t>(l);
+        const bool used = k < b.count;
+        const LeafTriangle t = used ? triangles_[b.first + k] : LeafTriangle{glm::vec3(nan), glm::vec3(nan), glm::vec3(nan)};
+        pack.ax[l] = t.a.x; pack.ay[l] = t.a.y; pack.az[l] = t.a.z;
+        pack.bx[l] = t.b.x; pack.by[l] = t.b.y; pack.bz[l] = t.b.z;
+        pack.cx[l] = t.c.x; pack.cy[l] = t.c.y; pack.cz[l] = t.c.z;
+        pack.id[l] = used ? triangle_id_[b.first + k] : kEmptyChild;
+      }
+      packs_.push_back(pack);
+    }
+  }
+
   // Wide: depth-first allocation, so a child's index is always larger than its parent's.
   wide_.clear();
   wide_root_ = kEmptyChild;
   if (binary_.empty()) return;
-  auto leaf_ref = [&](const BinaryNode& n) { return kLeafBit | (n.first << 4) | n.count; };
   if (binary_[0].is_leaf()) {
-    wide_root_ = leaf_ref(binary_[0]);
+    wide_root_ = leaf_ref[0];
     return;
   }
   struct Item {
@@ -47,9 +73,9 @@ void Bvh::derive_layouts() {
     const auto me = static_cast<std::uint32_t>(wide_.size());
     if (it.parent == kEmptyChild) wide_root_ = me;
     else wide_[it.parent].child[it.slot] = me;
-    std::uint32_t kids[4] = {it.binary + 1, binary_[it.binary].right, 0, 0};
+    std::uint32_t kids[kWideArity] = {it.binary + 1, binary_[it.binary].right};
     int count = 2;
-    while (count < 4) {
+    while (count < kWideArity) {
       int best = -1;
       float best_area = -1.0f;
       for (int k = 0; k < count; ++k) {
@@ -64,9 +90,9 @@ void Bvh::derive_layouts() {
       kids[best] = opened + 1;
       kids[count++] = binary_[opened].right;
     }
-    Wide4Node node;
+    WideNode node;
     std::memset(&node, 0, sizeof(node));
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < kWideArity; ++k) {
       if (k >= count) {
         node.lo_x[k] = node.lo_y[k] = node.lo_z[k] = 3.0e38f;
         node.hi_x[k] = node.hi_y[k] = node.hi_z[k] = -3.0e38f;
@@ -76,7 +102,7 @@ void Bvh::derive_layouts() {
       const BinaryNode& c = binary_[kids[k]];
       node.lo_x[k] = c.box.lo.x; node.lo_y[k] = c.box.lo.y; node.lo_z[k] = c.box.lo.z;
       node.hi_x[k] = c.box.hi.x; node.hi_y[k] = c.box.hi.y; node.hi_z[k] = c.box.hi.z;
-      node.child[k] = c.is_leaf() ? leaf_ref(c) : kEmptyChild;  // inner: patched when visited
+      node.child[k] = c.is_leaf() ? leaf_ref[kids[k]] : kEmptyChild;  // inner: patched when visited
     }
     wide_.push_back(node);
     for (int k = count - 1; k >= 0; --k)
@@ -99,7 +125,7 @@ std::uint64_t Bvh::content_hash() const {
     mix(&n.first, sizeof(n.first));
     mix(&n.count, sizeof(n.count));
   }
-  if (!wide_.empty()) mix(wide_.data(), wide_.size() * sizeof(Wide4Node));
+  if (!wide_.empty()) mix(wide_.data(), wide_.size() * sizeof(WideNode));
   mix(triangle_id_.data(), triangle_id_.size() * sizeof(std::uint32_t));
   return h;
 }

@@ -77,25 +77,124 @@ inline bool test_leaf_any(const Bvh& bvh, const RayPrep& r, std::uint32_t first,
   return false;
 }
 
-// Tests the 4 child boxes of a wide node together; returns a bit mask of hit children and
-// their entry distances.
-inline unsigned wide_box_hits(const Wide4Node& n, const RayPrep& r, float tmax, float (&tnear)[4]) {
-  using L = par::Lanes<4>;
+// The 8 child boxes of a wide node in lanes. Near and far planes are picked by the sign of
+// the direction (not by min/max), so an inverted (empty) box always misses. Returns the
+// bit mask of hit children and their entry distances.
+struct WideRay {
+  glm::vec3 o, inv;
+  float tmin;
+  bool neg[3];
+  explicit WideRay(const RayPrep& r) : o(r.o), inv(r.inv), tmin(r.tmin) {
+    for (int a = 0; a < 3; ++a) neg[a] = std::signbit(r.inv[a]);
+  }
+};
+
+inline unsigned wide_box_hits(const WideNode& n, const WideRay& r, float tmax, float (&tnear)[kWideArity]) {
+  using L = par::Lanes<kWideArity>;
+  const L::f32 nx = L::load(r.neg[0] ? n.hi_x : n.lo_x), fx = L::load(r.neg[0] ? n.lo_x : n.hi_x);
+  const L::f32 ny = L::load(r.neg[1] ? n.hi_y : n.lo_y), fy = L::load(r.neg[1] ? n.lo_y : n.hi_y);
+  const L::f32 nz = L::load(r.neg[2] ? n.hi_z : n.lo_z), fz = L::load(r.neg[2] ? n.lo_z : n.hi_z);
   const L::f32 ox(r.o.x), oy(r.o.y), oz(r.o.z), ix(r.inv.x), iy(r.inv.y), iz(r.inv.z);
-  const L::f32 x0 = (L::load(n.lo_x) - ox) * ix, x1 = (L::load(n.hi_x) - ox) * ix;
-  const L::f32 y0 = (L::load(n.lo_y) - oy) * iy, y1 = (L::load(n.hi_y) - oy) * iy;
-  const L::f32 z0 = (L::load(n.lo_z) - oz) * iz, z1 = (L::load(n.hi_z) - oz) * iz;
-  const L::f32 widen(kFarWiden), shrink(kNearShrink);
-  const L::f32 entry = L::max(L::max(L::min(x0, x1), L::min(y0, y1)), L::min(z0, z1));
-  const L::f32 near = L::max(L::select(entry > L::f32(0.0f), entry * shrink, entry * widen), L::f32(r.tmin));
-  const L::f32 far = L::min(L::min(L::max(x0, x1), L::max(y0, y1)) * widen,
-                            L::min(L::max(z0, z1) * widen, L::f32(tmax)));
-  const auto m = near <= far;
+  const L::f32 entry = L::max(L::max((nx - ox) * ix, (ny - oy) * iy), (nz - oz) * iz);
+  const L::f32 exit = L::min(L::min((fx - ox) * ix, (fy - oy) * iy), (fz - oz) * iz);
+  // Widen by a few ulps (entry down, exit up) so rounding never culls a hit.
+  const L::f32 zero(0.0f), shrink(kNearShrink), widen(kFarWiden);
+  const L::f32 near = L::max(L::select(entry > zero, entry * shrink, entry * widen), L::f32(r.tmin));
+  const L::f32 far = L::min(L::select(exit > zero, exit * widen, exit * shrink), L::f32(tmax));
+  float fa[kWideArity];
   L::store(near, tnear);
+  L::store(far, fa);
   unsigned bits = 0;
-  for (int k = 0; k < 4; ++k)
-    if (m[k] && n.child[k] != kEmptyChild) bits |= 1u << k;
+  for (int k = 0; k < kWideArity; ++k) bits |= static_cast<unsigned>(tnear[k] <= fa[k]) << k;
   return bits;
+}
+
+// The watertight test (ray_triangle.h) on 4 triangles in lanes, with exactly the scalar
+// operation sequence so every lane's t bits equal the scalar test's; a lane whose edge
+// function is exactly zero is redone by the scalar test (its double fallback).
+struct PackRay {
+  int kx, ky, kz;
+  float sx, sy, sz;
+  glm::vec3 o;
+};
+
+// Returns the mask of lanes hit in [tmin, tmax] and their t, u, v.
+inline unsigned intersect_pack(const TrianglePack& p, const RayPrep& r, float tmin, float tmax, float (&t)[4],
+                               float (&u)[4], float (&v)[4]) {
+  using L = par::Lanes<4>;
+  const RayShear& sh = r.shear;
+  const float* a[3] = {p.ax, p.ay, p.az};
+  const float* b[3] = {p.bx, p.by, p.bz};
+  const float* c[3] = {p.cx, p.cy, p.cz};
+  const L::f32 okx(sh.origin[sh.kx]), oky(sh.origin[sh.ky]), okz(sh.origin[sh.kz]);
+  const L::f32 Akx = L::load(a[sh.kx]) - okx, Aky = L::load(a[sh.ky]) - oky, Akz = L::load(a[sh.kz]) - okz;
+  const L::f32 Bkx = L::load(b[sh.kx]) - okx, Bky = L::load(b[sh.ky]) - oky, Bkz = L::load(b[sh.kz]) - okz;
+  const L::f32 Ckx = L::load(c[sh.kx]) - okx, Cky = L::load(c[sh.ky]) - oky, Ckz = L::load(c[sh.kz]) - okz;
+  const L::f32 sx(sh.sx), sy(sh.sy), sz(sh.sz);
+  const L::f32 ax = Akx - sx * Akz, ay = Aky - sy * Akz;
+  const L::f32 bx = Bkx - sx * Bkz, by = Bky - sy * Bkz;
+  const L::f32 cx = Ckx - sx * Ckz, cy = Cky - sy * Ckz;
+  const L::f32 U = cx * by - cy * bx;
+  const L::f32 V = ax * cy - ay * cx;
+  const L::f32 W = bx * ay - by * ax;
+  const L::f32 zero(0.0f);
+  const L::f32 det = U + V + W;
+  const L::f32 T = U * (sz * Akz) + V * (sz * Bkz) + W * (sz * Ckz);
+  const L::f32 inv = L::f32(1.0f) / det;
+  const L::f32 tt = T * inv;
+  float Us[4], Vs[4], Ws[4], dets[4], ts[4], invs[4];
+  L::store(U, Us); L::store(V, Vs); L::store(W, Ws); L::store(det, dets); L::store(tt, ts); L::store(inv, invs);
+  unsigned bits = 0;
+  for (int l = 0; l < 4; ++l) {
+    if (p.id[l] == kEmptyChild) continue;
+    if (Us[l] == 0.0f || Vs[l] == 0.0f || Ws[l] == 0.0f) {
+      TriangleHit h;
+      const glm::vec3 A(p.ax[l], p.ay[l], p.az[l]), B(p.bx[l], p.by[l], p.bz[l]), C(p.cx[l], p.cy[l], p.cz[l]);
+      if (intersect_triangle_watertight(sh, A, B, C, tmin, tmax, h)) {
+        t[l] = h.t; u[l] = h.u; v[l] = h.v;
+        bits |= 1u << l;
+      }
+      continue;
+    }
+    const bool neg = Us[l] < 0.0f || Vs[l] < 0.0f || Ws[l] < 0.0f;
+    const bool pos = Us[l] > 0.0f || Vs[l] > 0.0f || Ws[l] > 0.0f;
+    if ((neg && pos) || dets[l] == 0.0f) continue;
+    if (!(ts[l] >= tmin && ts[l] <= tmax)) continue;
+    t[l] = ts[l];
+    u[l] = Vs[l] * invs[l];
+    v[l] = Ws[l] * invs[l];
+    bits |= 1u << l;
+  }
+  return bits;
+}
+
+inline void test_packs_closest(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, Hit& best,
+                               TraversalCounters& c) {
+  const std::uint32_t first = (ref & ~kLeafBit) >> 2, count = (ref & 3u) + 1;
+  const auto& packs = bvh.triangle_packs();
+  for (std::uint32_t p = first; p < first + count; ++p) {
+    const TrianglePack& pk = packs[p];
+    c.triangle_tests += 4;
+    float t[4], u[4], v[4];
+    unsigned bits = intersect_pack(pk, r, r.tmin, best.t, t, u, v);
+    while (bits) {
+      const int l = __builtin_ctz(bits);
+      bits &= bits - 1;
+      // Lanes were tested against the best t before this pack: compare t again.
+      if (t[l] < best.t || (t[l] == best.t && pk.id[l] < best.triangle)) best = {t[l], u[l], v[l], pk.id[l]};
+    }
+  }
+}
+
+inline bool test_packs_any(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, TraversalCounters& c) {
+  const std::uint32_t first = (ref & ~kLeafBit) >> 2, count = (ref & 3u) + 1;
+  const auto& packs = bvh.triangle_packs();
+  for (std::uint32_t p = first; p < first + count; ++p) {
+    c.triangle_tests += 4;
+    float t[4], u[4], v[4];
+    if (intersect_pack(packs[p], r, r.tmin, r.tmax, t, u, v)) return true;
+  }
+  return false;
 }
 
 struct StackEntry {
@@ -112,6 +211,7 @@ Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
   best.t = ray.tmax;
   if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
     const RayPrep r(ray);
+    const WideRay wr(r);
     const auto& nodes = bvh.wide_nodes();
     StackEntry stack[kTraversalStackSize];
     int sp = 0;
@@ -120,20 +220,21 @@ Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
       const StackEntry e = stack[--sp];
       if (e.tnear > best.t) continue;
       if (e.ref & kLeafBit) {
-        test_leaf_closest(bvh, r, (e.ref & ~kLeafBit) >> 4, e.ref & 15u, best, c);
+        test_packs_closest(bvh, r, e.ref, best, c);
         continue;
       }
       ++c.nodes_visited;
-      const Wide4Node& n = nodes[e.ref];
-      float tn[4];
-      unsigned bits = wide_box_hits(n, r, best.t, tn);
+      const WideNode& n = nodes[e.ref];
+      float tn[kWideArity];
+      unsigned bits = wide_box_hits(n, wr, best.t, tn);
+      if (!bits) continue;
       // Push far-to-near so the nearest child is popped first.
-      StackEntry hits[4];
+      StackEntry hits[kWideArity];
       int count = 0;
       while (bits) {
         const int k = __builtin_ctz(bits);
         bits &= bits - 1;
-        StackEntry s{n.child[k], tn[k]};
+        const StackEntry s{n.child[k], tn[k]};
         int j = count++;
         while (j > 0 && hits[j - 1].tnear < s.tnear) {
           hits[j] = hits[j - 1];
@@ -161,6 +262,7 @@ bool any_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
   bool found = false;
   if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
     const RayPrep r(ray);
+    const WideRay wr(r);
     const auto& nodes = bvh.wide_nodes();
     std::uint32_t stack[kTraversalStackSize];
     int sp = 0;
@@ -168,12 +270,12 @@ bool any_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
     while (sp > 0 && !found) {
       const std::uint32_t ref = stack[--sp];
       if (ref & kLeafBit) {
-        found = test_leaf_any(bvh, r, (ref & ~kLeafBit) >> 4, ref & 15u, c);
+        found = test_packs_any(bvh, r, ref, c);
         continue;
       }
       ++c.nodes_visited;
-      float tn[4];
-      unsigned bits = wide_box_hits(nodes[ref], r, r.tmax, tn);
+      float tn[kWideArity];
+      unsigned bits = wide_box_hits(nodes[ref], wr, r.tmax, tn);
       while (bits) {
         const int k = __builtin_ctz(bits);
         bits &= bits - 1;

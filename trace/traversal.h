@@ -16,7 +16,7 @@
 namespace speculum::trace {
 
 constexpr std::uint32_t kNoHit = 0xffffffffu;
-constexpr int kTraversalStackSize = 96;
+constexpr int kTraversalStackSize = 128;
 
 struct Hit {
   float t = std::numeric_limits<float>::infinity();
@@ -39,7 +39,7 @@ struct TraversalCounters {
   }
 };
 
-// 4-wide layout, stack-based, nearest child first.
+// 8-wide layout, stack-based, nearest child first.
 Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters = nullptr);
 bool any_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters = nullptr);
 
