@@ -21,7 +21,7 @@ ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffe
         continue;
       }
       const SurfaceParams& s = g.surface.pixels[i];
-      const glm::vec3 p = g.position.pixels[i], v = g.view.pixels[i];
+      const glm::vec3 p = g.position.pixels[i], v = g.view_direction(i);
       glm::vec3 n = g.normal.pixels[i];
       if (glm::dot(n, v) < 0.0f) n = -n;  // refractors seen from inside: light the near side
       glm::vec3 radiance = s.emissive;

@@ -17,7 +17,7 @@ ImageRGBA reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& m
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface.pixels[i];
       if (!is_specular(s)) continue;
-      const glm::vec3 v = g.view.pixels[i], incident = -v;
+      const glm::vec3 v = g.view_direction(i), incident = -v;
       glm::vec3 n = g.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return map_of(g.object.pixels[i]).radiance(d, exponent);

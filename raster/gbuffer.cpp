@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
@@ -57,13 +58,21 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visibili
   ensure_size(g.object, w, h);
   ensure_size(g.position, w, h);
   ensure_size(g.normal, w, h);
-  ensure_size(g.view, w, h);
+  g.eye = eye;
   ensure_size(g.uv, w, h);
   ensure_size(g.surface, w, h);
   ensure_size(g.reflector, w, h);
   const TriangleMesh& m = scene.mesh;
   const bool has_uv1 = !m.uvs1.empty();
   const bool has_tangents = !m.tangents.empty();
+  // Untextured materials have the same parameters everywhere: evaluate them once.
+  std::vector<SurfaceParams> constant_params;
+  std::vector<std::uint8_t> textured;
+  for (const Material& mat : scene.materials) {
+    constant_params.push_back(surface_params(mat));
+    textured.push_back(mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
+                       mat.emissive_texture.valid() || mat.transmission_texture.valid());
+  }
   executor.parallel_for("gbuffer.resolve", vis.triangle.size(), kPixelChunk,
                         [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
@@ -92,14 +101,14 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visibili
       const glm::vec3 to_eye = eye - p;
       const float dl = glm::length(to_eye);
       const glm::vec3 v = dl > 0.0f ? to_eye / dl : glm::vec3(0, 0, 1);
-      const SurfaceParams s = surface_params(scene, mat, uv, uv1);
+      const SurfaceParams s =
+          textured[mat] ? surface_params(scene, mat, uv, uv1) : constant_params[mat];
       // Opaque surfaces are shaded on the side the camera sees (double-sided or not, a
       // visible back face would otherwise shade black); refractors keep their orientation
       // so the reflection node knows whether the ray enters or leaves.
       if (!s.is_refractor() && glm::dot(n, v) < 0.0f) n = -n;
       g.position.pixels[i] = p;
       g.normal.pixels[i] = n;
-      g.view.pixels[i] = v;
       g.uv.pixels[i] = uv;
       g.surface.pixels[i] = s;
       g.reflector.pixels[i] = is_specular(s) ? vis.object.pixels[i] : kNoId;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -23,13 +24,19 @@ struct GBuffer {
   Buffer2D<glm::vec3> position;     // world space
   Buffer2D<glm::vec3> normal;       // unit shading normal, facing the camera side for
                                     // opaque surfaces; geometric orientation for refractors
-  Buffer2D<glm::vec3> view;         // unit direction from the sample towards the eye
+  glm::vec3 eye{0.0f};              // the camera position (view directions derive from it)
   Buffer2D<glm::vec2> uv;
   Buffer2D<SurfaceParams> surface;  // diffuse colour, metallic, roughness, glossiness (Phong
                                     // exponent), ior, transmission, emissive
   IdBuffer reflector;               // object id of non-diffuse surfaces, kNoId otherwise
 
   bool covered(std::size_t i) const { return object.pixels[i] != kNoId; }
+  // Unit direction from covered sample i towards the eye.
+  glm::vec3 view_direction(std::size_t i) const {
+    const glm::vec3 d = eye - position.pixels[i];
+    const float l = glm::length(d);
+    return l > 0.0f ? d / l : glm::vec3(0.0f, 0.0f, 1.0f);
+  }
 };
 
 GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,

@@ -80,21 +80,32 @@ void raster_rect(const Edges& e, const SetupTriangle& t, const ClipMap* map, int
                  int x1, int y1, int ox, int oy, TileScratch& s) {
   const std::int64_t step0 = e.a[0] * kSubpixelOne, step1 = e.a[1] * kSubpixelOne,
                      step2 = e.a[2] * kSubpixelOne;
-  for (int y = y0; y <= y1; ++y) {
-    std::int64_t r0 = edge_at(e, 0, x0, y), r1 = edge_at(e, 1, x0, y), r2 = edge_at(e, 2, x0, y);
+  // Per-lane offsets built by additions (AVX2 has no 64-bit multiply).
+  std::int64_t off0[W], off1[W], off2[W];
+  off0[0] = off1[0] = off2[0] = 0;
+  for (int l = 1; l < W; ++l)
+    off0[l] = off0[l - 1] + step0, off1[l] = off1[l - 1] + step1, off2[l] = off2[l - 1] + step2;
+  const std::int64_t row0 = off0[W - 1] + step0, row1 = off1[W - 1] + step1,
+                     row2 = off2[W - 1] + step2;
+  std::int64_t start0 = edge_at(e, 0, x0, y0), start1 = edge_at(e, 1, x0, y0),
+               start2 = edge_at(e, 2, x0, y0);
+  const std::int64_t down0 = e.b[0] * kSubpixelOne, down1 = e.b[1] * kSubpixelOne,
+                     down2 = e.b[2] * kSubpixelOne;
+  for (int y = y0; y <= y1; ++y, start0 += down0, start1 += down1, start2 += down2) {
+    std::int64_t r0 = start0, r1 = start1, r2 = start2;
     for (int x = x0; x <= x1; x += W) {
       std::int64_t v0[W], v1[W], v2[W];
       bool covered[W];
       bool any = false;
       for (int l = 0; l < W; ++l) {
-        v0[l] = r0 + step0 * l;
-        v1[l] = r1 + step1 * l;
-        v2[l] = r2 + step2 * l;
+        v0[l] = r0 + off0[l];
+        v1[l] = r1 + off1[l];
+        v2[l] = r2 + off2[l];
         covered[l] = (x + l <= x1) & (v0[l] >= e.threshold[0]) & (v1[l] >= e.threshold[1]) &
                      (v2[l] >= e.threshold[2]);
         any |= covered[l];
       }
-      r0 += step0 * W, r1 += step1 * W, r2 += step2 * W;
+      r0 += row0, r1 += row1, r2 += row2;
       if (!any) continue;
       for (int l = 0; l < W; ++l) {
         if (!covered[l]) continue;

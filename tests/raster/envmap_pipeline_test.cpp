@@ -50,7 +50,7 @@ TEST(EnvmapReflect, MirrorLayerIsSchlickFresnelTimesEnvironment) {
       EXPECT_EQ(spec.pixels[i], glm::vec4(0, 0, 0, 1));
       continue;
     }
-    const float cos_nv = glm::dot(g.normal.pixels[i], g.view.pixels[i]);
+    const float cos_nv = glm::dot(g.normal.pixels[i], g.view_direction(i));
     const glm::vec3 expected = fresnel_schlick(cos_nv, glm::vec3(m.base_color)) * scene.environment.constant;
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(spec.pixels[i][c], expected[c], 1e-4f * (1 + expected[c]));
     ++checked;
