@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "parallel/lanes.h"
 
@@ -14,17 +15,21 @@ namespace {
 
 constexpr int kBlock = 8;  // coverage block side: blocks whose corners all fail are skipped
 constexpr int kTilePixels = kTileSize * kTileSize;
+constexpr int kPad = 16;  // lanes may read/write past a row's end (never past the arrays)
+constexpr std::uint32_t kNoRef = 0xffffffffu;
 
-// The winner so far of every sample of one tile (the early depth test's state).
+// The winner so far of every sample of one tile (the early depth test's state). All 32-bit
+// so a row of W samples is tested and updated as W lanes.
 struct TileScratch {
-  float inv_w[kTilePixels];
-  float p1[kTilePixels], p2[kTilePixels];  // the winner's perspective weights (eager, so the
-                                           // resolve needs no edge functions)
-  std::uint32_t triangle[kTilePixels];
-  const SetupTriangle* setup[kTilePixels];
-  const ClipMap* clip_map[kTilePixels];
-  std::uint32_t coverage[kTilePixels];
+  alignas(64) float inv_w[kTilePixels + kPad];
+  float p1[kTilePixels + kPad], p2[kTilePixels + kPad];  // the winner's perspective weights
+                                                         // (eager: the resolve needs no edges)
+  std::uint32_t triangle[kTilePixels + kPad];
+  std::uint32_t ref[kTilePixels + kPad];  // index into the tile's triangle refs
+  std::uint32_t coverage[kTilePixels + kPad];
   bool count_coverage;
+  std::vector<const SetupTriangle*> setup;  // per ref
+  std::vector<const ClipMap*> clip_map;     // per ref
 };
 
 // E_i(p) = A_i p.x + B_i p.y + C_i for the edge opposite vertex i, positive inside;
@@ -76,8 +81,8 @@ inline Weights weights(const Edges& e, std::int64_t e0, std::int64_t e1, std::in
 // Coverage + early depth test over the pixel rectangle [x0,x1]×[y0,y1] (inclusive,
 // absolute pixels inside the tile at (ox, oy)), W pixels of a row at a time.
 template <int W>
-void raster_rect(const Edges& e, const SetupTriangle& t, const ClipMap* map, int x0, int y0,
-                 int x1, int y1, int ox, int oy, TileScratch& s) {
+void raster_rect_wide(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
+                      int x1, int y1, int ox, int oy, TileScratch& s) {
   const std::int64_t step0 = e.a[0] * kSubpixelOne, step1 = e.a[1] * kSubpixelOne,
                      step2 = e.a[2] * kSubpixelOne;
   // Per-lane offsets built by additions (AVX2 has no 64-bit multiply).
@@ -120,26 +125,98 @@ void raster_rect(const Edges& e, const SetupTriangle& t, const ClipMap* map, int
           s.p1[idx] = w.p1;
           s.p2[idx] = w.p2;
           s.triangle[idx] = t.triangle;
-          s.setup[idx] = &t;
-          s.clip_map[idx] = map;
+          s.ref[idx] = ref;
         }
       }
     }
   }
 }
 
+// The same with 32-bit edge values in Lanes<W> (AVX2 has no 64-bit multiply or int64→float
+// conversion): used when every edge value in the rectangle fits comfortably in int32. The
+// integers are equal to the 64-bit ones and the float operations are the same, in the same
+// order, so both paths give the same bits.
+template <int W>
+void raster_rect_lanes(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
+                       int x1, int y1, int ox, int oy, TileScratch& s) {
+  using L = par::Lanes<W>;
+  using I = typename L::i32;
+  using U = typename L::u32;
+  using F = typename L::f32;
+  const I lane = L::iota(0);
+  const I off0 = lane * std::int32_t(e.a[0] * kSubpixelOne),
+          off1 = lane * std::int32_t(e.a[1] * kSubpixelOne),
+          off2 = lane * std::int32_t(e.a[2] * kSubpixelOne);
+  const std::int32_t row0 = std::int32_t(e.a[0] * kSubpixelOne * W),
+                     row1 = std::int32_t(e.a[1] * kSubpixelOne * W),
+                     row2 = std::int32_t(e.a[2] * kSubpixelOne * W);
+  const std::int32_t down0 = std::int32_t(e.b[0] * kSubpixelOne),
+                     down1 = std::int32_t(e.b[1] * kSubpixelOne),
+                     down2 = std::int32_t(e.b[2] * kSubpixelOne);
+  const I t0 = I(std::int32_t(e.threshold[0])), t1 = I(std::int32_t(e.threshold[1])),
+          t2 = I(std::int32_t(e.threshold[2]));
+  const F ia(e.inv_area), iw0(e.inv_w[0]), iw1(e.inv_w[1]), iw2(e.inv_w[2]);
+  const U tri(t.triangle), refs(ref);
+  std::int32_t start0 = std::int32_t(edge_at(e, 0, x0, y0)),
+               start1 = std::int32_t(edge_at(e, 1, x0, y0)),
+               start2 = std::int32_t(edge_at(e, 2, x0, y0));
+  for (int y = y0; y <= y1; ++y, start0 += down0, start1 += down1, start2 += down2) {
+    std::int32_t r0 = start0, r1 = start1, r2 = start2;
+    for (int x = x0; x <= x1; x += W, r0 += row0, r1 += row1, r2 += row2) {
+      const I v0 = I(r0) + off0, v1 = I(r1) + off1, v2 = I(r2) + off2;
+      const auto inside = (v0 >= t0) && (v1 >= t1) && (v2 >= t2) && (lane <= I(x1 - x));
+      if (L::none(inside)) continue;
+      const F p0 = L::to_float(v0) * ia * iw0, p1 = L::to_float(v1) * ia * iw1,
+              p2 = L::to_float(v2) * ia * iw2;
+      const F inv_w = (p0 + p1) + p2;
+      const int idx = (y - oy) * kTileSize + (x - ox);
+      const typename F::mask_type covered(inside);
+      if (s.count_coverage)
+        for (int l = 0; l < W; ++l) s.coverage[idx + l] += covered[l] ? 1u : 0u;
+      const F best = L::load(&s.inv_w[idx]);
+      const U best_tri = L::load(&s.triangle[idx]);
+      const typename F::mask_type win =
+          covered && ((inv_w > best) ||
+                      ((inv_w == best) && typename F::mask_type(tri < best_tri)));
+      if (L::none(win)) continue;
+      L::store(L::select(win, inv_w, best), &s.inv_w[idx]);
+      L::store(L::select(win, p1, L::load(&s.p1[idx])), &s.p1[idx]);
+      L::store(L::select(win, p2, L::load(&s.p2[idx])), &s.p2[idx]);
+      L::store(L::select(win, tri, best_tri), &s.triangle[idx]);
+      L::store(L::select(win, refs, U(L::load(&s.ref[idx]))), &s.ref[idx]);
+    }
+  }
+}
+
+// Picks the 32-bit lane path when |E| stays below 2^30 over the rectangle widened to whole
+// groups of W lanes (E is linear: its extremes are at the corners).
+template <int W>
+void raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
+                 int x1, int y1, int ox, int oy, TileScratch& s) {
+  const int xw = x0 + ((x1 - x0) / W + 1) * W - 1;
+  constexpr std::int64_t kLimit = std::int64_t(1) << 30;
+  bool narrow = true;
+  for (int i = 0; i < 3 && narrow; ++i)
+    for (const auto [px, py] : {std::pair{x0, y0}, {xw, y0}, {x0, y1}, {xw, y1}}) {
+      const std::int64_t v = edge_at(e, i, px, py);
+      narrow &= v < kLimit && v > -kLimit;
+    }
+  if (narrow && W > 1) raster_rect_lanes<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
+  else raster_rect_wide<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
+}
+
 // Hierarchical coverage: small triangles go straight to pixels; larger ones are walked in
 // 8×8 blocks and a block is skipped when one edge is negative at all four corner samples
 // (E is linear, so its maximum over the block is at a corner).
 template <int W>
-void raster_triangle(const SetupTriangle& t, const ClipMap* map, int tx0, int ty0, int tx1,
+void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0, int tx1,
                      int ty1, TileScratch& s) {
   const int x0 = std::max(t.px0, tx0), x1 = std::min(t.px1, tx1);
   const int y0 = std::max(t.py0, ty0), y1 = std::min(t.py1, ty1);
   if (x0 > x1 || y0 > y1) return;
   const Edges e = make_edges(t);
   if (x1 - x0 < kBlock && y1 - y0 < kBlock) {
-    raster_rect<W>(e, t, map, x0, y0, x1, y1, tx0, ty0, s);
+    raster_rect<W>(e, t, ref, x0, y0, x1, y1, tx0, ty0, s);
     return;
   }
   for (int by = y0; by <= y1; by += kBlock) {
@@ -153,7 +230,7 @@ void raster_triangle(const SetupTriangle& t, const ClipMap* map, int tx0, int ty
                       edge_at(e, i, bx1, by1)});
         rejected = m < e.threshold[i];
       }
-      if (!rejected) raster_rect<W>(e, t, map, bx, by, bx1, by1, tx0, ty0, s);
+      if (!rejected) raster_rect<W>(e, t, ref, bx, by, bx1, by1, tx0, ty0, s);
     }
   }
 }
@@ -169,7 +246,9 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
   const int ty1 = std::min(ty0 + kTileSize, vp.height) - 1;
   std::fill(std::begin(s.inv_w), std::end(s.inv_w), 0.0f);
   std::fill(std::begin(s.triangle), std::end(s.triangle), kNoId);
-  std::fill(std::begin(s.setup), std::end(s.setup), nullptr);
+  std::fill(std::begin(s.ref), std::end(s.ref), kNoRef);
+  s.setup.clear();
+  s.clip_map.clear();
   s.count_coverage = !out.coverage.empty();
   if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
 
@@ -177,8 +256,10 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
     const std::uint32_t begin = chunk.tile_offsets[tile], end = chunk.tile_offsets[tile + 1];
     for (std::uint32_t k = begin; k < end; ++k) {
       const SetupTriangle& t = chunk.triangles[chunk.tile_list[k]];
-      const ClipMap* map = t.clip_map >= 0 ? &chunk.clip_maps[t.clip_map] : nullptr;
-      raster_triangle<W>(t, map, tx0, ty0, tx1, ty1, s);
+      const auto ref = static_cast<std::uint32_t>(s.setup.size());
+      s.setup.push_back(&t);
+      s.clip_map.push_back(t.clip_map >= 0 ? &chunk.clip_maps[t.clip_map] : nullptr);
+      raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);
     }
   }
 
@@ -186,7 +267,8 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
   for (int y = ty0; y <= ty1; ++y) {
     for (int x = tx0; x <= tx1; ++x) {
       const int idx = (y - ty0) * kTileSize + (x - tx0);
-      const SetupTriangle* t = s.setup[idx];
+      const std::uint32_t ref = s.ref[idx];
+      const SetupTriangle* t = ref == kNoRef ? nullptr : s.setup[ref];
       const std::size_t o = static_cast<std::size_t>(y) * vp.width + x;
       if (s.count_coverage) out.coverage.pixels[o] = s.coverage[idx];
       if (!t) {
@@ -199,7 +281,7 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
       const float inv_w = s.inv_w[idx];
       float b1 = s.p1[idx] / inv_w, b2 = s.p2[idx] / inv_w;
       if (t->swapped) std::swap(b1, b2);
-      if (const ClipMap* m = s.clip_map[idx]) {
+      if (const ClipMap* m = s.clip_map[ref]) {
         const float b0 = 1.0f - b1 - b2;
         const glm::vec3 b = b0 * m->bary[0] + b1 * m->bary[1] + b2 * m->bary[2];
         b1 = b.y, b2 = b.z;
