@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/scene.h"
@@ -20,8 +21,14 @@ namespace speculum::trace {
 struct Aabb {
   glm::vec3 lo{3.0e38f};
   glm::vec3 hi{-3.0e38f};
-  void grow(const glm::vec3& p);
-  void grow(const Aabb& b);
+  void grow(const glm::vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void grow(const Aabb& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
   bool empty() const { return !(lo.x <= hi.x); }
   float half_area() const;  // surface area / 2; 0 for an empty box
   glm::vec3 center() const { return (lo + hi) * 0.5f; }

@@ -14,14 +14,6 @@
 
 namespace speculum::trace {
 
-void Aabb::grow(const glm::vec3& p) {
-  lo = glm::min(lo, p);
-  hi = glm::max(hi, p);
-}
-void Aabb::grow(const Aabb& b) {
-  lo = glm::min(lo, b.lo);
-  hi = glm::max(hi, b.hi);
-}
 float Aabb::half_area() const {
   if (empty()) return 0.0f;
   const glm::vec3 e = hi - lo;

@@ -89,7 +89,7 @@ struct WideRay {
   }
 };
 
-inline unsigned wide_box_hits(const WideNode& n, const WideRay& r, float tmax, float (&tnear)[kWideArity]) {
+[[gnu::always_inline]] inline unsigned wide_box_hits(const WideNode& n, const WideRay& r, float tmax, float (&tnear)[kWideArity]) {
   using L = par::Lanes<kWideArity>;
   const L::f32 nx = L::load(r.neg[0] ? n.hi_x : n.lo_x), fx = L::load(r.neg[0] ? n.lo_x : n.hi_x);
   const L::f32 ny = L::load(r.neg[1] ? n.hi_y : n.lo_y), fy = L::load(r.neg[1] ? n.lo_y : n.hi_y);
@@ -119,7 +119,7 @@ struct PackRay {
 };
 
 // Returns the mask of lanes hit in [tmin, tmax] and their t, u, v.
-inline unsigned intersect_pack(const TrianglePack& p, const RayPrep& r, float tmin, float tmax, float (&t)[4],
+[[gnu::always_inline]] inline unsigned intersect_pack(const TrianglePack& p, const RayPrep& r, float tmin, float tmax, float (&t)[4],
                                float (&u)[4], float (&v)[4]) {
   using L = par::Lanes<4>;
   const RayShear& sh = r.shear;
@@ -142,9 +142,24 @@ inline unsigned intersect_pack(const TrianglePack& p, const RayPrep& r, float tm
   const L::f32 T = U * (sz * Akz) + V * (sz * Bkz) + W * (sz * Ckz);
   const L::f32 inv = L::f32(1.0f) / det;
   const L::f32 tt = T * inv;
+  const auto zero_edge = (U == zero) || (V == zero) || (W == zero);
+  unsigned bits = 0;
+  if (!L::any(zero_edge)) {
+    // The common case, branch-free: sign test, det != 0 and the t range, as lane masks
+    // (unused lanes hold NaN vertices, so their t fails the range test).
+    const auto neg = (U < zero) || (V < zero) || (W < zero);
+    const auto pos = (U > zero) || (V > zero) || (W > zero);
+    const auto ok = !(neg && pos) && (det != zero) && (tt >= L::f32(tmin)) && (tt <= L::f32(tmax));
+    if (L::none(ok)) return 0;
+    const L::f32 weights([](int l) { return static_cast<float>(1 << l); });
+    bits = static_cast<unsigned>(L::hadd(L::select(ok, weights, zero)));  // exact: small integers
+    L::store(tt, t);
+    L::store(V * inv, u);
+    L::store(W * inv, v);
+    return bits;
+  }
   float Us[4], Vs[4], Ws[4], dets[4], ts[4], invs[4];
   L::store(U, Us); L::store(V, Vs); L::store(W, Ws); L::store(det, dets); L::store(tt, ts); L::store(inv, invs);
-  unsigned bits = 0;
   for (int l = 0; l < 4; ++l) {
     if (p.id[l] == kEmptyChild) continue;
     if (Us[l] == 0.0f || Vs[l] == 0.0f || Ws[l] == 0.0f) {
@@ -168,7 +183,7 @@ inline unsigned intersect_pack(const TrianglePack& p, const RayPrep& r, float tm
   return bits;
 }
 
-inline void test_packs_closest(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, Hit& best,
+[[gnu::always_inline]] inline void test_packs_closest(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, Hit& best,
                                TraversalCounters& c) {
   const std::uint32_t first = (ref & ~kLeafBit) >> 2, count = (ref & 3u) + 1;
   const auto& packs = bvh.triangle_packs();
@@ -186,7 +201,7 @@ inline void test_packs_closest(const Bvh& bvh, const RayPrep& r, std::uint32_t r
   }
 }
 
-inline bool test_packs_any(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, TraversalCounters& c) {
+[[gnu::always_inline]] inline bool test_packs_any(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, TraversalCounters& c) {
   const std::uint32_t first = (ref & ~kLeafBit) >> 2, count = (ref & 3u) + 1;
   const auto& packs = bvh.triangle_packs();
   for (std::uint32_t p = first; p < first + count; ++p) {
