@@ -230,40 +230,58 @@ Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
     const auto& nodes = bvh.wide_nodes();
     StackEntry stack[kTraversalStackSize];
     int sp = 0;
-    stack[sp++] = {bvh.wide_root(), ray.tmin};
-    while (sp > 0) {
-      const StackEntry e = stack[--sp];
-      if (e.tnear > best.t) continue;
-      if (e.ref & kLeafBit) {
-        test_packs_closest(bvh, r, e.ref, best, c);
-        continue;
-      }
-      ++c.nodes_visited;
-      const WideNode& n = nodes[e.ref];
-      float tn[kWideArity];
-      unsigned bits = wide_box_hits(n, wr, best.t, tn);
-      if (!bits) continue;
-      // Push far-to-near so the nearest child is popped first.
-      StackEntry hits[kWideArity];
-      int count = 0;
-      while (bits) {
-        const int k = __builtin_ctz(bits);
-        bits &= bits - 1;
-        const StackEntry s{n.child[k], tn[k]};
-        int j = count++;
-        while (j > 0 && hits[j - 1].tnear < s.tnear) {
-          hits[j] = hits[j - 1];
-          --j;
-        }
-        hits[j] = s;
-      }
-      for (int k = 0; k < count; ++k) {
-        if (sp == kTraversalStackSize) {
-          ++c.stack_overflows;
+    StackEntry cur{bvh.wide_root(), ray.tmin};
+    while (true) {
+      if (cur.ref & kLeafBit) {
+        test_packs_closest(bvh, r, cur.ref, best, c);
+      } else {
+        ++c.nodes_visited;
+        const WideNode& n = nodes[cur.ref];
+        float tn[kWideArity];
+        unsigned bits = wide_box_hits(n, wr, best.t, tn);
+        if (bits) {
+          int k = __builtin_ctz(bits);
+          bits &= bits - 1;
+          if (!bits) {  // one child hit (the common case): descend without the stack
+            cur = {n.child[k], tn[k]};
+            continue;
+          }
+          // Several: push all but the nearest, far-to-near, and descend into the nearest.
+          StackEntry hits[kWideArity];
+          hits[0] = {n.child[k], tn[k]};
+          int count = 1;
+          while (bits) {
+            k = __builtin_ctz(bits);
+            bits &= bits - 1;
+            const StackEntry s{n.child[k], tn[k]};
+            int j = count++;
+            while (j > 0 && hits[j - 1].tnear < s.tnear) {
+              hits[j] = hits[j - 1];
+              --j;
+            }
+            hits[j] = s;
+          }
+          for (int i = 0; i + 1 < count; ++i) {
+            if (sp == kTraversalStackSize) {
+              ++c.stack_overflows;
+              continue;
+            }
+            stack[sp++] = hits[i];
+          }
+          cur = hits[count - 1];
           continue;
         }
-        stack[sp++] = hits[k];
       }
+      // Pop the next entry still nearer than the best hit.
+      bool found = false;
+      while (sp > 0) {
+        cur = stack[--sp];
+        if (cur.tnear <= best.t) {
+          found = true;
+          break;
+        }
+      }
+      if (!found) break;
     }
   }
   if (!best.hit()) best = Hit{};
