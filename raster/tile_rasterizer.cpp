@@ -39,6 +39,7 @@ struct Edges {
   std::int64_t threshold[3];
   float inv_area;
   float inv_w[3];
+  bool small;  // vertex extent ≤ 32 px: every edge value near the triangle fits in int32
 };
 
 Edges make_edges(const SetupTriangle& t) {
@@ -55,6 +56,11 @@ Edges make_edges(const SetupTriangle& t) {
     e.inv_w[i] = t.inv_w[i];
   }
   const std::int64_t area = e.a[0] * t.x[0] + e.b[0] * t.y[0] + e.c[0];
+  // |E(p)| ≤ |A||p.x − x_v| + |B||p.y − y_v| ≤ 2·D·(D + 16 px) for p in the bounding box
+  // widened by up to 16 lanes: with D ≤ 2^13 that is < 2^28.
+  const std::int32_t dx = std::max({t.x[0], t.x[1], t.x[2]}) - std::min({t.x[0], t.x[1], t.x[2]});
+  const std::int32_t dy = std::max({t.y[0], t.y[1], t.y[2]}) - std::min({t.y[0], t.y[1], t.y[2]});
+  e.small = dx <= (1 << 13) && dy <= (1 << 13);
   e.inv_area = 1.0f / static_cast<float>(area);
   return e;
 }
@@ -188,15 +194,16 @@ void raster_rect_lanes(const Edges& e, const SetupTriangle& t, std::uint32_t ref
   }
 }
 
-// Picks the 32-bit lane path when |E| stays below 2^30 over the rectangle widened to whole
-// groups of W lanes (E is linear: its extremes are at the corners).
+// Picks the 32-bit lane path for small triangles (see make_edges) or when |E| stays below
+// 2^30 over the rectangle widened to whole groups of W lanes (E is linear: its extremes are
+// at the corners).
 template <int W>
 void raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
                  int x1, int y1, int ox, int oy, TileScratch& s) {
   const int xw = x0 + ((x1 - x0) / W + 1) * W - 1;
   constexpr std::int64_t kLimit = std::int64_t(1) << 30;
   bool narrow = true;
-  for (int i = 0; i < 3 && narrow; ++i)
+  for (int i = 0; i < 3 && narrow && !e.small; ++i)
     for (const auto [px, py] : {std::pair{x0, y0}, {xw, y0}, {x0, y1}, {xw, y1}}) {
       const std::int64_t v = edge_at(e, i, px, py);
       narrow &= v < kLimit && v > -kLimit;
