@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "parallel/lanes.h"
 #include "trace/bvh.h"
 
 namespace speculum::trace {
@@ -22,6 +23,7 @@ float Aabb::half_area() const {
 
 namespace {
 
+namespace stdx = std::experimental;
 constexpr int kMaxBins = 32;
 constexpr std::size_t kParallelRange = 1u << 15;  // ranges above this are split at top level
 constexpr std::size_t kBinChunk = 1u << 14;
@@ -44,9 +46,20 @@ struct TempNode {
   std::int64_t left_task = -1, right_task = -1;  // or the root of a subtree task's list
 };
 
+// A bin's box as lanes (x, y, z, unused) so growing it is two vector min/max.
+using L4 = par::Lanes<4>;
 struct Bin {
-  Aabb box;
+  L4::f32 lo = L4::f32(3.0e38f);
+  L4::f32 hi = L4::f32(-3.0e38f);
   std::uint32_t count = 0;
+  Aabb box() const {
+    float l[4], h[4];
+    L4::store(lo, l);
+    L4::store(hi, h);
+    Aabb b;
+    if (count) b = {glm::vec3(l[0], l[1], l[2]), glm::vec3(h[0], h[1], h[2])};
+    return b;
+  }
 };
 using Bins = std::array<std::array<Bin, kMaxBins>, 3>;
 
@@ -68,12 +81,21 @@ struct Binner {
 };
 
 void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
+  // Lane 3 of a ref's lo/hi holds the id/pad bits: it is zeroed before the bin index is
+  // formed, and ignored in the bin boxes. Lanes 0-2 do exactly Binner::bin's operations.
+  const L4::f32 blo([&](int a) { return a < 3 ? b.lo[a] : 0.0f; });
+  const L4::f32 scale([&](int a) { return a < 3 ? b.scale[a] : 0.0f; });
+  const auto xyz = L4::to_float(L4::iota(0)) < L4::f32(3.0f);
+  const L4::i32 top(b.bins - 1), bottom(0);
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec3 c = refs[i].centroid2();
+    const L4::f32 lo = L4::load(&refs[i].lo.x);
+    const L4::f32 hi = L4::load(&refs[i].hi.x);
+    const L4::f32 c = L4::select(xyz, lo + hi, L4::f32(0.0f));
+    const L4::i32 idx = L4::min(L4::max(L4::to_int((c - blo) * scale), bottom), top);
     for (int a = 0; a < 3; ++a) {
-      Bin& bin = out[a][b.bin(c, a)];
-      bin.box.lo = glm::min(bin.box.lo, refs[i].lo);
-      bin.box.hi = glm::max(bin.box.hi, refs[i].hi);
+      Bin& bin = out[a][idx[a]];
+      bin.lo = L4::min(bin.lo, lo);
+      bin.hi = L4::max(bin.hi, hi);
       ++bin.count;
     }
   }
@@ -94,14 +116,14 @@ Split best_split(const Bins& bins, const Aabb& cbox, std::size_t n, const BvhBui
     Aabb acc;
     std::uint32_t cnt = 0;
     for (int i = nb - 1; i > 0; --i) {
-      acc.grow(bins[a][i].box);
+      acc.grow(bins[a][i].box());
       cnt += bins[a][i].count;
       right_cost[i] = acc.half_area() * static_cast<float>(cnt);
     }
     acc = Aabb{};
     cnt = 0;
     for (int i = 0; i < nb - 1; ++i) {
-      acc.grow(bins[a][i].box);
+      acc.grow(bins[a][i].box());
       cnt += bins[a][i].count;
       if (cnt == 0 || cnt == n) continue;
       const float cost = acc.half_area() * static_cast<float>(cnt) + right_cost[i + 1];
@@ -292,7 +314,8 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
       for (std::size_t c = 0; c < chunks; ++c)
         for (int a = 0; a < 3; ++a)
           for (int i = 0; i < opt.bins; ++i) {
-            bins[a][i].box.grow(part[c][a][i].box);
+            bins[a][i].lo = L4::min(bins[a][i].lo, part[c][a][i].lo);
+            bins[a][i].hi = L4::max(bins[a][i].hi, part[c][a][i].hi);
             bins[a][i].count += part[c][a][i].count;
           }
       top[it.node].box = it.range.box;
