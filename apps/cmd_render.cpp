@@ -39,6 +39,13 @@ void run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (o.spp < 1 || (k * k != o.spp && technique.name != "reference"))
     throw InputError("--spp", "must be a square (1, 4, 9, 16, ...) for k×k supersampling, got " +
                                   std::to_string(o.spp));
+  // About 200 bytes per sample pass through the feed-forward pipeline: refuse sizes that
+  // could only end in the out-of-memory killer.
+  constexpr double kMaxSamples = double(1 << 26);
+  if (double(o.width) * o.height * o.spp > kMaxSamples)
+    throw InputError("--width/--height/--spp", "more than 67M samples (" + std::to_string(o.width) +
+                                                   "x" + std::to_string(o.height) + " x spp " +
+                                                   std::to_string(o.spp) + ")");
   if (!ends_with(o.output, ".png") && !ends_with(o.output, ".exr"))
     throw InputError(o.output, "output must end in .png or .exr");
   const Scene scene = load_scene(o.scene.empty() ? default_scene_name() : o.scene);
