@@ -97,10 +97,11 @@ struct WideRay {
   const L::f32 ox(r.o.x), oy(r.o.y), oz(r.o.z), ix(r.inv.x), iy(r.inv.y), iz(r.inv.z);
   const L::f32 entry = L::max(L::max((nx - ox) * ix, (ny - oy) * iy), (nz - oz) * iz);
   const L::f32 exit = L::min(L::min((fx - ox) * ix, (fy - oy) * iy), (fz - oz) * iz);
-  // Widen by a few ulps (entry down, exit up) so rounding never culls a hit.
-  const L::f32 zero(0.0f), shrink(kNearShrink), widen(kFarWiden);
-  const L::f32 near = L::max(L::select(entry > zero, entry * shrink, entry * widen), L::f32(r.tmin));
-  const L::f32 far = L::min(L::select(exit > zero, exit * widen, exit * shrink), L::f32(tmax));
+  // Widen by a few ulps (entry down, exit up) so rounding never culls a hit. Written with
+  // abs rather than a select: fixed_size masks are bitsets, and a select costs a round trip.
+  const L::f32 eps(kFarWiden - 1.0f);
+  const L::f32 near = L::max(entry - L::abs(entry) * eps, L::f32(r.tmin));
+  const L::f32 far = L::min(exit + L::abs(exit) * eps, L::f32(tmax));
   float fa[kWideArity];
   L::store(near, tnear);
   L::store(far, fa);
@@ -142,14 +143,17 @@ struct PackRay {
   const L::f32 T = U * (sz * Akz) + V * (sz * Bkz) + W * (sz * Ckz);
   const L::f32 inv = L::f32(1.0f) / det;
   const L::f32 tt = T * inv;
-  const auto zero_edge = (U == zero) || (V == zero) || (W == zero);
+  // An exactly-zero edge function anywhere (or a product that underflows: a harmless false
+  // alarm) sends the pack to the scalar path with its double-precision fallback.
+  const auto zero_edge = (U * V * W) == zero;
   unsigned bits = 0;
   if (!L::any(zero_edge)) {
-    // The common case, branch-free: sign test, det != 0 and the t range, as lane masks
-    // (unused lanes hold NaN vertices, so their t fails the range test).
-    const auto neg = (U < zero) || (V < zero) || (W < zero);
-    const auto pos = (U > zero) || (V > zero) || (W > zero);
-    const auto ok = !(neg && pos) && (det != zero) && (tt >= L::f32(tmin)) && (tt <= L::f32(tmax));
+    // The common case, branch-free, as few lane masks as possible (each is a bitset round
+    // trip in fixed_size simd): same-sign edge functions, t in range. det == 0 needs no
+    // test: with mixed signs excluded it means t = T/0 = ±inf or NaN, which fails the range
+    // test, as do the NaN lanes of unused slots.
+    const L::f32 mn = L::min(L::min(U, V), W), mx = L::max(L::max(U, V), W);
+    const auto ok = ((mn >= zero) || (mx <= zero)) && (tt >= L::f32(tmin)) && (tt <= L::f32(tmax));
     if (L::none(ok)) return 0;
     const L::f32 weights([](int l) { return static_cast<float>(1 << l); });
     bits = static_cast<unsigned>(L::hadd(L::select(ok, weights, zero)));  // exact: small integers
