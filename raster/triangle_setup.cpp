@@ -35,13 +35,19 @@ constexpr int kClipPlanes = 6;
 
 // The one projection used for every vertex (shared or produced by clipping), so equal
 // clip positions always snap to equal fixed-point positions.
-inline void project_and_snap(const glm::vec4& clip, const Viewport& vp, std::int32_t& x,
+// Returns false for a position that cannot be snapped (non-finite or far outside the guard
+// band: only reachable from overflowing input coordinates), which the caller drops.
+inline bool project_and_snap(const glm::vec4& clip, const Viewport& vp, std::int32_t& x,
                              std::int32_t& y, float& inv_w) {
   inv_w = 1.0f / clip.w;
   const float sx = (clip.x * inv_w * 0.5f + 0.5f) * static_cast<float>(vp.width);
   const float sy = (0.5f - clip.y * inv_w * 0.5f) * static_cast<float>(vp.height);
+  constexpr float kLimit = 4.0f * kGuardBandPixels + 65536.0f;
+  if (!(std::abs(sx) < kLimit && std::abs(sy) < kLimit && inv_w > 0.0f && std::isfinite(inv_w)))
+    return false;
   x = static_cast<std::int32_t>(std::nearbyint(sx * static_cast<float>(kSubpixelOne)));
   y = static_cast<std::int32_t>(std::nearbyint(sy * static_cast<float>(kSubpixelOne)));
+  return true;
 }
 
 // Emits a snapped triangle if it has area, faces the right way and covers a sample centre.
@@ -124,7 +130,8 @@ void clip_and_emit(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenV
   if (n < 3) return;
   std::int32_t xs[12], ys[12];
   float ws[12];
-  for (int i = 0; i < n; ++i) project_and_snap(poly[i].p, vp, xs[i], ys[i], ws[i]);
+  for (int i = 0; i < n; ++i)
+    if (!project_and_snap(poly[i].p, vp, xs[i], ys[i], ws[i])) return;
   for (int i = 1; i + 1 < n; ++i) {
     const ClipMap map{{poly[0].b, poly[i].b, poly[i + 1].b}};
     emit(xs[0], ys[0], ws[0], xs[i], ys[i], ws[i], xs[i + 1], ys[i + 1], ws[i + 1], triangle, vp,
@@ -148,7 +155,7 @@ ScreenVertex make_screen_vertex(const glm::vec4& clip, const Viewport& vp) {
     v.outcode |= kNeedsClip;
     return v;
   }
-  project_and_snap(clip, vp, v.x, v.y, v.inv_w);
+  if (!project_and_snap(clip, vp, v.x, v.y, v.inv_w)) v.outcode |= kNeedsClip;
   return v;
 }
 

@@ -264,3 +264,26 @@ TEST(RasterInput, AbsurdSizesAndCamerasThrowInputError) {
 
 }  // namespace
 }  // namespace speculum::raster
+
+namespace speculum::raster {
+namespace {
+
+TEST(RasterInput, OverflowingCoordinatesAreDroppedNotUndefined) {
+  // Finite but huge vertices overflow clip space to inf/NaN: such triangles are dropped
+  // and the rest of the image is unaffected.
+  Scene scene;
+  scene.name = "huge";
+  testing::add_triangles(scene, {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}}, {0, 1, 2});
+  Scene with_huge = scene;
+  testing::add_triangles(with_huge, {{3e38f, 0, 0}, {0, -3e38f, 1}, {0, 0, -3e38f}}, {0, 1, 2});
+  Camera cam;
+  cam.eye = {0, 0, 3};
+  par::Executor ex(2);
+  const auto a = render_visibility(ex, scene, cam, 64, 64);
+  const auto b = render_visibility(ex, with_huge, cam, 64, 64);
+  for (std::size_t i = 0; i < a.triangle.size(); ++i)
+    if (b.triangle.pixels[i] != 1u) EXPECT_EQ(a.triangle.pixels[i], b.triangle.pixels[i]);
+}
+
+}  // namespace
+}  // namespace speculum::raster
