@@ -27,6 +27,7 @@ struct BenchRasterOptions {
   int repeat = 10;
   bool json = false;
   std::string write_ply;
+  std::string cull = "none";
   pipeline::CameraOverrides camera;
 };
 
@@ -45,6 +46,10 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
                                                            : load_scene(o.scene);
   if (!o.write_ply.empty()) pipeline::write_ply(o.write_ply, scene);
   const Camera camera = pipeline::resolve_camera(scene, o.camera);
+  raster::RasterOptions raster_options;
+  if (o.cull == "back") raster_options.cull = raster::CullMode::Back;
+  else if (o.cull == "front") raster_options.cull = raster::CullMode::Front;
+  else if (o.cull != "none") throw InputError("--cull", "expected none, back or front");
   par::Executor executor(global.threads);
   std::vector<double> frame_ms;
   std::map<std::string, std::vector<double>> kernel_ms;
@@ -56,7 +61,8 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   for (int run = 0; run <= o.repeat; ++run) {  // run 0 is the warm-up
     executor.clear_launches();
     const auto t0 = executor.now_ns();
-    raster::render_visibility(executor, scene, camera, o.width, o.height, {}, workspace, vis);
+    raster::render_visibility(executor, scene, camera, o.width, o.height, raster_options,
+                              workspace, vis);
     raster::resolve_gbuffer(executor, scene, vis, camera.eye, g);
     const auto t1 = executor.now_ns();
     if (run == 0) {
@@ -74,11 +80,11 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   const std::size_t triangles = scene.mesh.triangle_count();
   if (o.json) {
     std::printf("{\"scene\": \"%s\", \"triangles\": %zu, \"width\": %d, \"height\": %d, "
-                "\"threads\": %d, \"lanes\": %d, \"repeat\": %d, \"ms_median\": %.3f, "
+                "\"threads\": %d, \"lanes\": %d, \"cull\": \"%s\", \"repeat\": %d, \"ms_median\": %.3f, "
                 "\"ms_min\": %.3f, \"ms_max\": %.3f, \"mtris_per_s\": %.3f, "
                 "\"covered_fraction\": %.4f, \"kernels_ms_median\": {",
                 scene.name.c_str(), triangles, o.width, o.height, executor.threads(),
-                par::default_lanes(), o.repeat, med, lo, hi, triangles / (med * 1e-3) / 1e6,
+                par::default_lanes(), o.cull.c_str(), o.repeat, med, lo, hi, triangles / (med * 1e-3) / 1e6,
                 double(covered) / (double(o.width) * o.height));
     bool first = true;
     for (const auto& [name, v] : kernel_ms) {
@@ -112,6 +118,8 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global) {
   cmd->add_option("--height", o->height, "Target height")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd->add_option("--repeat", o->repeat, "Timed repetitions after one warm-up")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON object");
+  cmd->add_option("--cull", o->cull, "Face culling: none (as the llvmpipe yardstick), back, front")
+      ->capture_default_str();
   cmd->add_option("--write-ply", o->write_ply, "Also write the triangles as binary PLY");
   pipeline::add_camera_options(*cmd, o->camera);
   cmd->callback([o, &global] { run_bench_raster(*o, global); });
