@@ -83,6 +83,8 @@ struct Binner {
 void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
   // Lane 3 of a ref's lo/hi holds the id/pad bits: it is zeroed before the bin index is
   // formed, and ignored in the bin boxes. Lanes 0-2 do exactly Binner::bin's operations.
+  // Hardware min/max (stdx) instead of the select-based Lanes ones: the values are never
+  // NaN in lanes 0-2, where both agree.
   const L4::f32 blo([&](int a) { return a < 3 ? b.lo[a] : 0.0f; });
   const L4::f32 scale([&](int a) { return a < 3 ? b.scale[a] : 0.0f; });
   const auto xyz = L4::to_float(L4::iota(0)) < L4::f32(3.0f);
@@ -91,11 +93,11 @@ void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
     const L4::f32 lo = L4::load(&refs[i].lo.x);
     const L4::f32 hi = L4::load(&refs[i].hi.x);
     const L4::f32 c = L4::select(xyz, lo + hi, L4::f32(0.0f));
-    const L4::i32 idx = L4::min(L4::max(L4::to_int((c - blo) * scale), bottom), top);
+    const L4::i32 idx = stdx::min(stdx::max(L4::to_int((c - blo) * scale), bottom), top);
     for (int a = 0; a < 3; ++a) {
       Bin& bin = out[a][idx[a]];
-      bin.lo = L4::min(bin.lo, lo);
-      bin.hi = L4::max(bin.hi, hi);
+      bin.lo = stdx::min(bin.lo, lo);
+      bin.hi = stdx::max(bin.hi, hi);
       ++bin.count;
     }
   }

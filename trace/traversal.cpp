@@ -14,6 +14,15 @@ namespace speculum::trace {
 
 namespace {
 
+// Lanes<W>::min/max are select-based (NaN and ±0 identical for every W), which costs a
+// bitset-mask round trip per call in fixed_size simd. The box and leaf kernels here run
+// at one fixed width and only ever take min/max of non-NaN values (or of padding lanes
+// whose result is discarded), where the hardware min/max give the same values.
+template <class V>
+inline V vmin(const V& a, const V& b) { return std::experimental::min(a, b); }
+template <class V>
+inline V vmax(const V& a, const V& b) { return std::experimental::max(a, b); }
+
 constexpr float kFarWiden = 1.0f + 8.0f * 5.96e-8f;   // > 1 + 2 gamma(3)
 constexpr float kNearShrink = 1.0f - 8.0f * 5.96e-8f;  // the same margin on the entry side
 
@@ -95,13 +104,16 @@ struct WideRay {
   const L::f32 ny = L::load(r.neg[1] ? n.hi_y : n.lo_y), fy = L::load(r.neg[1] ? n.lo_y : n.hi_y);
   const L::f32 nz = L::load(r.neg[2] ? n.hi_z : n.lo_z), fz = L::load(r.neg[2] ? n.lo_z : n.hi_z);
   const L::f32 ox(r.o.x), oy(r.o.y), oz(r.o.z), ix(r.inv.x), iy(r.inv.y), iz(r.inv.z);
-  const L::f32 entry = L::max(L::max((nx - ox) * ix, (ny - oy) * iy), (nz - oz) * iz);
-  const L::f32 exit = L::min(L::min((fx - ox) * ix, (fy - oy) * iy), (fz - oz) * iz);
+  // Clamped to finite values: an empty child's inverted box gives entry +inf / exit -inf,
+  // and the widening below must not turn them into inf - inf = NaN.
+  const L::f32 big(3.0e38f);
+  const L::f32 entry = vmin(vmax(vmax((nx - ox) * ix, (ny - oy) * iy), (nz - oz) * iz), big);
+  const L::f32 exit = vmax(vmin(vmin((fx - ox) * ix, (fy - oy) * iy), (fz - oz) * iz), -big);
   // Widen by a few ulps (entry down, exit up) so rounding never culls a hit. Written with
   // abs rather than a select: fixed_size masks are bitsets, and a select costs a round trip.
   const L::f32 eps(kFarWiden - 1.0f);
-  const L::f32 near = L::max(entry - L::abs(entry) * eps, L::f32(r.tmin));
-  const L::f32 far = L::min(exit + L::abs(exit) * eps, L::f32(tmax));
+  const L::f32 near = vmax(entry - L::abs(entry) * eps, L::f32(r.tmin));
+  const L::f32 far = vmin(exit + L::abs(exit) * eps, L::f32(tmax));
   float fa[kWideArity];
   L::store(near, tnear);
   L::store(far, fa);
@@ -152,7 +164,7 @@ struct PackRay {
     // trip in fixed_size simd): same-sign edge functions, t in range. det == 0 needs no
     // test: with mixed signs excluded it means t = T/0 = ±inf or NaN, which fails the range
     // test, as do the NaN lanes of unused slots.
-    const L::f32 mn = L::min(L::min(U, V), W), mx = L::max(L::max(U, V), W);
+    const L::f32 mn = vmin(vmin(U, V), W), mx = vmax(vmax(U, V), W);
     const auto ok = ((mn >= zero) || (mx <= zero)) && (tt >= L::f32(tmin)) && (tt <= L::f32(tmax));
     if (L::none(ok)) return 0;
     const L::f32 weights([](int l) { return static_cast<float>(1 << l); });
