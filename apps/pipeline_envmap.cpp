@@ -28,14 +28,6 @@ void add_envmap_passes(par::Graph& g, const Scene* scene, const FrameSettings& f
      c.set_output("shadow_maps", render_shadow_maps(c.executor(), *scene, f.shadow_map_size));
    }).writes<ShadowMaps>("shadow_maps").param("size", f.shadow_map_size);
 
-  g.add("reflector_cube_maps", [scene, f](par::NodeContext& c) {
-     auto& maps = c.output<ReflectorMaps>("reflector_maps");
-     maps = render_reflector_maps(c.executor(), *scene, c.input<ShadowMaps>("shadow_maps"),
-                                  c.input<EnvironmentMap>("environment"), f.cube_map_size);
-     c.count("cube_maps", maps.cubes.size());
-   }).reads<ShadowMaps>("shadow_maps").reads<EnvironmentMap>("environment")
-     .writes<ReflectorMaps>("reflector_maps").param("size", f.cube_map_size);
-
   g.add("visibility", [scene, f, sw, sh](par::NodeContext& c) {
      c.set_output("visibility", render_visibility(c.executor(), *scene, f.camera, sw, sh));
    }).writes<VisibilityBuffer>("visibility").param("width", sw).param("height", sh);
@@ -44,6 +36,15 @@ void add_envmap_passes(par::Graph& g, const Scene* scene, const FrameSettings& f
      c.set_output("gbuffer", resolve_gbuffer(c.executor(), *scene,
                                              c.input<VisibilityBuffer>("visibility"), f.camera.eye));
    }).reads<VisibilityBuffer>("visibility").writes<GBuffer>("gbuffer");
+
+  g.add("reflector_cube_maps", [scene, f](par::NodeContext& c) {
+     auto& maps = c.output<ReflectorMaps>("reflector_maps");
+     maps = render_reflector_maps(c.executor(), *scene, c.input<ShadowMaps>("shadow_maps"),
+                                  c.input<EnvironmentMap>("environment"), f.cube_map_size,
+                                  &c.input<GBuffer>("gbuffer"));
+     c.count("cube_maps", maps.cubes.size());
+   }).reads<ShadowMaps>("shadow_maps").reads<EnvironmentMap>("environment").reads<GBuffer>("gbuffer")
+     .writes<ReflectorMaps>("reflector_maps").param("size", f.cube_map_size);
 
   g.add("direct_light", [scene, f](par::NodeContext& c) {
      c.set_output("direct", direct_light(c.executor(), *scene, c.input<GBuffer>("gbuffer"),

@@ -29,7 +29,7 @@ inline constexpr const char* kRadiance = "radiance";      // ImageRGBA, linear, 
 inline constexpr const char* kDisplay = "display";        // ImageRGBA, tone-mapped
 
 // --technique envmap (SURVEY §3.1):
-//   environment → shadow_map → reflector_cube_maps → visibility → gbuffer → direct_light
+//   environment → shadow_map → visibility → gbuffer → reflector_cube_maps → direct_light
 //   → envmap_reflect → composite → resolve → tonemap
 // The scene pointer must outlive the graph's runs.
 void add_envmap_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);

@@ -1,15 +1,40 @@
 // Dynamic environment maps per reflector: see reflector_maps.h.
 #include "raster/reflector_maps.h"
 
+#include <algorithm>
+
 #include <glm/geometric.hpp>
 
 #include "raster/direct_light.h"
 
 namespace speculum::raster {
 
+namespace {
+
+// Mean position and normal of object `object`'s samples, summed serially in sample order
+// (a fixed-order reduction). False when the object covers no sample.
+bool visible_centroid(const GBuffer& g, std::uint32_t object, glm::vec3& centre, glm::vec3& normal) {
+  glm::dvec3 p(0.0), n(0.0);
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < g.object.size(); ++i)
+    if (g.object.pixels[i] == object) {
+      p += glm::dvec3(g.position.pixels[i]);
+      n += glm::dvec3(g.normal.pixels[i]);
+      ++count;
+    }
+  if (count == 0) return false;
+  centre = glm::vec3(p / double(count));
+  const double nl = glm::length(n);
+  normal = nl > 0.0 ? glm::vec3(n / nl) : glm::vec3(0.0f, 1.0f, 0.0f);
+  return true;
+}
+
+}  // namespace
+
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
-                                    const EnvironmentMap& env, int size) {
+                                    const EnvironmentMap& env, int size,
+                                    const GBuffer* camera_view) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   const Bounds all = scene.bounds();
@@ -25,6 +50,13 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
       for (int k = 0; k < 3; ++k) b.grow(m.positions[m.indices[3 * t + k]]);
     }
     if (!specular || !b.valid()) continue;
+    glm::vec3 centre = b.center();
+    const glm::vec3 e = b.extent();
+    const float smallest = std::min({e.x, e.y, e.z}), largest = std::max({e.x, e.y, e.z});
+    glm::vec3 seen, normal;
+    if (camera_view && smallest < 0.05f * largest &&
+        visible_centroid(*camera_view, static_cast<std::uint32_t>(o), seen, normal))
+      centre = seen + normal * (0.01f * glm::length(e));
     CubeMapOptions opt;
     opt.size = size;
     opt.znear = 1e-4f * scene_size;
@@ -32,12 +64,13 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
     CubeMap cube = render_cube_map(
-        executor, scene, b.center(), opt, [&](const GBuffer& g, const Camera& cam) {
+        executor, scene, centre, opt, [&](const GBuffer& g, const Camera& cam) {
           return direct_light(executor, scene, g, cam, shadows, env);
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
     out.maps.push_back(environment_from_faces(executor, cube.colour, false));
     out.cubes.push_back(std::move(cube));
+    out.centres.push_back(centre);
   }
   return out;
 }

@@ -1,6 +1,10 @@
 // Dynamic environment maps (SURVEY §3.1): for every specular object, the scene without it
-// rendered into a cube map (colour = direct light + ambient, and distance) around the
-// centre of its bounding box, then mip-mapped with glossy prefiltering.
+// rendered into a cube map (colour = direct light + ambient, and distance) around a
+// reference point o, then mip-mapped with glossy prefiltering. o is the centre of the
+// object's bounding box, except for flat reflectors (smallest box side < 5% of the largest),
+// whose box centre may sit under other objects (a floor under a vase): there o is the
+// centroid of the reflector's samples in the camera's G-buffer, lifted off the surface by
+// 1% of the box diagonal along their mean normal.
 #pragma once
 
 #include <vector>
@@ -9,6 +13,7 @@
 #include "parallel/executor.h"
 #include "raster/cube_map.h"
 #include "raster/environment.h"
+#include "raster/gbuffer.h"
 #include "raster/shadow_map.h"
 
 namespace speculum::raster {
@@ -17,6 +22,7 @@ struct ReflectorMaps {
   std::vector<int> map_of_object;     // per object: index into maps, -1 when not a reflector
   std::vector<CubeMap> cubes;         // colour + distance, as rendered
   std::vector<EnvironmentMap> maps;   // the same colour, prefiltered for lookups
+  std::vector<glm::vec3> centres;     // reference point o of each map
   const EnvironmentMap* for_object(std::uint32_t object) const {
     if (object >= map_of_object.size() || map_of_object[object] < 0) return nullptr;
     return &maps[map_of_object[object]];
@@ -25,8 +31,10 @@ struct ReflectorMaps {
 
 // Specular objects: at least one triangle's material reflects or refracts
 // (is_specular(surface_params(material))).
+// `camera_view` (may be null) is the camera's G-buffer, used for flat reflectors.
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
-                                    const EnvironmentMap& env, int size = 256);
+                                    const EnvironmentMap& env, int size = 256,
+                                    const GBuffer* camera_view = nullptr);
 
 }  // namespace speculum::raster
