@@ -109,26 +109,43 @@ struct Split {
   float cost = 3.0e38f;
 };
 
+inline float half_area_of(const L4::f32& lo, const L4::f32& hi) {
+  float e[4];
+  L4::store(hi - lo, e);
+  return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+
 Split best_split(const Bins& bins, const Aabb& cbox, std::size_t n, const BvhBuildOptions& opt) {
   Split best;
   const int nb = opt.bins;
   for (int a = 0; a < 3; ++a) {
     if (!(cbox.hi[a] - cbox.lo[a] > 0.0f)) continue;
     float right_cost[kMaxBins];
-    Aabb acc;
+    L4::f32 lo(3.0e38f), hi(-3.0e38f);
     std::uint32_t cnt = 0;
+    float area = 0.0f;
     for (int i = nb - 1; i > 0; --i) {
-      acc.grow(bins[a][i].box());
-      cnt += bins[a][i].count;
-      right_cost[i] = acc.half_area() * static_cast<float>(cnt);
+      if (bins[a][i].count) {  // an empty bin changes neither the box nor the count
+        lo = stdx::min(lo, bins[a][i].lo);
+        hi = stdx::max(hi, bins[a][i].hi);
+        cnt += bins[a][i].count;
+        area = half_area_of(lo, hi);
+      }
+      right_cost[i] = area * static_cast<float>(cnt);
     }
-    acc = Aabb{};
+    lo = L4::f32(3.0e38f);
+    hi = L4::f32(-3.0e38f);
     cnt = 0;
+    area = 0.0f;
     for (int i = 0; i < nb - 1; ++i) {
-      acc.grow(bins[a][i].box());
-      cnt += bins[a][i].count;
+      if (bins[a][i].count) {
+        lo = stdx::min(lo, bins[a][i].lo);
+        hi = stdx::max(hi, bins[a][i].hi);
+        cnt += bins[a][i].count;
+        area = half_area_of(lo, hi);
+      }
       if (cnt == 0 || cnt == n) continue;
-      const float cost = acc.half_area() * static_cast<float>(cnt) + right_cost[i + 1];
+      const float cost = area * static_cast<float>(cnt) + right_cost[i + 1];
       if (cost < best.cost) best = {a, i, cost};
     }
   }
@@ -137,33 +154,54 @@ Split best_split(const Bins& bins, const Aabb& cbox, std::size_t n, const BvhBui
 
 // Partitions refs[r.begin, r.end) by the split (or halves it when there is none) and
 // returns the two child ranges with their bounds, computed in the same pass.
+// Box and centroid bounds accumulated in lanes (lane 3 ignored).
+struct LaneBounds {
+  L4::f32 lo = L4::f32(3.0e38f), hi = L4::f32(-3.0e38f);
+  L4::f32 clo = L4::f32(3.0e38f), chi = L4::f32(-3.0e38f);
+  void grow(const PrimRef& r) {
+    const L4::f32 l = L4::load(&r.lo.x), h = L4::load(&r.hi.x);
+    const L4::f32 c = l + h;
+    lo = stdx::min(lo, l);
+    hi = stdx::max(hi, h);
+    clo = stdx::min(clo, c);
+    chi = stdx::max(chi, c);
+  }
+  void to(Range& r) const {
+    float a[4], b[4], c[4], d[4];
+    L4::store(lo, a); L4::store(hi, b); L4::store(clo, c); L4::store(chi, d);
+    if (r.end > r.begin) {
+      r.box = {glm::vec3(a[0], a[1], a[2]), glm::vec3(b[0], b[1], b[2])};
+      r.cbox = {glm::vec3(c[0], c[1], c[2]), glm::vec3(d[0], d[1], d[2])};
+    }
+  }
+};
+
 std::pair<Range, Range> partition(PrimRef* refs, const Range& r, const Split& s, const Binner& b) {
   Range L{r.begin, r.begin, {}, {}}, R{r.end, r.end, {}, {}};
+  LaneBounds lb, rb;
   if (s.axis < 0) {
     const std::uint32_t mid = r.begin + (r.end - r.begin) / 2;
     L.end = mid;
     R.begin = mid;
+    for (std::uint32_t i = r.begin; i < mid; ++i) lb.grow(refs[i]);
+    for (std::uint32_t i = mid; i < r.end; ++i) rb.grow(refs[i]);
   } else {
+    // Hoare-style in place; every element is classified once and grows its side's bounds.
     PrimRef* lo = refs + r.begin;
     PrimRef* hi = refs + r.end;
+    auto left = [&](const PrimRef& p) { return b.bin(p.centroid2(), s.axis) <= s.bin; };
     while (true) {
-      while (lo < hi && b.bin(lo->centroid2(), s.axis) <= s.bin) ++lo;
-      while (lo < hi && b.bin((hi - 1)->centroid2(), s.axis) > s.bin) --hi;
+      while (lo < hi && left(*lo)) lb.grow(*lo++);
+      while (lo < hi && !left(*(hi - 1))) rb.grow(*--hi);
       if (lo >= hi) break;
       std::swap(*lo, *(hi - 1));
+      lb.grow(*lo++);
+      rb.grow(*--hi);
     }
     L.end = R.begin = static_cast<std::uint32_t>(lo - refs);
   }
-  for (std::uint32_t i = L.begin; i < L.end; ++i) {
-    L.box.lo = glm::min(L.box.lo, refs[i].lo);
-    L.box.hi = glm::max(L.box.hi, refs[i].hi);
-    L.cbox.grow(refs[i].centroid2());
-  }
-  for (std::uint32_t i = R.begin; i < R.end; ++i) {
-    R.box.lo = glm::min(R.box.lo, refs[i].lo);
-    R.box.hi = glm::max(R.box.hi, refs[i].hi);
-    R.cbox.grow(refs[i].centroid2());
-  }
+  lb.to(L);
+  rb.to(R);
   return {L, R};
 }
 
@@ -194,7 +232,7 @@ void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt,
     bool leaf = static_cast<int>(it.range.end - it.range.begin) <= opt.max_leaf_size;
     const Binner binner(it.range.cbox, opt.bins);
     if (!leaf) {
-      for (auto& axis : bins) axis.fill(Bin{});
+      for (int a = 0; a < 3; ++a) std::fill_n(bins[a].begin(), opt.bins, Bin{});
       bin_refs(refs + it.range.begin, it.range.end - it.range.begin, binner, bins);
       leaf = make_leaf(it.range, bins, opt, split);
     }
