@@ -95,16 +95,17 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
     const VisibilityBuffer vis =
         render_visibility(executor, scene, cam, options.size, options.size, options.raster);
-    const GBuffer g = resolve_gbuffer(executor, scene, vis, centre);
     ImageF& dist = cube.distance[face];
     dist = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
     executor.parallel_for("cube_map.distance", dist.size(), 4096,
                           [&](std::size_t begin, std::size_t end) {
                             for (std::size_t i = begin; i < end; ++i)
-                              if (g.covered(i))
-                                dist.pixels[i] = glm::length(g.position.pixels[i] - centre);
+                              if (vis.triangle.pixels[i] != kNoId)
+                                dist.pixels[i] = glm::length(
+                                    visible_position(scene.mesh, vis, i) - centre);
                           });
-    if (shade) cube.colour[face] = shade(g, cam);
+    // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
+    if (shade) cube.colour[face] = shade(resolve_gbuffer(executor, scene, vis, centre), cam);
   }
   return cube;
 }

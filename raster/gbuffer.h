@@ -46,6 +46,16 @@ GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visib
 void resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
                      const glm::vec3& eye, GBuffer& out);
 
+// World position of covered visibility sample i (barycentric interpolation only): what
+// distance-only passes (shadow and distance maps) need, without resolving materials.
+inline glm::vec3 visible_position(const TriangleMesh& m, const VisibilityBuffer& vis,
+                                  std::size_t i) {
+  const std::uint32_t t = vis.triangle.pixels[i];
+  const glm::vec2 b = vis.bary.pixels[i];
+  return (1.0f - b.x - b.y) * m.positions[m.indices[3 * t]] +
+         b.x * m.positions[m.indices[3 * t + 1]] + b.y * m.positions[m.indices[3 * t + 2]];
+}
+
 // The scalar views of the G-buffer for inspection: specular level (max of F0 for
 // non-diffuse surfaces, 0 otherwise) and glossiness (Phong exponent).
 ImageF specular_level_image(const GBuffer& g);

@@ -46,10 +46,14 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
       m.camera.zfar = dist + 1.5f * radius;
       m.view_projection = projection_matrix(m.camera, size, size) * view_matrix(m.camera);
       const VisibilityBuffer vis = render_visibility(executor, scene, m.camera, size, size);
-      const GBuffer g = resolve_gbuffer(executor, scene, vis, m.camera.eye);
       m.distance = ImageF(size, size, std::numeric_limits<float>::infinity());
-      for (std::size_t i = 0; i < m.distance.size(); ++i)
-        if (g.covered(i)) m.distance.pixels[i] = glm::length(g.position.pixels[i] - m.camera.eye);
+      executor.parallel_for("shadow_map.distance", m.distance.size(), 4096,
+                            [&](std::size_t begin, std::size_t end) {
+                              for (std::size_t i = begin; i < end; ++i)
+                                if (vis.triangle.pixels[i] != kNoId)
+                                  m.distance.pixels[i] = glm::length(
+                                      visible_position(scene.mesh, vis, i) - m.camera.eye);
+                            });
     } else {
       CubeMapOptions opt;
       opt.size = size;
