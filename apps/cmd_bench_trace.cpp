@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -170,10 +171,19 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
   const std::size_t n = rays.size();
   trace::HitStream hits;
   hits.resize(n);
+  // Rays we treat as invalid (non-finite, zero direction) are made inactive for Embree too
+  // (tfar < tnear), so both sides see the same work and Embree never sees a NaN.
+  auto active_tfar = [&](std::size_t i) {
+    const float v[8] = {rays.ox[i], rays.oy[i], rays.oz[i], rays.dx[i], rays.dy[i], rays.dz[i], rays.tmin[i], rays.tmax[i]};
+    bool ok = rays.dx[i] != 0.0f || rays.dy[i] != 0.0f || rays.dz[i] != 0.0f;
+    for (float x : v) ok = ok && !std::isnan(x);
+    for (int k = 0; k < 6; ++k) ok = ok && std::isfinite(v[k]);
+    return ok ? rays.tmax[i] : -std::numeric_limits<float>::infinity();
+  };
   auto fill = [&](RTCRayHit& rh, std::size_t i) {
     rh.ray.org_x = rays.ox[i]; rh.ray.org_y = rays.oy[i]; rh.ray.org_z = rays.oz[i];
     rh.ray.dir_x = rays.dx[i]; rh.ray.dir_y = rays.dy[i]; rh.ray.dir_z = rays.dz[i];
-    rh.ray.tnear = rays.tmin[i]; rh.ray.tfar = rays.tmax[i];
+    rh.ray.tnear = rays.tmin[i]; rh.ray.tfar = active_tfar(i);
     rh.ray.mask = 0xffffffffu; rh.ray.time = 0; rh.ray.flags = 0; rh.ray.id = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
@@ -209,7 +219,7 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
           valid[l] = p + l < e ? -1 : 0;
           rh.ray.org_x[l] = rays.ox[i]; rh.ray.org_y[l] = rays.oy[i]; rh.ray.org_z[l] = rays.oz[i];
           rh.ray.dir_x[l] = rays.dx[i]; rh.ray.dir_y[l] = rays.dy[i]; rh.ray.dir_z[l] = rays.dz[i];
-          rh.ray.tnear[l] = rays.tmin[i]; rh.ray.tfar[l] = rays.tmax[i];
+          rh.ray.tnear[l] = rays.tmin[i]; rh.ray.tfar[l] = active_tfar(i);
           rh.ray.mask[l] = 0xffffffffu; rh.ray.time[l] = 0; rh.ray.flags[l] = 0; rh.ray.id[l] = 0;
           rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
         }
@@ -223,8 +233,8 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
     });
     t16.push_back(ms_since(t0));
   }
-  fig.mrays1 = static_cast<double>(n) / (median(t1) * 1e3);
-  fig.mrays16 = static_cast<double>(n) / (median(t16) * 1e3);
+  fig.mrays1 = static_cast<double>(n) / (std::max(median(t1), 1e-6) * 1e3);
+  fig.mrays16 = static_cast<double>(n) / (std::max(median(t16), 1e-6) * 1e3);
   rtcReleaseScene(rs);
   rtcReleaseDevice(device);
   return fig;
@@ -282,7 +292,8 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
     trace_ms.push_back(ms_since(t0));
   }
   const Checksum sum = checksum(hits);
-  const double mrays = static_cast<double>(rays.size()) / (median(trace_ms) * 1e3);
+  // Guarded so an empty ray file prints 0, never inf (which is not JSON).
+  const double mrays = static_cast<double>(rays.size()) / (std::max(median(trace_ms), 1e-6) * 1e3);
   std::printf("{\"mesh\": \"%s\", \"rays_file\": \"%s\", \"triangles\": %zu, \"rays\": %zu, \"threads\": %d, "
               "\"repeat\": %d, \"build_ms\": %.3f, \"mrays_per_s\": %.3f, \"hits\": %llu, \"prim_sum\": %llu, "
               "\"t_sum\": %.6f, \"nodes_per_ray\": %.2f, \"triangle_tests_per_ray\": %.2f, \"stack_overflows\": %llu",
@@ -300,7 +311,8 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
                 "\"ratio_vs_intersect1\": %.3f, \"ratio_vs_intersect16\": %.3f, \"build_ratio\": %.3f",
                 RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, e.build_ms, e.mrays1, e.mrays16,
                 static_cast<unsigned long long>(e.sum.hits), static_cast<unsigned long long>(e.sum.prim_sum),
-                e.sum.t_sum, mrays / e.mrays1, mrays / e.mrays16, median(build_ms) / e.build_ms);
+                e.sum.t_sum, mrays / std::max(e.mrays1, 1e-9), mrays / std::max(e.mrays16, 1e-9),
+                median(build_ms) / std::max(e.build_ms, 1e-9));
   }
 #endif
   std::printf("}\n");

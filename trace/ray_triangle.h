@@ -26,9 +26,11 @@ struct RayShear {
     kx = kz == 2 ? 0 : kz + 1;
     ky = kx == 2 ? 0 : kx + 1;
     if (d[kz] < 0.0f) std::swap(kx, ky);  // keep the winding so the signs mean the same
-    sx = d[kx] / d[kz];
-    sy = d[ky] / d[kz];
+    // One division: the shear only has to be the same for every triangle a ray meets
+    // (that is what makes the test watertight), not the correctly rounded quotient.
     sz = 1.0f / d[kz];
+    sx = d[kx] * sz;
+    sy = d[ky] * sz;
   }
 };
 
