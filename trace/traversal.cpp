@@ -236,6 +236,11 @@ struct StackEntry {
 }  // namespace
 
 Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
+  return closest_hit_limited_stack(bvh, ray, kTraversalStackSize, counters);
+}
+
+Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit, TraversalCounters* counters) {
+  stack_limit = stack_limit < 1 ? 1 : (stack_limit > kTraversalStackSize ? kTraversalStackSize : stack_limit);
   TraversalCounters c;
   c.rays = 1;
   Hit best;
@@ -278,7 +283,7 @@ Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
             hits[j] = s;
           }
           for (int i = 0; i + 1 < count; ++i) {
-            if (sp == kTraversalStackSize) {
+            if (sp == stack_limit) {
               ++c.stack_overflows;
               continue;
             }

@@ -42,6 +42,10 @@ struct TraversalCounters {
 // 8-wide layout, stack-based, nearest child first.
 Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters = nullptr);
 bool any_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters = nullptr);
+// closest_hit with a smaller stack (1..kTraversalStackSize), so tests can drive the
+// overflow path: entries that do not fit are dropped and counted.
+Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit,
+                              TraversalCounters* counters = nullptr);
 
 // Threaded layout, stackless, fixed depth-first order.
 Hit closest_hit_threaded(const Bvh& bvh, const Ray& ray, TraversalCounters* counters = nullptr);

@@ -201,3 +201,32 @@ TEST(Bvh, BadInputThrows) {
 
 }  // namespace
 }  // namespace speculum::trace
+
+namespace speculum::trace {
+namespace {
+
+// With a stack of 4 entries the traversal must drop work, count every drop, never write
+// past the stack, and still agree with the oracle on every ray that did not overflow.
+TEST(Bvh, StackOverflowIsCountedNotUndefined) {
+  const testing::Soup s = testing::random_soup(4000, 51);
+  par::Executor ex(1);
+  const Bvh bvh = Bvh::build(s.positions, s.indices, ex);
+  std::uint64_t overflows = 0;
+  int clean = 0;
+  for (std::uint32_t i = 0; i < 400; ++i) {
+    const Ray r = testing::random_ray(i, 61);
+    TraversalCounters c;
+    const Hit h = closest_hit_limited_stack(bvh, r, 4, &c);
+    overflows += c.stack_overflows;
+    if (c.stack_overflows == 0) {
+      ++clean;
+      const Hit o = closest_hit_oracle(s.positions, s.indices, r);
+      EXPECT_EQ(o.triangle, h.triangle);
+    }
+  }
+  EXPECT_GT(overflows, 0u);
+  EXPECT_GT(clean, 0);
+}
+
+}  // namespace
+}  // namespace speculum::trace
