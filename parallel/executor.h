@@ -19,7 +19,48 @@
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
+#if defined(__SANITIZE_THREAD__)
+// ThreadSanitizer's annotation entry points (libtsan). Debian's libtbb.so is not
+// instrumented, so TSan cannot see the happens-before edges of TBB's fork/join; we state
+// them ourselves at every launch (see ForkJoinSync).
+extern "C" void __tsan_acquire(void* addr);
+extern "C" void __tsan_release(void* addr);
+#endif
+
 namespace speculum::par {
+
+// The happens-before edges of one fork/join, stated to ThreadSanitizer (no code otherwise).
+// fork(): the launching thread publishes its writes; enter(): a task starts after them;
+// leave(): a task's writes are published to the join; join(): the launcher, after TBB's
+// wait returns, sees every task's writes. Two separate sync addresses, so tasks of one
+// launch get no edge between each other (a race between two chunks is still reported).
+class ForkJoinSync {
+ public:
+  // Scope guards: leave()/join() also on the exceptional path.
+  struct LeaveOnExit {
+    ForkJoinSync& sync;
+    ~LeaveOnExit() { sync.leave(); }
+  };
+  struct JoinOnExit {
+    ForkJoinSync& sync;
+    ~JoinOnExit() { sync.join(); }
+  };
+#if defined(__SANITIZE_THREAD__)
+  void fork() { __tsan_release(&fork_); }
+  void enter() { __tsan_acquire(&fork_); }
+  void leave() { __tsan_release(&join_); }
+  void join() { __tsan_acquire(&join_); }
+
+ private:
+  char fork_ = 0;
+  char join_ = 0;
+#else
+  void fork() {}
+  void enter() {}
+  void leave() {}
+  void join() {}
+#endif
+};
 
 // One named kernel launch, as the profiler and `inspect` show it.
 struct LaunchRecord {
@@ -81,10 +122,15 @@ class Executor {
     if (synchronous() || chunks <= 1) {
       for (std::size_t c = 0; c < chunks; ++c) run_chunk(c);
     } else {
+      ForkJoinSync sync;  // per launch
+      sync.fork();
+      ForkJoinSync::JoinOnExit join{sync};
       arena_->execute([&] {
         tbb::parallel_for(
             tbb::blocked_range<std::size_t>(0, chunks, 1),
             [&](const tbb::blocked_range<std::size_t>& r) {
+              sync.enter();
+              ForkJoinSync::LeaveOnExit leave{sync};
               for (std::size_t c = r.begin(); c != r.end(); ++c) run_chunk(c);
             },
             tbb::simple_partitioner());
@@ -114,7 +160,14 @@ class Executor {
   template <class F>
   decltype(auto) run(F&& f) {
     if (synchronous()) return std::forward<F>(f)();
-    return arena_->execute(std::forward<F>(f));
+    ForkJoinSync sync;  // the arena may run f on one of its own threads
+    sync.fork();
+    ForkJoinSync::JoinOnExit join{sync};
+    return arena_->execute([&]() -> decltype(auto) {
+      sync.enter();
+      ForkJoinSync::LeaveOnExit leave{sync};
+      return std::forward<F>(f)();
+    });
   }
 
   // Launch records since the last clear; recording is on by default and cheap.

@@ -234,14 +234,23 @@ RunReport Graph::run(Executor& executor, const CaptureHook& capture) {
       tbb::task_group group;
       std::vector<std::atomic<std::size_t>> pending(nodes_.size());
       for (std::size_t i = 0; i < nodes_.size(); ++i) pending[i].store(predecessor_count_[i]);
+      // One fork/join sync per node (TSan annotations; nothing in normal builds): the
+      // thread that spawns a node publishes to it, every node publishes to the final wait.
+      std::vector<ForkJoinSync> sync(nodes_.size());
+      ForkJoinSync done;
       std::function<void(std::size_t)> launch = [&](std::size_t i) {
-        group.run([&, i] {
+        ForkJoinSync* node_sync = &sync[i];  // by value: the task reads nothing unsynced first
+        node_sync->fork();
+        group.run([&, i, node_sync] {
+          node_sync->enter();
+          ForkJoinSync::LeaveOnExit leave{done};
           run_node(i, executor, capture, records[i]);
           // acq_rel: the last predecessor to finish publishes every input to the successor.
           for (std::size_t s : successors_[i])
             if (pending[s].fetch_sub(1, std::memory_order_acq_rel) == 1) launch(s);
         });
       };
+      ForkJoinSync::JoinOnExit join{done};
       for (std::size_t i : order_)
         if (predecessor_count_[i] == 0) launch(i);
       group.wait();
