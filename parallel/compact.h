@@ -16,7 +16,7 @@ namespace speculum::par {
 // Counters of one hierarchical compaction (bounded-loop accounting, DESIGN.md).
 struct HierarchicalCompactStats {
   std::uint64_t blocks = 0;
-  std::uint64_t search_steps = 0;  // iterations of the Fig.4.7 loop, summed over outputs
+  std::uint64_t search_steps = 0;  // psum probes of the Fig.4.7 search, summed over outputs
 };
 
 // out[0, count) = indices i with keep[i] != 0, ascending; returns count. out.size() >= the
@@ -27,7 +27,7 @@ std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const
 
 // Same result, computed gather-only: blocks of `block_size` elements (s in ROGER; any s >= 1)
 // get an inclusive count of empty elements pSum; output slot i of a block gathers the unique
-// kept j with j - pSum[j] = i by the tightened dichotomic search of Fig.4.7; the block counts
+// kept j with j - pSum[j] = i (the Fig.4.7 invariant) by a branch-free bisection; the block counts
 // are scanned into block displacements and every output slot gathers from its block
 // (concatenation, Fig.4.8). `scratch` holds the block-local results (resized to n rounded
 // up to s); pass one in to avoid reallocating it each call.
@@ -37,9 +37,9 @@ std::size_t compact_hierarchical(Executor& ex, std::string_view name,
                                  HierarchicalCompactStats* stats = nullptr);
 
 // The within-block step alone (exposed for tests and teaching): for one block of flags,
-// writes the kept positions (block-local) to out[0, count) by the Fig.4.7 search and
-// returns count; `psum` receives the inclusive empty counts. `steps` accumulates loop
-// iterations.
+// writes the kept positions (block-local) to out[0, count) by the Fig.4.7 search (as a
+// branch-free bisection on j - pSum[j]) and returns count; `psum` receives the inclusive
+// empty counts. `steps` accumulates psum probes.
 std::size_t compact_block_gather(std::span<const std::uint8_t> block, std::span<std::uint32_t> psum,
                                  std::span<std::uint32_t> out, std::uint64_t& steps);
 

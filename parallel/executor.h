@@ -11,6 +11,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -60,6 +61,41 @@ class ForkJoinSync {
   void leave() {}
   void join() {}
 #endif
+};
+
+// The callable handed to TBB for one launch: pointers to the launch's sync and to the real
+// body (which stays on the launcher's stack), and an index passed to bodies that take one
+// first (the graph's node number). TBB copies it on one thread and runs the copy
+// on another, an edge TSan cannot see; so the pointers are copied and read with relaxed
+// atomics (plain moves in machine code), the only accesses before enter() makes the
+// launcher's writes visible.
+template <class F>
+class ForkJoinTask {
+ public:
+  ForkJoinTask(ForkJoinSync& sync, F& f, std::size_t index = 0)
+      : sync_(&sync), f_(&f), index_(index) {}
+  ForkJoinTask(const ForkJoinTask& other) {
+    __atomic_store_n(&sync_, __atomic_load_n(&other.sync_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
+    __atomic_store_n(&f_, __atomic_load_n(&other.f_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
+    __atomic_store_n(&index_, __atomic_load_n(&other.index_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
+  }
+  ForkJoinTask& operator=(const ForkJoinTask&) = delete;
+  template <class... Args>
+  void operator()(Args&&... args) const {
+    ForkJoinSync* sync = __atomic_load_n(&sync_, __ATOMIC_RELAXED);
+    sync->enter();
+    ForkJoinSync::LeaveOnExit leave{*sync};
+    F& f = *__atomic_load_n(&f_, __ATOMIC_RELAXED);
+    if constexpr (std::is_invocable_v<F&, std::size_t, Args...>)
+      f(__atomic_load_n(&index_, __ATOMIC_RELAXED), std::forward<Args>(args)...);
+    else
+      f(std::forward<Args>(args)...);
+  }
+
+ private:
+  ForkJoinSync* sync_;
+  F* f_;
+  std::size_t index_;
 };
 
 // One named kernel launch, as the profiler and `inspect` show it.
@@ -125,15 +161,13 @@ class Executor {
       ForkJoinSync sync;  // per launch
       sync.fork();
       ForkJoinSync::JoinOnExit join{sync};
+      auto run_range = [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c) run_chunk(c);
+      };
       arena_->execute([&] {
-        tbb::parallel_for(
-            tbb::blocked_range<std::size_t>(0, chunks, 1),
-            [&](const tbb::blocked_range<std::size_t>& r) {
-              sync.enter();
-              ForkJoinSync::LeaveOnExit leave{sync};
-              for (std::size_t c = r.begin(); c != r.end(); ++c) run_chunk(c);
-            },
-            tbb::simple_partitioner());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+                          ForkJoinTask<decltype(run_range)>(sync, run_range),
+                          tbb::simple_partitioner());
       });
     }
     record(name, n, chunks, t0, now_ns() - t0);

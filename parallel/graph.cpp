@@ -238,17 +238,19 @@ RunReport Graph::run(Executor& executor, const CaptureHook& capture) {
       // thread that spawns a node publishes to it, every node publishes to the final wait.
       std::vector<ForkJoinSync> sync(nodes_.size());
       ForkJoinSync done;
-      std::function<void(std::size_t)> launch = [&](std::size_t i) {
-        ForkJoinSync* node_sync = &sync[i];  // by value: the task reads nothing unsynced first
-        node_sync->fork();
-        group.run([&, i, node_sync] {
-          node_sync->enter();
-          ForkJoinSync::LeaveOnExit leave{done};
-          run_node(i, executor, capture, records[i]);
-          // acq_rel: the last predecessor to finish publishes every input to the successor.
-          for (std::size_t s : successors_[i])
-            if (pending[s].fetch_sub(1, std::memory_order_acq_rel) == 1) launch(s);
-        });
+      std::function<void(std::size_t)> launch;
+      // Node i's task body; it runs after sync[i].enter() (ForkJoinTask), i.e. after
+      // everything its spawner did, and publishes to the final wait through `done`.
+      auto body = [&](std::size_t i) {
+        ForkJoinSync::LeaveOnExit leave{done};
+        run_node(i, executor, capture, records[i]);
+        // acq_rel: the last predecessor to finish publishes every input to the successor.
+        for (std::size_t s : successors_[i])
+          if (pending[s].fetch_sub(1, std::memory_order_acq_rel) == 1) launch(s);
+      };
+      launch = [&](std::size_t i) {
+        sync[i].fork();
+        group.run(ForkJoinTask<decltype(body)>(sync[i], body, i));
       };
       ForkJoinSync::JoinOnExit join{done};
       for (std::size_t i : order_)

@@ -3,6 +3,7 @@
 #include "parallel/partition.h"
 
 #include <algorithm>
+#include <bit>
 #include <stdexcept>
 #include <string>
 
@@ -28,6 +29,30 @@ std::vector<std::size_t> chunk_offsets(std::span<std::uint32_t> counts, std::siz
   return totals;
 }
 
+// Software write-combining for the digit scatter: each bucket collects one cache line of
+// keys (and the matching payloads) before they go out together, so the scatter writes
+// whole lines instead of one element to each of up to 2048 pages per step.
+template <class Key>
+struct WriteCombine {
+  static constexpr std::size_t kLine = 64 / sizeof(Key);  // elements per bucket buffer
+  std::vector<Key> keys;
+  std::vector<std::uint32_t> payload;
+  std::vector<std::uint32_t> fill;
+  void reserve(std::size_t buckets) {
+    if (fill.size() >= buckets) return;
+    keys.resize(buckets * kLine);
+    payload.resize(buckets * kLine);
+    fill.resize(buckets);
+  }
+};
+
+template <class Key>
+WriteCombine<Key>& thread_write_combine(std::size_t buckets) {
+  thread_local WriteCombine<Key> wc;
+  wc.reserve(buckets);
+  return wc;
+}
+
 template <class Key>
 void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
                      std::span<std::uint32_t> payload, RadixSortScratch<Key>* scratch, std::size_t chunk) {
@@ -37,31 +62,72 @@ void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
     throw std::invalid_argument("radix_sort: payload size differs from key count");
   if (n <= 1) return;
   if (chunk == 0) chunk = 1;
+  // Only the bits that differ between keys need sorting passes: find them in one read
+  // (OR of key ^ keys[0]), then cover [lowest, highest] varying bit with the fewest digits
+  // of at most kMaxDigitBits bits, equally sized (3 passes for full 32-bit keys).
+  constexpr unsigned kMaxDigitBits = 11;
+  const Key first = keys[0];
+  const Key varying = ex.parallel_reduce(
+      launch_name(name, "varying_bits"), n, chunk, Key{0},
+      [&](std::size_t b, std::size_t e) {
+        Key v = 0;
+        for (std::size_t i = b; i < e; ++i) v |= keys[i] ^ first;
+        return v;
+      },
+      [](Key a, Key b) { return Key(a | b); });
+  if (varying == 0) return;  // all keys equal: a stable sort leaves everything in place
+  const unsigned lo_bit = unsigned(std::countr_zero(varying));
+  const unsigned bits = unsigned(std::bit_width(varying)) - lo_bit;
+  const unsigned passes = (bits + kMaxDigitBits - 1) / kMaxDigitBits;
+  const unsigned digit_bits = (bits + passes - 1) / passes;
+  const std::size_t buckets = std::size_t(1) << digit_bits;
+
   RadixSortScratch<Key> own;
   RadixSortScratch<Key>& s = scratch ? *scratch : own;
   s.keys.resize(n);
   if (with_payload) s.payload.resize(n);
-  constexpr std::size_t kBuckets = 256;
   const std::size_t chunks = Executor::chunk_count(n, chunk);
-  s.counts.resize(chunks * kBuckets);
+  s.counts.resize(chunks * buckets);
   std::span<Key> src_k = keys, dst_k = s.keys;
   std::span<std::uint32_t> src_p = payload, dst_p = with_payload ? std::span(s.payload) : payload;
   const std::string hist_name = launch_name(name, "digit_counts");
   const std::string scatter_name = launch_name(name, "digit_scatter");
-  for (unsigned shift = 0; shift < 8 * sizeof(Key); shift += 8) {
+  for (unsigned pass = 0; pass < passes; ++pass) {
+    const unsigned shift = lo_bit + pass * digit_bits;
+    const Key mask = Key(buckets - 1);
     ex.parallel_for(hist_name, n, chunk, [&](std::size_t b, std::size_t e) {
-      std::uint32_t* count = s.counts.data() + (b / chunk) * kBuckets;
-      std::fill(count, count + kBuckets, 0u);
-      for (std::size_t i = b; i < e; ++i) ++count[(src_k[i] >> shift) & 0xff];
+      std::uint32_t* count = s.counts.data() + (b / chunk) * buckets;
+      std::fill(count, count + buckets, 0u);
+      for (std::size_t i = b; i < e; ++i) ++count[(src_k[i] >> shift) & mask];
     });
-    const auto totals = chunk_offsets(s.counts, chunks, kBuckets);
+    const auto totals = chunk_offsets(s.counts, chunks, buckets);
     if (std::find(totals.begin(), totals.end(), n) != totals.end()) continue;  // digit constant
     ex.parallel_for(scatter_name, n, chunk, [&](std::size_t b, std::size_t e) {
-      std::uint32_t* offset = s.counts.data() + (b / chunk) * kBuckets;
+      constexpr std::size_t L = WriteCombine<Key>::kLine;
+      std::uint32_t* offset = s.counts.data() + (b / chunk) * buckets;
+      WriteCombine<Key>& wc = thread_write_combine<Key>(buckets);
+      std::uint32_t* fill = wc.fill.data();
+      Key* buf_k = wc.keys.data();
+      std::uint32_t* buf_p = wc.payload.data();
+      std::fill(fill, fill + buckets, 0u);
       for (std::size_t i = b; i < e; ++i) {
-        const std::uint32_t slot = offset[(src_k[i] >> shift) & 0xff]++;
-        dst_k[slot] = src_k[i];
-        if (with_payload) dst_p[slot] = src_p[i];
+        const Key k = src_k[i];
+        const std::size_t d = std::size_t((k >> shift) & mask);
+        const std::uint32_t f = fill[d];
+        buf_k[d * L + f] = k;
+        if (with_payload) buf_p[d * L + f] = src_p[i];
+        if (f + 1 == L) {
+          std::copy_n(buf_k + d * L, L, dst_k.data() + offset[d]);
+          if (with_payload) std::copy_n(buf_p + d * L, L, dst_p.data() + offset[d]);
+          offset[d] += L;
+          fill[d] = 0;
+        } else {
+          fill[d] = f + 1;
+        }
+      }
+      for (std::size_t d = 0; d < buckets; ++d) {  // partial lines, in bucket order
+        std::copy_n(buf_k + d * L, fill[d], dst_k.data() + offset[d]);
+        if (with_payload) std::copy_n(buf_p + d * L, fill[d], dst_p.data() + offset[d]);
       }
     });
     std::swap(src_k, dst_k);

@@ -33,7 +33,9 @@ struct RadixSortScratch {
 };
 
 // Sorts keys ascending, carrying payload[i] along; stable (equal keys keep their order).
-// 8-bit digits, least significant first; a digit that is equal for all keys is skipped.
+// Only the span of bits that differ between keys is sorted, in the fewest equal digits of
+// <= 11 bits (3 passes for arbitrary 32-bit keys), least significant first; per-thread
+// write-combining buffers turn the scatter into whole-line writes.
 // payload may be empty (keys only); otherwise it must have keys.size() elements.
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch = nullptr,
