@@ -177,6 +177,10 @@ def main():
           b"property float x\nproperty float y\nproperty float z\nelement face 1\n"
           b"property list uchar int vertex_indices\nend_header\n" + struct.pack("<4f", 0, 0, 0, 1))
     write(BAD, "not_a_ply.ply", "hello\n", "w")
+    # Property before any element: crashed OpenMesh's PLY reader before our header check.
+    write(BAD, "property_before_element.ply", "ply\nformat ascii 1.0\n\xa6lement vertex 4\n"
+          "property float x\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n", "w")
+    write(BAD, "no_end_header.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n", "w")
     write(BAD, "empty.off", b"")
     write(BAD, "absurd_count.off", "OFF\n1000000000 1000000000 0\n0 0 0\n", "w")
     write(BAD, "truncated.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n", "w")
