@@ -11,4 +11,4 @@ $SUDO apt-get install -y -q --no-install-recommends \
   libtinygltf-dev nlohmann-json3-dev libstb-dev \
   libopenmesh-dev libtbb-dev \
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev \
-  assimp-testmodels graphviz
+  assimp-testmodels graphviz libembree-dev

@@ -1,4 +1,8 @@
+#include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -25,6 +29,25 @@ TEST(ImageIo, ExrRoundTripIsExact) {
   ASSERT_EQ(back.width, 7);
   ASSERT_EQ(back.height, 5);
   for (std::size_t i = 0; i < img.size(); ++i) EXPECT_EQ(back.pixels[i], img.pixels[i]) << i;
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The EXR header carries a capture date; writing the same pixels a second later must still
+// give the same bytes (CI compares hashes of output files).
+TEST(ImageIo, ExrBytesDoNotDependOnTheClock) {
+  ImageRGBA img(3, 2, glm::vec4(0.25f, 0.5f, 2.0f, 1.0f));
+  const std::string a = (temp_dir() / "clock_a.exr").string();
+  const std::string b = (temp_dir() / "clock_b.exr").string();
+  write_image(a, img);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  write_image(b, img);
+  const std::string bytes_a = file_bytes(a);
+  ASSERT_FALSE(bytes_a.empty());
+  EXPECT_EQ(bytes_a, file_bytes(b));
 }
 
 TEST(ImageIo, PngEncodesSrgbAndDecodesBack) {
