@@ -159,11 +159,11 @@ class Executor {
       for (std::size_t c = 0; c < chunks; ++c) run_chunk(c);
     } else {
       ForkJoinSync sync;  // per launch
-      sync.fork();
-      ForkJoinSync::JoinOnExit join{sync};
       auto run_range = [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t c = r.begin(); c != r.end(); ++c) run_chunk(c);
       };
+      sync.fork();  // after everything the tasks read is written
+      ForkJoinSync::JoinOnExit join{sync};
       arena_->execute([&] {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
                           ForkJoinTask<decltype(run_range)>(sync, run_range),

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -15,17 +16,23 @@ namespace {
 // elements of that bucket (bucket-major, then chunk order). Returns per-bucket totals.
 std::vector<std::size_t> chunk_offsets(std::span<std::uint32_t> counts, std::size_t chunks,
                                        std::size_t p) {
+  // Same offsets as walking bucket-major, but row by row: per-bucket totals, bucket starts,
+  // then each chunk's row in chunk order (contiguous reads; a column walk strides by p).
   std::vector<std::size_t> totals(p, 0);
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t d = 0; d < p; ++d) totals[d] += counts[c * p + d];
+  std::vector<std::uint32_t> next(p);
   std::size_t running = 0;
   for (std::size_t d = 0; d < p; ++d) {
-    const std::size_t start = running;
-    for (std::size_t c = 0; c < chunks; ++c) {
-      const std::uint32_t k = counts[c * p + d];
-      counts[c * p + d] = std::uint32_t(running);
-      running += k;
-    }
-    totals[d] = running - start;
+    next[d] = std::uint32_t(running);
+    running += totals[d];
   }
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t d = 0; d < p; ++d) {
+      const std::uint32_t k = counts[c * p + d];
+      counts[c * p + d] = next[d];
+      next[d] += k;
+    }
   return totals;
 }
 
@@ -96,29 +103,41 @@ void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
     const unsigned shift = lo_bit + pass * digit_bits;
     const Key mask = Key(buckets - 1);
     ex.parallel_for(hist_name, n, chunk, [&](std::size_t b, std::size_t e) {
-      std::uint32_t* count = s.counts.data() + (b / chunk) * buckets;
+      std::uint32_t* const count = s.counts.data() + (b / chunk) * buckets;
+      const Key* const in_k = src_k.data();
+      const unsigned sh = shift;
+      const Key m = mask;
       std::fill(count, count + buckets, 0u);
-      for (std::size_t i = b; i < e; ++i) ++count[(src_k[i] >> shift) & mask];
+      for (std::size_t i = b; i < e; ++i) ++count[(in_k[i] >> sh) & m];
     });
     const auto totals = chunk_offsets(s.counts, chunks, buckets);
     if (std::find(totals.begin(), totals.end(), n) != totals.end()) continue;  // digit constant
     ex.parallel_for(scatter_name, n, chunk, [&](std::size_t b, std::size_t e) {
       constexpr std::size_t L = WriteCombine<Key>::kLine;
-      std::uint32_t* offset = s.counts.data() + (b / chunk) * buckets;
+      // Everything the loop touches in locals: through the closure, every store could
+      // alias the captures and force reloads.
+      std::uint32_t* const offset = s.counts.data() + (b / chunk) * buckets;
       WriteCombine<Key>& wc = thread_write_combine<Key>(buckets);
-      std::uint32_t* fill = wc.fill.data();
-      Key* buf_k = wc.keys.data();
-      std::uint32_t* buf_p = wc.payload.data();
+      std::uint32_t* const fill = wc.fill.data();
+      Key* const buf_k = wc.keys.data();
+      std::uint32_t* const buf_p = wc.payload.data();
+      const Key* const in_k = src_k.data();
+      const std::uint32_t* const in_p = src_p.data();
+      Key* const out_k = dst_k.data();
+      std::uint32_t* const out_p = dst_p.data();
+      const unsigned sh = shift;
+      const Key m = mask;
+      const bool pay = with_payload;
       std::fill(fill, fill + buckets, 0u);
       for (std::size_t i = b; i < e; ++i) {
-        const Key k = src_k[i];
-        const std::size_t d = std::size_t((k >> shift) & mask);
+        const Key k = in_k[i];
+        const std::size_t d = std::size_t((k >> sh) & m);
         const std::uint32_t f = fill[d];
         buf_k[d * L + f] = k;
-        if (with_payload) buf_p[d * L + f] = src_p[i];
-        if (f + 1 == L) {
-          std::copy_n(buf_k + d * L, L, dst_k.data() + offset[d]);
-          if (with_payload) std::copy_n(buf_p + d * L, L, dst_p.data() + offset[d]);
+        if (pay) buf_p[d * L + f] = in_p[i];
+        if (f + 1 == L) {  // fixed-size copies: inlined vector moves, not memmove calls
+          std::memcpy(out_k + offset[d], buf_k + d * L, L * sizeof(Key));
+          if (pay) std::memcpy(out_p + offset[d], buf_p + d * L, L * sizeof(std::uint32_t));
           offset[d] += L;
           fill[d] = 0;
         } else {
@@ -126,8 +145,8 @@ void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
         }
       }
       for (std::size_t d = 0; d < buckets; ++d) {  // partial lines, in bucket order
-        std::copy_n(buf_k + d * L, fill[d], dst_k.data() + offset[d]);
-        if (with_payload) std::copy_n(buf_p + d * L, fill[d], dst_p.data() + offset[d]);
+        std::copy_n(buf_k + d * L, fill[d], out_k + offset[d]);
+        if (pay) std::copy_n(buf_p + d * L, fill[d], out_p + offset[d]);
       }
     });
     std::swap(src_k, dst_k);
