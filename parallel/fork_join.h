@@ -1,6 +1,6 @@
 // Fork/join happens-before edges for ThreadSanitizer around TBB launches (executor.h,
-// graph.cpp); compiles to nothing unless built with -fsanitize=thread (DESIGN.md
-// "Determinism" relies on these launches; tests/tsan.supp names this file).
+// graph.cpp). The annotations compile to nothing unless built with -fsanitize=thread;
+// ForkJoinTask is then a two-pointer forwarder. tests/tsan.supp names this file.
 #pragma once
 
 #include <cstddef>
