@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "parallel/chunk_counts.h"
+
 namespace speculum::par {
 
 namespace {
@@ -171,20 +173,8 @@ void partition_stable(Executor& ex, std::string_view name, std::span<const std::
     throw std::invalid_argument("partition_stable: output spans too small");
   if (chunk == 0) chunk = 1;
   const std::size_t chunks = Executor::chunk_count(n, chunk);
-  std::vector<std::uint32_t> counts(chunks * p);
-  std::vector<std::uint8_t> bad(chunks, 0);
-  ex.parallel_for(launch_name(name, "bucket_counts"), n, chunk, [&](std::size_t b, std::size_t e) {
-    std::uint32_t* count = counts.data() + (b / chunk) * p;
-    for (std::size_t i = b; i < e; ++i) {
-      if (bucket[i] >= p) {
-        bad[b / chunk] = 1;
-        return;
-      }
-      ++count[bucket[i]];
-    }
-  });
-  if (std::find(bad.begin(), bad.end(), 1) != bad.end())
-    throw std::invalid_argument("partition_stable: a bucket id is >= the bucket count " + std::to_string(p));
+  std::vector<std::uint32_t> counts = count_ids_per_chunk(
+      ex, name, "bucket_counts", bucket, p, chunk, "partition_stable", "bucket");
   const auto totals = chunk_offsets(counts, chunks, p);
   std::size_t running = 0;
   for (std::size_t d = 0; d < p; ++d) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "parallel/chunk_counts.h"
 #include "parallel/partition.h"
 
 namespace speculum::par {
@@ -71,20 +72,8 @@ void histogram(Executor& ex, std::string_view name, std::span<const std::uint32_
   const std::size_t n = bin.size();
   if (chunk == 0) chunk = 1;
   const std::size_t chunks = Executor::chunk_count(n, chunk);
-  std::vector<std::uint32_t> local(chunks * bins, 0);
-  std::vector<std::uint8_t> bad(chunks, 0);
-  ex.parallel_for(launch_name(name, "chunk_counts"), n, chunk, [&](std::size_t b, std::size_t e) {
-    std::uint32_t* c = local.data() + (b / chunk) * bins;
-    for (std::size_t i = b; i < e; ++i) {
-      if (bin[i] >= bins) {
-        bad[b / chunk] = 1;
-        return;
-      }
-      ++c[bin[i]];
-    }
-  });
-  if (std::find(bad.begin(), bad.end(), 1) != bad.end())
-    throw std::invalid_argument("histogram: a bin id is >= the bin count " + std::to_string(bins));
+  const std::vector<std::uint32_t> local =
+      count_ids_per_chunk(ex, name, "chunk_counts", bin, bins, chunk, "histogram", "bin");
   ex.parallel_for(launch_name(name, "sum_chunks"), bins, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       std::uint64_t total = 0;

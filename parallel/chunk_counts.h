@@ -1,0 +1,24 @@
+// Per-chunk counts of small integer ids: the counting pass shared by stable partition and
+// histogram (ROGER §4.5 bucket sort counts per block before any output is placed).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "parallel/executor.h"
+
+namespace speculum::par {
+
+// counts[c * bins + id] = how many elements of chunk c carry `id`. Launch "<name>/<phase>".
+// Throws std::invalid_argument("<what>: a <id_kind> id is >= the <id_kind> count N") when an
+// id is out of range.
+std::vector<std::uint32_t> count_ids_per_chunk(Executor& ex, std::string_view name,
+                                               std::string_view phase,
+                                               std::span<const std::uint32_t> ids,
+                                               std::size_t bins, std::size_t chunk,
+                                               std::string_view what, std::string_view id_kind);
+
+}  // namespace speculum::par
