@@ -13,6 +13,18 @@
 namespace speculum::pipeline {
 namespace {
 
+// Both workloads are framed by one named camera with the same clip planes.
+Camera bench_camera(const glm::vec3& eye, const glm::vec3& target, float vfov_degrees) {
+  Camera c;
+  c.name = "bench";
+  c.eye = eye;
+  c.target = target;
+  c.vfov_degrees = vfov_degrees;
+  c.znear = 0.05f;
+  c.zfar = 100.0f;
+  return c;
+}
+
 Scene spheres_room() {
   procedural::SceneBuilder b("bench:spheres-room");
   const auto wall = b.add_material(procedural::diffuse("wall", {0.7f, 0.7f, 0.7f}));
@@ -22,14 +34,7 @@ Scene spheres_room() {
     for (int i = 0; i < 10; ++i)
       b.add_object("sphere" + std::to_string(j * 10 + i), ball,
                    procedural::sphere({-4.5f + i, 0.45f + 0.3f * ((i + j) % 3), -4.5f + j}, 0.42f, 50));
-  Camera c;
-  c.name = "bench";
-  c.eye = {0.0f, 4.5f, 7.5f};
-  c.target = {0.0f, 0.5f, -1.0f};
-  c.vfov_degrees = 60.0f;
-  c.znear = 0.05f;
-  c.zfar = 100.0f;
-  b.scene().cameras.push_back(c);
+  b.scene().cameras.push_back(bench_camera({0.0f, 4.5f, 7.5f}, {0.0f, 0.5f, -1.0f}, 60.0f));
   Scene s = b.take();
   finish_scene(s);
   return s;
@@ -52,14 +57,7 @@ Scene random_triangles() {
     }
   }
   b.add_object("triangles", m, std::move(mesh));
-  Camera c;
-  c.name = "bench";
-  c.eye = {0.0f, 0.0f, 3.2f};
-  c.target = {0.0f, 0.0f, 0.0f};
-  c.vfov_degrees = 45.0f;
-  c.znear = 0.05f;
-  c.zfar = 100.0f;
-  b.scene().cameras.push_back(c);
+  b.scene().cameras.push_back(bench_camera({0.0f, 0.0f, 3.2f}, {0.0f, 0.0f, 0.0f}, 45.0f));
   Scene s = b.take();
   finish_scene(s);
   return s;
