@@ -11,4 +11,5 @@ $SUDO apt-get install -y -q --no-install-recommends \
   libtinygltf-dev nlohmann-json3-dev libstb-dev \
   libopenmesh-dev libtbb-dev \
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev \
-  assimp-testmodels graphviz libembree-dev
+  assimp-testmodels graphviz libembree-dev \
+  ccache chromium

@@ -23,4 +23,7 @@ void add_bench_command(CLI::App& app, GlobalOptions& global);
 void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global);
 void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global);
 
+// `experiment` parent (apps/cmd_experiment.cpp) and its children, one per cmd_experiment_*.cpp.
+void add_experiment_command(CLI::App& app, GlobalOptions& global);
+
 }  // namespace speculum::cli

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   cli::add_render_command(app, global);
   cli::add_techniques_command(app, global);
   cli::add_bench_command(app, global);
+  cli::add_experiment_command(app, global);
 
   try {
     app.parse(argc, argv);

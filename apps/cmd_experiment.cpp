@@ -1,0 +1,16 @@
+// `speculum experiment NAME`: the paper-reproduction sweeps (issues 6–8). Each experiment
+// is a child subcommand in its own apps/cmd_experiment_*.cpp, registered here.
+#include "apps/cli.h"
+
+namespace speculum::cli {
+
+void add_experiment_command(CLI::App& app, GlobalOptions& global) {
+  auto* cmd = app.add_subcommand(
+      "experiment", "Reproduce a paper's measurements: sweeps that print a table (or --json rows)");
+  cmd->require_subcommand(1);
+  cmd->fallthrough();
+  // One line per experiment (apps/cmd_experiment_*.cpp):
+  (void)global;
+}
+
+}  // namespace speculum::cli
