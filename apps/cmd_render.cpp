@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <cstdlib>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "apps/cli.h"
 #include "apps/pipeline_camera_options.h"
@@ -25,11 +28,29 @@ struct RenderOptions {
   std::uint32_t seed = 0;
   float exposure = 1.0f;
   bool timings = false;
+  float alpha = 0.0f;
+  int bounces = 1;
+  std::vector<std::string> params;
   pipeline::CameraOverrides camera;
 };
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// --param name=value (repeatable) → FrameSettings::params.
+std::map<std::string, double> parse_technique_params(const std::vector<std::string>& items) {
+  std::map<std::string, double> out;
+  for (const std::string& item : items) {
+    const auto eq = item.find('=');
+    char* end = nullptr;
+    const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
+    if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0' ||
+        !std::isfinite(v))
+      throw InputError("--param", "expected name=number, got '" + item + "'");
+    out[item.substr(0, eq)] = v;
+  }
+  return out;
 }
 
 void run_render(const RenderOptions& o, const GlobalOptions& global) {
@@ -56,6 +77,9 @@ void run_render(const RenderOptions& o, const GlobalOptions& global) {
   f.spp = o.spp;
   f.seed = o.seed;
   f.exposure = o.exposure;
+  f.alpha = o.alpha;
+  f.bounces = o.bounces;
+  f.params = parse_technique_params(o.params);
   f.camera = pipeline::resolve_camera(scene, o.camera);
   par::Executor executor(global.threads);
   par::Graph graph;
@@ -92,6 +116,12 @@ void add_render_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("--seed", opts->seed, "Random seed")->capture_default_str();
   cmd->add_option("--exposure", opts->exposure, "Exposure multiplier before tone mapping")
       ->capture_default_str();
+  cmd->add_option("--alpha", opts->alpha, "yu-lod: LOD threshold α of YU eq.7 (0: LOD off)")
+      ->check(CLI::Range(0.0f, 1e6f))->capture_default_str();
+  cmd->add_option("--bounces", opts->bounces, "Specular bounces (ray-hierarchy, recursive techniques)")
+      ->check(CLI::Range(1, 16))->capture_default_str();
+  cmd->add_option("--param", opts->params,
+                  "Technique parameter name=value, repeatable (see `speculum techniques`)");
   cmd->add_flag("--timings", opts->timings, "Print each pass's wall time on stderr");
   pipeline::add_camera_options(*cmd, opts->camera);
   cmd->callback([opts, &global] { run_render(*opts, global); });

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
+#include <string>
 
 #include "core/image.h"
 #include "core/scene.h"
@@ -22,6 +24,16 @@ struct FrameSettings {
   int cube_map_size = 256;   // per-reflector dynamic environment maps
   int environment_size = 0;  // 0: from the environment image
   float exposure = 1.0f;
+  // Technique parameters (each technique reads the ones it documents; `render` sets them
+  // from --alpha, --bounces and the repeatable --param name=value).
+  float alpha = 0.0f;  // yu-lod: LOD threshold of YU eq.7; 0: LOD off
+  int bounces = 1;     // ray-hierarchy and recursive techniques: specular bounces
+  std::map<std::string, double> params;
+  // params[name] when given, else `fallback`.
+  double param(const std::string& name, double fallback) const {
+    const auto it = params.find(name);
+    return it == params.end() ? fallback : it->second;
+  }
 };
 
 // The graph's resource names that callers read back.
