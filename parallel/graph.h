@@ -84,6 +84,10 @@ class NodeBuilder {
   // Connects a declared port to a differently named resource.
   NodeBuilder& bind(std::string_view port, std::string resource);
   template <class V> NodeBuilder& param(std::string key, const V& value);
+  // What the pass does, in one or two sentences with its document section (shown by
+  // `inspect`), e.g. "Screen-space quad-tree of cone-spheres over the secondary rays
+  // (ROGER §3.2)."
+  NodeBuilder& describe(std::string text);
 
  private:
   template <class T>
@@ -145,6 +149,7 @@ class Graph {
     std::unique_ptr<Node> node;
     std::vector<PortDecl> ports;
     Params params;
+    std::string description;
   };
   const std::vector<NodeEntry>& nodes() const { return nodes_; }
 
@@ -180,6 +185,11 @@ NodeBuilder& NodeBuilder::add_port(std::string resource, std::string port_name, 
   entry.ports.push_back({std::move(port_name), std::move(resource), typeid(T), type_name<T>(),
                          output, previous});
   graph_->compiled_ = false;
+  return *this;
+}
+
+inline NodeBuilder& NodeBuilder::describe(std::string text) {
+  graph_->nodes_[index_].description = std::move(text);
   return *this;
 }
 
