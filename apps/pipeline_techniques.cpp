@@ -1,6 +1,7 @@
 // The technique table: see pipeline_techniques.h.
 #include "apps/pipeline_techniques.h"
 
+#include "apps/pipeline_planar_mirror.h"
 #include "core/error.h"
 
 namespace speculum::pipeline {
@@ -15,6 +16,11 @@ const std::vector<Technique>& techniques() {
        "reference tracer: BVH ray tracing, Whitted mirrors/refraction, Phong-lobe glossy "
        "sampling (--spp path samples); the ground truth",
        add_reference_passes},
+      {"planar-mirror",
+       "planar mirrors by geometry transformation (SURVEY §5): the camera reflected about "
+       "each mirror plane, scene clipped at the plane, recursive to --param depth=3; other "
+       "specular surfaces as envmap",
+       add_planar_mirror_passes},
   };
   return table;
 }

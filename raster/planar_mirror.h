@@ -1,0 +1,55 @@
+// Planar mirrors by geometry transformation (SURVEY §5): each planar mirror's reflection is
+// the scene seen by the camera reflected about the mirror plane, clipped to the viewer's
+// side of the plane, masked to the mirror's own samples and weighted by Fresnel; mirrors
+// seen in a mirrored view recurse, to depth k. Exact up to rasterization.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "raster/environment.h"
+#include "raster/gbuffer.h"
+#include "raster/mirrored_camera.h"
+#include "raster/shadow_map.h"
+
+namespace speculum::raster {
+
+struct PlanarMirror {
+  std::uint32_t object = kNoId;
+  Plane plane;
+  Scene front;  // the scene clipped to plane.signed_distance > 0, this mirror left out
+  Scene back;   // the same for the other side
+  const Scene& clipped_for(const glm::vec3& eye) const {
+    return plane.signed_distance(eye) >= 0.0f ? front : back;
+  }
+};
+
+// Objects whose material is a mirror (is_mirror_lobe, not a refractor) and whose vertices
+// all lie within `tolerance` × (bounding-box diagonal) of one plane. The plane normal is
+// the area-weighted mean of the triangle normals.
+std::vector<PlanarMirror> find_planar_mirrors(const Scene& scene, float tolerance = 1e-3f);
+
+struct PlanarMirrorSettings {
+  int depth = 3;  // mirror bounces rendered by geometry transformation
+  int width = 0;  // target size in samples (the camera G-buffer's)
+  int height = 0;
+};
+
+struct PlanarMirrorStats {
+  std::uint64_t mirrored_views = 0;  // visibility + shading passes of mirrored cameras
+  std::uint64_t mirror_samples = 0;  // samples that received a mirrored image
+};
+
+// The specular layer of G-buffer `g` (seen from `camera` in `view_scene`, object ids of
+// `scene`): planar-mirror samples get F(N·V) × the mirrored view's radiance (recursively,
+// `depth` levels; beyond it the environment lookup); every other specular sample gets the
+// environment-map layer (envmap_reflect). `shadows` and `env` are the original scene's.
+ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
+                                const std::vector<PlanarMirror>& mirrors, const GBuffer& g,
+                                const Camera& camera, const std::vector<ShadowMap>& shadows,
+                                const EnvironmentMap& env, const PlanarMirrorSettings& settings,
+                                PlanarMirrorStats* stats = nullptr);
+
+}  // namespace speculum::raster

@@ -1,0 +1,242 @@
+// Tests of planar mirrors by geometry transformation (SURVEY §5): the mirrored camera sees
+// exactly the reflected rays, clipping conserves area, the technique matches the reference
+// tracer up to rasterization, two facing mirrors show k images weighted F^k, and the
+// output is the same for 1 and 2 threads.
+#include "raster/planar_mirror.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "apps/pipeline_planar_mirror.h"
+#include "apps/pipeline_techniques.h"
+#include "apps/pipeline_frame.h"
+#include "core/camera_rays.h"
+#include "core/optics.h"
+#include "core/scene_loader.h"
+#include "raster_test_scenes.h"
+#include "trace/reference_tracer.h"
+
+namespace speculum::raster {
+namespace {
+
+using testing::add_triangles;
+
+// An axis-aligned quad [lo, hi] in the plane perpendicular to `axis`, wound so its
+// geometric normal points along +axis (sign > 0) or −axis.
+void add_quad(Scene& s, int axis, float at, glm::vec2 lo, glm::vec2 hi, float sign,
+              std::uint32_t material) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  auto p = [&](float a, float b) {
+    glm::vec3 q(0.0f);
+    q[axis] = at;
+    q[u] = a;
+    q[v] = b;
+    return q;
+  };
+  std::vector<glm::vec3> pts = {p(lo.x, lo.y), p(hi.x, lo.y), p(hi.x, hi.y), p(lo.x, hi.y)};
+  if (sign < 0) std::swap(pts[1], pts[3]);
+  add_triangles(s, pts, {0, 1, 2, 0, 2, 3}, {}, material);
+  auto& m = s.mesh;
+  const glm::vec3 n = glm::normalize(glm::cross(pts[1] - pts[0], pts[2] - pts[0]));
+  for (std::size_t i = m.normals.size() - 4; i < m.normals.size(); ++i) m.normals[i] = n;
+}
+
+Material emitter(glm::vec3 e) {
+  Material m;
+  m.base_color = glm::vec4(0, 0, 0, 1);
+  m.metallic = 0.0f;
+  m.roughness = 1.0f;
+  m.emissive = e;
+  return m;
+}
+
+Material mirror_material(float reflectance) {
+  Material m;
+  m.base_color = glm::vec4(glm::vec3(reflectance), 1.0f);
+  m.metallic = 1.0f;
+  m.roughness = 0.0f;
+  return m;
+}
+
+double triangle_area(const TriangleMesh& m, std::size_t t) {
+  const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+      c(m.positions[m.indices[3 * t + 2]]);
+  return 0.5 * glm::length(glm::cross(b - a, c - a));
+}
+
+TEST(PlanarMirror, MirroredCameraSeesTheReflectedRaysLeftRightMirrored) {
+  Camera cam;
+  cam.eye = {0.3f, 1.2f, 4.0f};
+  cam.target = {-0.5f, 0.8f, -1.0f};
+  Plane plane{glm::normalize(glm::vec3(0.2f, 0.1f, 1.0f)), -2.0f};
+  const Camera m = mirrored_camera(cam, plane);
+  const int w = 40, h = 30;
+  for (int y = 0; y < h; y += 7)
+    for (int x = 0; x < w; x += 5) {
+      const Ray r = primary_ray(cam, w, h, x + 0.5f, y + 0.5f);
+      const Ray q = primary_ray(m, w, h, (w - 1 - x) + 0.5f, y + 0.5f);
+      const glm::vec3 expected = glm::normalize(plane.reflect_direction(r.direction));
+      EXPECT_LT(glm::length(glm::normalize(q.direction) - expected), 1e-5f) << x << "," << y;
+      EXPECT_LT(glm::length(q.origin - plane.reflect_point(r.origin)), 1e-5f);
+    }
+}
+
+TEST(PlanarMirror, ClippingKeepsOneSideAndConservesArea) {
+  Scene s = load_scene("sphere-in-room:size=3000");
+  const Plane plane{glm::normalize(glm::vec3(1.0f, 0.3f, -0.2f)), 0.4f};
+  const Scene front = clip_scene_to_half_space(s, plane, 1.0f);
+  const Scene back = clip_scene_to_half_space(s, plane, -1.0f);
+  double area = 0, split = 0;
+  for (std::size_t t = 0; t < s.mesh.triangle_count(); ++t) area += triangle_area(s.mesh, t);
+  for (const Scene* c : {&front, &back})
+    for (std::size_t t = 0; t < c->mesh.triangle_count(); ++t) split += triangle_area(c->mesh, t);
+  EXPECT_NEAR(split, area, 1e-4 * area);  // no slivers lost or duplicated
+  for (std::size_t v : front.mesh.indices) EXPECT_GE(plane.signed_distance(front.mesh.positions[v]), -1e-5f);
+  for (std::size_t v : back.mesh.indices) EXPECT_LE(plane.signed_distance(back.mesh.positions[v]), 1e-5f);
+  // Objects keep contiguous ranges covering every kept triangle.
+  std::size_t covered = 0;
+  for (const Object& o : front.objects) covered += o.triangle_count;
+  EXPECT_EQ(covered, front.mesh.triangle_count());
+}
+
+TEST(PlanarMirror, FindsTheCorridorMirrorsOnly) {
+  const Scene s = load_scene("mirror-corridor:size=4000");
+  const auto mirrors = find_planar_mirrors(s);
+  ASSERT_EQ(mirrors.size(), 2u);
+  for (const PlanarMirror& m : mirrors) {
+    EXPECT_NEAR(std::abs(m.plane.normal.x), 1.0f, 1e-5f);
+    EXPECT_NEAR(std::abs(m.plane.offset), 2.0f, 1e-5f);
+  }
+  // The mirror spheres of sphere-in-room are not planar.
+  EXPECT_TRUE(find_planar_mirrors(load_scene("sphere-in-room:size=3000")).empty());
+}
+
+// Emissive quads in front of a mirror, no lights, black environment: the radiance is
+// emission and mirrored emission only, so raster and reference differ only where a pixel
+// centre lands on the other side of an edge.
+Scene emissive_mirror_scene() {
+  Scene s;
+  s.name = "emissive mirror";
+  s.materials = {mirror_material(0.8f), emitter({0.9f, 0.2f, 0.1f}), emitter({0.1f, 0.6f, 0.9f}),
+                 emitter({0.4f, 0.4f, 0.4f})};
+  add_quad(s, 2, -2.0f, {-2.0f, -1.5f}, {2.0f, 1.5f}, 1.0f, 0);   // mirror, facing +z
+  add_quad(s, 1, -1.5f, {-2.0f, -2.0f}, {2.0f, 4.0f}, 1.0f, 3);   // floor (y = -1.5)
+  add_quad(s, 2, 0.0f, {-1.2f, -1.0f}, {-0.2f, 0.2f}, 1.0f, 1);    // red panel
+  add_quad(s, 0, 0.8f, {-1.0f, -1.5f}, {0.5f, 0.5f}, -1.0f, 2);    // blue panel facing -x
+  s.environment.constant = glm::vec3(0.0f);
+  s.cameras.push_back(Camera{});
+  return s;
+}
+
+Camera emissive_camera() {
+  Camera c;
+  c.eye = {1.6f, 0.4f, 3.5f};
+  c.target = {-0.2f, -0.2f, -2.0f};
+  c.vfov_degrees = 50.0f;
+  return c;
+}
+
+pipeline::FrameSettings small_settings(const Camera& c, int depth) {
+  pipeline::FrameSettings f;
+  f.width = 96;
+  f.height = 72;
+  f.camera = c;
+  f.shadow_map_size = 64;
+  f.environment_size = 8;
+  f.params["depth"] = depth;
+  return f;
+}
+
+TEST(PlanarMirror, MatchesTheReferenceTracerUpToRasterization) {
+  const Scene s = emissive_mirror_scene();
+  const auto f = small_settings(emissive_camera(), 2);
+  par::Executor ex(2);
+  const auto frame = pipeline::render_frame(s, pipeline::find_technique("planar-mirror"), f, ex);
+  trace::ReferenceOptions o;
+  o.width = f.width;
+  o.height = f.height;
+  o.spp = 1;
+  o.max_depth = 2;
+  o.environment_lighting = false;
+  const ImageRGBA ref = trace::render_reference(s, f.camera, o, ex);
+  // A differing pixel must sit on an edge of the reference image (a 4-neighbour differs).
+  const auto differs = [](const glm::vec4& a, const glm::vec4& b) {
+    return glm::length(glm::vec3(a) - glm::vec3(b)) > 1e-3f;
+  };
+  int diff = 0, off_edge = 0, lit = 0;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const glm::vec4 r = ref.at(x, y);
+      if (glm::length(glm::vec3(r)) > 0.0f) ++lit;
+      if (!differs(frame.radiance.at(x, y), r)) continue;
+      ++diff;
+      bool edge = false;
+      for (auto [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx >= 0 && ny >= 0 && nx < f.width && ny < f.height && differs(ref.at(nx, ny), r)) edge = true;
+      }
+      if (!edge) ++off_edge;
+    }
+  const int pixels = f.width * f.height;
+  EXPECT_GT(lit, pixels / 3);  // the set-up really shows emitters
+  // Threshold: at most 4% of pixels differ, and every differing pixel is an edge pixel.
+  EXPECT_LT(diff, pixels * 4 / 100) << "differing pixels";
+  EXPECT_EQ(off_edge, 0) << "differing pixels away from any edge (of " << diff << ")";
+}
+
+// Two parallel mirrors of reflectance 0.5 (x = ±2) face each other; the camera between
+// them looks at mirror A (x = −2) head-on; an emissive bar just behind the camera is seen
+// only through the mirrors: the image after j bounces has radiance 0.5^j E (virtual bars
+// at x = −3, −9, −11, −17, separated on screen). Schlick's (1−cosθ)^5 < 1e-9 at these
+// angles, so F = 0.5 to float precision. Threshold: pixel values equal 0.5^j within 1e-5.
+TEST(PlanarMirror, TwoFacingMirrorsShowKImagesAttenuatedByFk) {
+  Scene s;
+  s.name = "facing mirrors";
+  s.materials = {mirror_material(0.5f), emitter(glm::vec3(1.0f))};
+  s.materials[1].double_sided = true;
+  add_quad(s, 0, -2.0f, {-20.0f, -20.0f}, {20.0f, 20.0f}, 1.0f, 0);  // mirror A facing +x
+  add_quad(s, 0, 2.0f, {-20.0f, -20.0f}, {20.0f, 20.0f}, -1.0f, 0);  // mirror B facing -x
+  add_quad(s, 0, -1.0f, {0.15f, -0.3f}, {0.18f, 0.3f}, -1.0f, 1);    // bar behind the camera
+  s.environment.constant = glm::vec3(0.0f);
+  Camera c;
+  c.eye = {-1.5f, 0.0f, 0.0f};
+  c.target = {-2.0f, 0.0f, 0.0f};
+  c.vfov_degrees = 14.5f;
+  par::Executor ex(2);
+  for (int k = 1; k <= 4; ++k) {
+    auto f = small_settings(c, k);
+    f.width = 64;
+    f.height = 320;
+    const auto frame = pipeline::render_frame(s, pipeline::find_technique("planar-mirror"), f, ex);
+    std::vector<int> per_level(static_cast<std::size_t>(k) + 1, 0);
+    int other = 0;
+    for (const glm::vec4& p : frame.radiance.pixels) {
+      if (glm::vec3(p) == glm::vec3(0.0f)) continue;
+      int level = -1;
+      for (int j = 1; j <= k; ++j)
+        if (std::abs(p.x - std::pow(0.5f, float(j))) < 1e-5f && p.x == p.y && p.y == p.z) level = j;
+      if (level < 0) ++other;
+      else ++per_level[static_cast<std::size_t>(level)];
+    }
+    EXPECT_EQ(other, 0) << "k=" << k << ": pixels that are no 0.5^j image";
+    for (int j = 1; j <= k; ++j)
+      EXPECT_GT(per_level[static_cast<std::size_t>(j)], 0) << "k=" << k << " image " << j;
+  }
+}
+
+TEST(PlanarMirror, SameBytesForOneAndTwoThreads) {
+  const Scene s = load_scene("mirror-corridor:size=3000");
+  auto f = small_settings(s.cameras.front(), 3);
+  par::Executor one(1), two(2);
+  const auto a = pipeline::render_frame(s, pipeline::find_technique("planar-mirror"), f, one);
+  const auto b = pipeline::render_frame(s, pipeline::find_technique("planar-mirror"), f, two);
+  ASSERT_EQ(a.radiance.size(), b.radiance.size());
+  EXPECT_EQ(0, std::memcmp(a.radiance.pixels.data(), b.radiance.pixels.data(),
+                           a.radiance.size() * sizeof(glm::vec4)));
+}
+
+}  // namespace
+}  // namespace speculum::raster
