@@ -35,4 +35,26 @@ std::vector<std::uint32_t> count_ids_per_chunk(Executor& ex, std::string_view na
   return counts;
 }
 
+std::vector<std::size_t> chunk_offsets(std::span<std::uint32_t> counts, std::size_t chunks,
+                                       std::size_t bins) {
+  // Same offsets as walking id-major, but row by row: per-id totals, id starts, then each
+  // chunk's row in chunk order (contiguous reads; a column walk strides by bins).
+  std::vector<std::size_t> totals(bins, 0);
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t d = 0; d < bins; ++d) totals[d] += counts[c * bins + d];
+  std::vector<std::uint32_t> next(bins);
+  std::size_t running = 0;
+  for (std::size_t d = 0; d < bins; ++d) {
+    next[d] = std::uint32_t(running);
+    running += totals[d];
+  }
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t d = 0; d < bins; ++d) {
+      const std::uint32_t k = counts[c * bins + d];
+      counts[c * bins + d] = next[d];
+      next[d] += k;
+    }
+  return totals;
+}
+
 }  // namespace speculum::par

@@ -21,4 +21,10 @@ std::vector<std::uint32_t> count_ids_per_chunk(Executor& ex, std::string_view na
                                                std::size_t bins, std::size_t chunk,
                                                std::string_view what, std::string_view id_kind);
 
+// Turns counts[c * bins + id] (from count_ids_per_chunk or a digit count) into the first
+// output slot of chunk c's elements with that id: id-major, then chunk order (the stable
+// counting-scatter layout). Returns the per-id totals.
+std::vector<std::size_t> chunk_offsets(std::span<std::uint32_t> counts, std::size_t chunks,
+                                       std::size_t bins);
+
 }  // namespace speculum::par

@@ -1,5 +1,5 @@
 // Stable partition into p buckets (ROGER §4.5 bucket sort = p compactions computed
-// together) and stable LSD radix sort of 32/64-bit keys with a payload, both built on one
+// together) and stable radix sort of 32/64-bit keys with a payload, both built on one
 // counting scatter: per-chunk bucket counts, offsets laid out bucket-major then chunk order
 // (a serial pass), then each chunk writes its elements in order — deterministic and stable.
 #pragma once
@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "parallel/page_buffer.h"
 #include "parallel/stream.h"
 
 namespace speculum::par {
@@ -30,12 +31,15 @@ struct RadixSortScratch {
   std::vector<Key> keys;
   std::vector<std::uint32_t> payload;
   std::vector<std::uint32_t> counts;
+  PageBuffer packed;  // 32-bit keys: (key, payload) packed in one word, huge-page backed
 };
 
 // Sorts keys ascending, carrying payload[i] along; stable (equal keys keep their order).
-// Only the span of bits that differ between keys is sorted, in the fewest equal digits of
-// <= 11 bits (3 passes for arbitrary 32-bit keys), least significant first; per-thread
-// write-combining buffers turn the scatter into whole-line writes.
+// Only the span of bits that differ between keys is sorted. 32-bit keys: one scatter on the
+// top <= 11 of those bits into buckets (per-thread line buffers, streaming whole-line
+// stores), then every bucket sorted in cache on the rest; a bucket over 2^18 elements
+// (skewed keys) makes it fall back to the 64-bit keys' method: least-significant-digit
+// passes of <= 11 bits over the whole array with write-combining scatters.
 // payload may be empty (keys only); otherwise it must have keys.size() elements.
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch = nullptr,

@@ -1,0 +1,46 @@
+// A cache-line-aligned scratch area backed by transparent huge pages where the kernel
+// allows them (madvise), for scatter targets (DESIGN.md "Stream constraints": scatter cost).
+// A radix scatter writes to thousands of places at once; on 4 KiB pages nearly every line
+// flush goes to a page the TLB does not hold, on 2 MiB pages it does.
+#pragma once
+
+#include <cstddef>
+#include <cstdlib>
+#include <memory>
+#include <new>
+#include <type_traits>
+
+#include <sys/mman.h>
+
+namespace speculum::par {
+
+class PageBuffer {
+ public:
+  static constexpr std::size_t kHugePage = std::size_t(2) << 20;
+
+  // Room for n elements of T, 2 MiB aligned; contents unspecified (scratch only). Capacity
+  // only grows, so a reused buffer keeps its pages and pays no page faults per call.
+  template <class T>
+  T* reserve(std::size_t n) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes > capacity_) {
+      const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+      void* p = std::aligned_alloc(kHugePage, rounded);
+      if (!p) throw std::bad_alloc();
+      ::madvise(p, rounded, MADV_HUGEPAGE);  // advice only: may stay 4 KiB pages
+      data_.reset(static_cast<std::byte*>(p));
+      capacity_ = rounded;
+    }
+    return reinterpret_cast<T*>(data_.get());
+  }
+
+ private:
+  struct Free {
+    void operator()(std::byte* p) const { std::free(p); }
+  };
+  std::unique_ptr<std::byte, Free> data_;
+  std::size_t capacity_ = 0;
+};
+
+}  // namespace speculum::par
