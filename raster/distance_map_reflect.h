@@ -1,0 +1,32 @@
+// The `distance_map_reflect` node: SURVEY §4.2 localized reflections — each specular sample
+// of a reflector searches its reflector's colour + distance cube map (distance_map_search.h)
+// along R (and T for refractors, single interface) and looks the found hit direction up in
+// the map's prefiltered colour (glossy: the level of its Phong lobe), weighted by Schlick's
+// Fresnel exactly like envmap_reflect. Samples of objects without a map use the environment.
+#pragma once
+
+#include <cstdint>
+
+#include "parallel/executor.h"
+#include "raster/distance_map_search.h"
+#include "raster/environment.h"
+#include "raster/gbuffer.h"
+#include "raster/reflector_maps.h"
+
+namespace speculum::raster {
+
+struct DistanceReflectStats {
+  std::uint64_t searches = 0;  // searched rays (R and T)
+  std::uint64_t lookups = 0;   // distance-map reads over all searches
+  std::uint64_t bracketed = 0; // searches whose linear search found an undershoot/overshoot pair
+};
+
+// The specular layer (zero on diffuse samples). Works on any G-buffer, including a cube
+// face's (eye = the face centre), which is how multi-reflection shades reflectors seen in
+// other reflectors' maps. `stats` (may be null) is summed in chunk order.
+ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
+                               const EnvironmentMap& env, const ReflectorMaps& maps,
+                               const DistanceSearchOptions& options,
+                               DistanceReflectStats* stats = nullptr);
+
+}  // namespace speculum::raster

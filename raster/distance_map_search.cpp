@@ -1,0 +1,12 @@
+// The distance-map search on a cube map: see distance_map_search.h.
+#include "raster/distance_map_search.h"
+
+namespace speculum::raster {
+
+DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_world,
+                                         const glm::vec3& r, const DistanceSearchOptions& options) {
+  return search_distance([&](const glm::vec3& d) { return map.distance_towards(d); },
+                         x_world - map.centre, r, options);
+}
+
+}  // namespace speculum::raster

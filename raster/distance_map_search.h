@@ -1,0 +1,160 @@
+// The localized ray search in a distance cube map around a reference point o (SURVEY §4.1,
+// TECHNIQUES.md §2.2): parallax correction (eq.4), linear search with the §4.1.2 spacing,
+// secant refinement (eq.5, kept as regula falsi once bracketed). Each part is switchable.
+//
+// API (also used by the refraction impostors): coordinates are relative to o; `x` is the ray
+// origin, `r` a unit direction; `distance_towards(dir)` returns the stored |y − o| in the
+// direction `dir` (any length, non-zero), +inf where the map holds nothing. The answer is a
+// ray parameter d and the direction (from o) in which the hit x + r·d is looked up.
+#pragma once
+
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "raster/cube_map.h"
+
+namespace speculum::raster {
+
+struct DistanceSearchOptions {
+  bool parallax = true;    // eq.4 steps when no linear bracket is found (or linear is off)
+  int parallax_steps = 1;  // iterations of d ← R·l' − R·x (the first is eq.4 exactly)
+  bool linear = true;      // march t = k/N on r'(t) = s(1−t) + e t (§4.1.2)
+  int linear_steps = 16;   // N
+  bool secant = true;      // eq.5 refinement of the bracket (or of the parallax guesses)
+  int secant_steps = 4;
+};
+
+struct DistanceSearchResult {
+  float d = std::numeric_limits<float>::infinity();  // ray parameter; +inf: environment guess
+  glm::vec3 direction{0.0f, 0.0f, 1.0f};             // from o, where the hit is looked up
+  bool bracketed = false;  // the linear search found an undershoot → overshoot pair
+  int lookups = 0;         // distance-map reads
+};
+
+namespace distance_search_detail {
+
+// |l| / |l'| for l = x + r d: < 1 undershoot, > 1 overshoot; 0 where the map is empty.
+template <class DistanceFn>
+float ratio(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r, float d,
+            int& lookups) {
+  const glm::vec3 l = x + r * d;
+  const float len = glm::length(l);
+  if (len <= 0.0f) return 0.0f;
+  ++lookups;
+  const float stored = distance_towards(l);
+  return std::isinf(stored) ? 0.0f : len / stored;
+}
+
+inline glm::vec3 hit_direction(const glm::vec3& x, const glm::vec3& r, float d) {
+  if (!std::isfinite(d)) return r;
+  const glm::vec3 l = x + r * d;
+  return glm::dot(l, l) > 0.0f ? l : r;
+}
+
+}  // namespace distance_search_detail
+
+// One parallax step looking up `towards`: assumes the stored surface point l' is on a plane
+// perpendicular to r and returns where the ray meets it, d = r·l' − r·x. With towards = r
+// this is SURVEY eq.4, d_p = |r'| − R·x. +inf when the map is empty there.
+template <class DistanceFn>
+float parallax_step(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r,
+                    const glm::vec3& towards) {
+  const float stored = distance_towards(towards);
+  if (std::isinf(stored)) return stored;
+  const glm::vec3 l_stored = glm::normalize(towards) * stored;
+  return glm::dot(r, l_stored) - glm::dot(r, x);
+}
+
+// SURVEY eq.5 from two guesses d_l, d_p with ratios g = |l|/|l'|:
+// d_new = d_l + (d_p − d_l)(1 − g_l)/(g_p − g_l). Returns d_l when the ratios are equal.
+inline float secant_from_ratios(float d_l, float g_l, float d_p, float g_p) {
+  const float denom = g_p - g_l;
+  if (denom == 0.0f || !std::isfinite(denom)) return d_l;
+  return d_l + (d_p - d_l) * (1.0f - g_l) / denom;
+}
+template <class DistanceFn>
+float secant_step(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r,
+                  float d_l, float d_p) {
+  int lookups = 0;
+  return secant_from_ratios(d_l, distance_search_detail::ratio(distance_towards, x, r, d_l, lookups),
+                            d_p, distance_search_detail::ratio(distance_towards, x, r, d_p, lookups));
+}
+
+// The combined search. Order: x = o → the direct lookup along r. Linear search (when on)
+// for the first undershoot → overshoot pair, then `secant_steps` regula-falsi steps inside
+// it (without secant: the overshooting sample). Without a bracket: `parallax_steps` eq.4
+// iterations (when on), refined by plain secant steps between the last two guesses (the
+// ray start d = 0 counts as the first); with nothing on: the environment-map guess r.
+template <class DistanceFn>
+DistanceSearchResult search_distance(const DistanceFn& distance_towards, const glm::vec3& x,
+                                     const glm::vec3& r, const DistanceSearchOptions& o) {
+  using namespace distance_search_detail;
+  DistanceSearchResult out;
+  const float x_len = glm::length(x);
+  if (x_len == 0.0f) {  // from the reference point every ray is a direct lookup
+    out.lookups = 1;
+    out.d = distance_towards(r);
+    out.direction = r;
+    return out;
+  }
+  if (o.linear && o.linear_steps >= 2) {
+    float d_prev = 0.0f, g_prev = ratio(distance_towards, x, r, 0.0f, out.lookups);
+    const int n = o.linear_steps;
+    for (int k = 1; k < n; ++k) {
+      const float t = float(k) / float(n);
+      const float d = x_len * t / (1.0f - t);  // |R| = 1
+      const float g = ratio(distance_towards, x, r, d, out.lookups);
+      if (g_prev < 1.0f && g >= 1.0f) {
+        out.bracketed = true;
+        float d_l = d_prev, g_l = g_prev, d_p = d, g_p = g;  // undershoot, overshoot
+        float best = d_p;
+        for (int s = 0; o.secant && s < o.secant_steps; ++s) {
+          const float d_new = secant_from_ratios(d_l, g_l, d_p, g_p);
+          best = d_new;
+          const float g_new = ratio(distance_towards, x, r, d_new, out.lookups);
+          if (g_new < 1.0f) d_l = d_new, g_l = g_new;
+          else d_p = d_new, g_p = g_new;
+          if (g_new == 1.0f) break;
+        }
+        out.d = best;
+        out.direction = hit_direction(x, r, best);
+        return out;
+      }
+      d_prev = d;
+      g_prev = g;
+    }
+  }
+  if (!o.parallax || o.parallax_steps < 1) {
+    out.direction = r;  // environment mapping
+    return out;
+  }
+  float d_before = 0.0f, d = std::numeric_limits<float>::infinity();
+  for (int s = 0; s < o.parallax_steps; ++s) {
+    ++out.lookups;
+    const float next = parallax_step(distance_towards, x, r, hit_direction(x, r, d));
+    if (!std::isfinite(next)) break;
+    d_before = std::isfinite(d) ? d : 0.0f;
+    d = next;
+  }
+  for (int s = 0; o.secant && std::isfinite(d) && s < o.secant_steps; ++s) {
+    const float g_a = ratio(distance_towards, x, r, d_before, out.lookups);
+    const float g_b = ratio(distance_towards, x, r, d, out.lookups);
+    if (g_a == 0.0f || g_b == 0.0f || g_b == 1.0f) break;
+    const float next = secant_from_ratios(d_before, g_a, d, g_b);
+    if (!std::isfinite(next) || next < 0.0f) break;
+    d_before = d;
+    d = next;
+  }
+  out.d = d;
+  out.direction = hit_direction(x, r, d);
+  return out;
+}
+
+// The same in a distance cube map (nearest-texel distances); x_world in world space.
+DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_world,
+                                         const glm::vec3& r, const DistanceSearchOptions& options);
+
+}  // namespace speculum::raster
