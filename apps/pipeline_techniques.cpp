@@ -2,6 +2,7 @@
 #include "apps/pipeline_techniques.h"
 
 #include "apps/pipeline_planar_mirror.h"
+#include "apps/pipeline_distance_map.h"
 #include "core/error.h"
 
 namespace speculum::pipeline {
@@ -16,6 +17,11 @@ const std::vector<Technique>& techniques() {
        "reference tracer: BVH ray tracing, Whitted mirrors/refraction, Phong-lobe glossy "
        "sampling (--spp path samples); the ground truth",
        add_reference_passes},
+      {"distance-map",
+       "distance maps (SURVEY §4.1-4.2): per-reflector colour+distance cube, searched per "
+       "sample; --param parallax|linear|secant=0/1, parallax_steps=1, linear_steps=16, "
+       "secant_steps=4",
+       add_distance_map_passes},
       {"planar-mirror",
        "planar mirrors by geometry transformation (SURVEY §5): the camera reflected about "
        "each mirror plane, scene clipped at the plane, recursive to --param depth=3; other "
