@@ -17,6 +17,15 @@ void add_scenes_command(CLI::App& app, GlobalOptions& global);
 void add_info_command(CLI::App& app, GlobalOptions& global);
 void add_render_command(CLI::App& app, GlobalOptions& global);
 void add_techniques_command(CLI::App& app, GlobalOptions& global);
+// inspect / profile / compare (issue 9): apps/cmd_inspect.cpp, cmd_profile.cpp, cmd_compare.cpp.
+void add_inspect_command(CLI::App& app, GlobalOptions& global);
+void add_profile_command(CLI::App& app, GlobalOptions& global);
+void add_compare_command(CLI::App& app, GlobalOptions& global);
+// Thrown by a command whose result is an exit status (compare: 1 when outside the bound);
+// main returns `code` without printing anything more.
+struct ExitStatus {
+  int code = 1;
+};
 
 // `bench` parent (apps/cmd_bench.cpp) and its children, one per cmd_bench_*.cpp.
 void add_bench_command(CLI::App& app, GlobalOptions& global);
@@ -25,5 +34,6 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global);
 
 // `experiment` parent (apps/cmd_experiment.cpp) and its children, one per cmd_experiment_*.cpp.
 void add_experiment_command(CLI::App& app, GlobalOptions& global);
+void add_experiment_survey_subcommand(CLI::App& experiment, GlobalOptions& global);
 
 }  // namespace speculum::cli

@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
   cli::add_techniques_command(app, global);
   cli::add_bench_command(app, global);
   cli::add_experiment_command(app, global);
+  cli::add_inspect_command(app, global);
+  cli::add_profile_command(app, global);
+  cli::add_compare_command(app, global);
 
   try {
     app.parse(argc, argv);
@@ -40,6 +43,8 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fprintf(stderr, "speculum: %s\n", e.what());
     return 2;
+  } catch (const cli::ExitStatus& e) {  // a command's own verdict (compare: 1 = outside the bound)
+    return e.code;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "speculum: out of memory (input too large?)\n");
     return 2;

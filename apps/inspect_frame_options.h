@@ -1,0 +1,37 @@
+// The frame options `inspect` and `profile` share (scene, technique, size, spp, technique
+// parameters, camera) and the FrameSettings they make — the same meaning as `render`'s.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "apps/pipeline_camera_options.h"
+#include "apps/pipeline_techniques.h"
+#include "core/scene.h"
+
+namespace speculum::inspect {
+
+struct FrameOptions {
+  std::string scene;
+  std::string technique = "envmap";
+  int width = 320;
+  int height = 240;
+  int spp = 1;
+  std::uint32_t seed = 0;
+  float exposure = 1.0f;
+  float alpha = 0.0f;
+  int bounces = 1;
+  std::vector<std::string> params;
+  int cube_map_size = 256;
+  int shadow_map_size = 512;
+  pipeline::CameraOverrides camera;
+};
+
+void add_frame_options(CLI::App& cmd, FrameOptions& options);
+
+// Validates (InputError on bad values, as `render` does) and resolves the camera.
+pipeline::FrameSettings make_frame_settings(const FrameOptions& options, const Scene& scene);
+
+}  // namespace speculum::inspect
