@@ -1,4 +1,4 @@
-// Closest-hit / any-hit traversal of the 4-wide and threaded BVH layouts, the all-pairs
+// Closest-hit / any-hit traversal of the 8-wide and threaded BVH layouts, the all-pairs
 // oracle and the chunked stream kernels (see traversal.h). Box tests are the slab test
 // with the far distance widened by a few ulps (Ize, "Robust BVH ray traversal", 2013) so a
 // rounding error never culls a box the watertight triangle test would hit.
@@ -7,21 +7,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "parallel/lanes.h"
 #include "trace/ray_triangle.h"
+#include "trace/wide_kernels.h"
 
 namespace speculum::trace {
 
 namespace {
-
-// Lanes<W>::min/max are select-based (NaN and ±0 identical for every W), which costs a
-// bitset-mask round trip per call in fixed_size simd. The box and leaf kernels here run
-// at one fixed width and only ever take min/max of non-NaN values (or of padding lanes
-// whose result is discarded), where the hardware min/max give the same values.
-template <class V>
-inline V vmin(const V& a, const V& b) { return std::experimental::min(a, b); }
-template <class V>
-inline V vmax(const V& a, const V& b) { return std::experimental::max(a, b); }
 
 constexpr float kFarWiden = 1.0f + 8.0f * 5.96e-8f;   // > 1 + 2 gamma(3)
 constexpr float kNearShrink = 1.0f - 8.0f * 5.96e-8f;  // the same margin on the entry side
@@ -86,128 +77,14 @@ inline bool test_leaf_any(const Bvh& bvh, const RayPrep& r, std::uint32_t first,
   return false;
 }
 
-// The 8 child boxes of a wide node in lanes. Near and far planes are picked by the sign of
-// the direction (not by min/max), so an inverted (empty) box always misses. Returns the
-// bit mask of hit children and their entry distances.
-struct WideRay {
-  glm::vec3 o, inv;
-  float tmin;
-  bool neg[3];
-  explicit WideRay(const RayPrep& r) : o(r.o), inv(r.inv), tmin(r.tmin) {
-    for (int a = 0; a < 3; ++a) neg[a] = std::signbit(r.inv[a]);
-  }
-};
-
-[[gnu::always_inline]] inline unsigned wide_box_hits(const WideNode& n, const WideRay& r, float tmax, float (&tnear)[kWideArity]) {
-  using L = par::Lanes<kWideArity>;
-  const L::f32 nx = L::load(r.neg[0] ? n.hi_x : n.lo_x), fx = L::load(r.neg[0] ? n.lo_x : n.hi_x);
-  const L::f32 ny = L::load(r.neg[1] ? n.hi_y : n.lo_y), fy = L::load(r.neg[1] ? n.lo_y : n.hi_y);
-  const L::f32 nz = L::load(r.neg[2] ? n.hi_z : n.lo_z), fz = L::load(r.neg[2] ? n.lo_z : n.hi_z);
-  const L::f32 ox(r.o.x), oy(r.o.y), oz(r.o.z), ix(r.inv.x), iy(r.inv.y), iz(r.inv.z);
-  // Clamped to finite values: an empty child's inverted box gives entry +inf / exit -inf,
-  // and the widening below must not turn them into inf - inf = NaN.
-  const L::f32 big(3.0e38f);
-  const L::f32 entry = vmin(vmax(vmax((nx - ox) * ix, (ny - oy) * iy), (nz - oz) * iz), big);
-  const L::f32 exit = vmax(vmin(vmin((fx - ox) * ix, (fy - oy) * iy), (fz - oz) * iz), -big);
-  // Widen by a few ulps (entry down, exit up) so rounding never culls a hit. Written with
-  // abs rather than a select: fixed_size masks are bitsets, and a select costs a round trip.
-  const L::f32 eps(kFarWiden - 1.0f);
-  const L::f32 near = vmax(entry - L::abs(entry) * eps, L::f32(r.tmin));
-  const L::f32 far = vmin(exit + L::abs(exit) * eps, L::f32(tmax));
-  float fa[kWideArity];
-  L::store(near, tnear);
-  L::store(far, fa);
-  unsigned bits = 0;
-  for (int k = 0; k < kWideArity; ++k) bits |= static_cast<unsigned>(tnear[k] <= fa[k]) << k;
-  return bits;
-}
-
-// The watertight test (ray_triangle.h) on 4 triangles in lanes, with exactly the scalar
-// operation sequence so every lane's t bits equal the scalar test's; a lane whose edge
-// function is exactly zero is redone by the scalar test (its double fallback).
-struct PackRay {
-  int kx, ky, kz;
-  float sx, sy, sz;
-  glm::vec3 o;
-};
-
-// Returns the mask of lanes hit in [tmin, tmax] and their t, u, v.
-[[gnu::always_inline]] inline unsigned intersect_pack(const TrianglePack& p, const RayPrep& r, float tmin, float tmax, float (&t)[4],
-                               float (&u)[4], float (&v)[4]) {
-  using L = par::Lanes<4>;
-  const RayShear& sh = r.shear;
-  const float* a[3] = {p.ax, p.ay, p.az};
-  const float* b[3] = {p.bx, p.by, p.bz};
-  const float* c[3] = {p.cx, p.cy, p.cz};
-  const L::f32 okx(sh.origin[sh.kx]), oky(sh.origin[sh.ky]), okz(sh.origin[sh.kz]);
-  const L::f32 Akx = L::load(a[sh.kx]) - okx, Aky = L::load(a[sh.ky]) - oky, Akz = L::load(a[sh.kz]) - okz;
-  const L::f32 Bkx = L::load(b[sh.kx]) - okx, Bky = L::load(b[sh.ky]) - oky, Bkz = L::load(b[sh.kz]) - okz;
-  const L::f32 Ckx = L::load(c[sh.kx]) - okx, Cky = L::load(c[sh.ky]) - oky, Ckz = L::load(c[sh.kz]) - okz;
-  const L::f32 sx(sh.sx), sy(sh.sy), sz(sh.sz);
-  const L::f32 ax = Akx - sx * Akz, ay = Aky - sy * Akz;
-  const L::f32 bx = Bkx - sx * Bkz, by = Bky - sy * Bkz;
-  const L::f32 cx = Ckx - sx * Ckz, cy = Cky - sy * Ckz;
-  const L::f32 U = cx * by - cy * bx;
-  const L::f32 V = ax * cy - ay * cx;
-  const L::f32 W = bx * ay - by * ax;
-  const L::f32 zero(0.0f);
-  const L::f32 det = U + V + W;
-  const L::f32 T = U * (sz * Akz) + V * (sz * Bkz) + W * (sz * Ckz);
-  const L::f32 inv = L::f32(1.0f) / det;
-  const L::f32 tt = T * inv;
-  // An exactly-zero edge function anywhere (or a product that underflows: a harmless false
-  // alarm) sends the pack to the scalar path with its double-precision fallback.
-  const auto zero_edge = (U * V * W) == zero;
-  unsigned bits = 0;
-  if (!L::any(zero_edge)) {
-    // The common case, branch-free, as few lane masks as possible (each is a bitset round
-    // trip in fixed_size simd): same-sign edge functions, t in range. det == 0 needs no
-    // test: with mixed signs excluded it means t = T/0 = ±inf or NaN, which fails the range
-    // test, as do the NaN lanes of unused slots.
-    const L::f32 mn = vmin(vmin(U, V), W), mx = vmax(vmax(U, V), W);
-    const auto ok = ((mn >= zero) || (mx <= zero)) && (tt >= L::f32(tmin)) && (tt <= L::f32(tmax));
-    if (L::none(ok)) return 0;
-    const L::f32 weights([](int l) { return static_cast<float>(1 << l); });
-    bits = static_cast<unsigned>(L::hadd(L::select(ok, weights, zero)));  // exact: small integers
-    L::store(tt, t);
-    L::store(V * inv, u);
-    L::store(W * inv, v);
-    return bits;
-  }
-  float Us[4], Vs[4], Ws[4], dets[4], ts[4], invs[4];
-  L::store(U, Us); L::store(V, Vs); L::store(W, Ws); L::store(det, dets); L::store(tt, ts); L::store(inv, invs);
-  for (int l = 0; l < 4; ++l) {
-    if (p.id[l] == kEmptyChild) continue;
-    if (Us[l] == 0.0f || Vs[l] == 0.0f || Ws[l] == 0.0f) {
-      TriangleHit h;
-      const glm::vec3 A(p.ax[l], p.ay[l], p.az[l]), B(p.bx[l], p.by[l], p.bz[l]), C(p.cx[l], p.cy[l], p.cz[l]);
-      if (intersect_triangle_watertight(sh, A, B, C, tmin, tmax, h)) {
-        t[l] = h.t; u[l] = h.u; v[l] = h.v;
-        bits |= 1u << l;
-      }
-      continue;
-    }
-    const bool neg = Us[l] < 0.0f || Vs[l] < 0.0f || Ws[l] < 0.0f;
-    const bool pos = Us[l] > 0.0f || Vs[l] > 0.0f || Ws[l] > 0.0f;
-    if ((neg && pos) || dets[l] == 0.0f) continue;
-    if (!(ts[l] >= tmin && ts[l] <= tmax)) continue;
-    t[l] = ts[l];
-    u[l] = Vs[l] * invs[l];
-    v[l] = Ws[l] * invs[l];
-    bits |= 1u << l;
-  }
-  return bits;
-}
-
-[[gnu::always_inline]] inline void test_packs_closest(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, Hit& best,
-                               TraversalCounters& c) {
+[[gnu::always_inline]] inline void test_packs_closest(const TrianglePack* packs, const wide::PackRay& r, float tmin,
+                                                          std::uint32_t ref, Hit& best, TraversalCounters& c) {
   const std::uint32_t first = (ref & ~kLeafBit) >> 2, count = (ref & 3u) + 1;
-  const auto& packs = bvh.triangle_packs();
   for (std::uint32_t p = first; p < first + count; ++p) {
     const TrianglePack& pk = packs[p];
     c.triangle_tests += 4;
     float t[4], u[4], v[4];
-    unsigned bits = intersect_pack(pk, r, r.tmin, best.t, t, u, v);
+    unsigned bits = wide::intersect_pack(pk, r, tmin, best.t, t, u, v);
     while (bits) {
       const int l = __builtin_ctz(bits);
       bits &= bits - 1;
@@ -217,13 +94,13 @@ struct PackRay {
   }
 }
 
-[[gnu::always_inline]] inline bool test_packs_any(const Bvh& bvh, const RayPrep& r, std::uint32_t ref, TraversalCounters& c) {
+[[gnu::always_inline]] inline bool test_packs_any(const TrianglePack* packs, const wide::PackRay& r, float tmin,
+                                                     float tmax, std::uint32_t ref, TraversalCounters& c) {
   const std::uint32_t first = (ref & ~kLeafBit) >> 2, count = (ref & 3u) + 1;
-  const auto& packs = bvh.triangle_packs();
   for (std::uint32_t p = first; p < first + count; ++p) {
     c.triangle_tests += 4;
     float t[4], u[4], v[4];
-    if (intersect_pack(packs[p], r, r.tmin, r.tmax, t, u, v)) return true;
+    if (wide::intersect_pack(packs[p], r, tmin, tmax, t, u, v)) return true;
   }
   return false;
 }
@@ -247,20 +124,24 @@ Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit, T
   best.t = ray.tmax;
   if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
     const RayPrep r(ray);
-    const WideRay wr(r);
-    const auto& nodes = bvh.wide_nodes();
+    const wide::BoxRay br(r.o, r.inv, r.tmin);
+    const wide::PackRay pr(r.shear);
+    const WideNode* nodes = bvh.wide_nodes().data();
+    const TrianglePack* packs = bvh.triangle_packs().data();
     StackEntry stack[kTraversalStackSize];
     int sp = 0;
     StackEntry cur{bvh.wide_root(), ray.tmin};
     while (true) {
       if (cur.ref & kLeafBit) {
-        test_packs_closest(bvh, r, cur.ref, best, c);
+        test_packs_closest(packs, pr, r.tmin, cur.ref, best, c);
       } else {
         ++c.nodes_visited;
         const WideNode& n = nodes[cur.ref];
-        float tn[kWideArity];
-        unsigned bits = wide_box_hits(n, wr, best.t, tn);
+        __m256 tnv;
+        unsigned bits = wide::box_hits(n, br, best.t, tnv);
         if (bits) {
+          alignas(32) float tn[kWideArity];
+          _mm256_store_ps(tn, tnv);
           int k = __builtin_ctz(bits);
           bits &= bits - 1;
           if (!bits) {  // one child hit (the common case): descend without the stack
@@ -316,20 +197,22 @@ bool any_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
   bool found = false;
   if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
     const RayPrep r(ray);
-    const WideRay wr(r);
+    const wide::BoxRay br(r.o, r.inv, r.tmin);
+    const wide::PackRay pr(r.shear);
     const auto& nodes = bvh.wide_nodes();
+    const TrianglePack* packs = bvh.triangle_packs().data();
     std::uint32_t stack[kTraversalStackSize];
     int sp = 0;
     stack[sp++] = bvh.wide_root();
     while (sp > 0 && !found) {
       const std::uint32_t ref = stack[--sp];
       if (ref & kLeafBit) {
-        found = test_packs_any(bvh, r, ref, c);
+        found = test_packs_any(packs, pr, r.tmin, r.tmax, ref, c);
         continue;
       }
       ++c.nodes_visited;
-      float tn[kWideArity];
-      unsigned bits = wide_box_hits(nodes[ref], wr, r.tmax, tn);
+      __m256 tn;
+      unsigned bits = wide::box_hits(nodes[ref], br, r.tmax, tn);
       while (bits) {
         const int k = __builtin_ctz(bits);
         bits &= bits - 1;
