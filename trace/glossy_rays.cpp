@@ -1,0 +1,90 @@
+// The glossy_rays kernel (see glossy_rays.h), YU §3.3 eq.4–5.
+#include "trace/glossy_rays.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "core/error.h"
+#include "core/optics.h"
+#include "core/sampling.h"
+
+namespace speculum::trace {
+
+float sample_solid_angle(float cos_theta, float exponent, int n) {
+  const float p = phong_lobe_pdf(cos_theta, exponent);
+  return p > 0.0f ? 1.0f / (static_cast<float>(n) * p) : 0.0f;
+}
+
+GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& positions,
+                                const Buffer2D<glm::vec3>& normals,
+                                const Buffer2D<SurfaceParams>& surface, const IdBuffer& object,
+                                const glm::vec3& eye, const GlossyRayOptions& opt) {
+  if (opt.rays_per_pixel < 1 || opt.rays_per_pixel > 4096)
+    throw InputError("glossy_rays", "rays per pixel out of range (1..4096)");
+  const std::size_t n_pix = object.size();
+  if (positions.size() != n_pix || normals.size() != n_pix || surface.size() != n_pix)
+    throw InputError("glossy_rays", "G-buffer planes differ in size");
+  GlossyRays out;
+  out.width = object.width;
+  out.height = object.height;
+  out.rays_per_pixel = opt.rays_per_pixel;
+  // Which samples trace: a serial pass over flags, then the compaction primitive's order.
+  for (std::size_t i = 0; i < n_pix; ++i)
+    if (object.pixels[i] != kNoId && traces_glossy(surface.pixels[i]))
+      out.pixel.push_back(static_cast<std::uint32_t>(i));
+  const std::size_t N = static_cast<std::size_t>(opt.rays_per_pixel);
+  const std::size_t P = out.pixel.size();
+  out.fresnel.resize(P);
+  out.rays.resize(P * N);
+  out.solid_angle.assign(P * N, 0.0f);
+  constexpr std::size_t kChunk = 64;  // pixels per chunk
+  std::vector<std::uint64_t> rejected((P + kChunk - 1) / kChunk, 0);
+  ex.parallel_for("glossy_rays", P, kChunk, [&](std::size_t b, std::size_t e) {
+    std::uint64_t below = 0;
+    for (std::size_t k = b; k < e; ++k) {
+      const std::uint32_t i = out.pixel[k];
+      const glm::vec3 p = positions.pixels[i];
+      const glm::vec3 n = normals.pixels[i];
+      const SurfaceParams& s = surface.pixels[i];
+      glm::vec3 v = eye - p;
+      const float vl = glm::length(v);
+      v = vl > 0.0f ? v / vl : n;
+      const glm::vec3 r = reflect(-v, n);
+      out.fresnel[k] = specular_fresnel(s, std::max(glm::dot(n, v), 0.0f));
+      const Onb lobe(glm::normalize(r));
+      const glm::vec2 shift = random_float2(i, 0, 0, opt.seed);
+      // Offset along the normal scaled with the point's magnitude (as the reference tracer).
+      const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+      const glm::vec3 origin = p + n * (1e-4f * m);
+      for (std::size_t j = 0; j < N; ++j) {
+        const glm::vec2 u = rotate_unit_square(hamersley(static_cast<std::uint32_t>(j),
+                                                         static_cast<std::uint32_t>(N)), shift);
+        const glm::vec3 local = sample_phong_lobe(u, s.phong_exponent);
+        const glm::vec3 d = lobe.to_world(local);
+        const std::size_t slot = k * N + j;
+        Ray ray;
+        if (glm::dot(d, n) <= 0.0f) {
+          // Rejected, not reflected: the shading model gives such directions zero weight,
+          // and the estimator still divides by N (as the reference tracer does).
+          ++below;
+          ray.origin = origin;
+          ray.direction = glm::vec3(0.0f);
+          ray.tmin = 1.0f;
+          ray.tmax = 0.0f;
+        } else {
+          ray.origin = origin;
+          ray.direction = d;
+          out.solid_angle[slot] = sample_solid_angle(local.z, s.phong_exponent, static_cast<int>(N));
+        }
+        out.rays.set(slot, ray);
+      }
+    }
+    rejected[b / kChunk] = below;
+  });
+  for (const std::uint64_t r : rejected) out.below_horizon += r;
+  return out;
+}
+
+}  // namespace speculum::trace

@@ -1,0 +1,53 @@
+// The `glossy_rays` node of YU §3.3: for every glossy (or mirror) G-buffer sample, N
+// reflected rays importance-sampled from the normalized Phong lobe about R (eq.4) with a
+// per-pixel rotated 2-D Hamersley set, and each ray's solid angle Ω_s = 1/(N p) (eq.5).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/image.h"
+#include "core/shading.h"
+#include "parallel/executor.h"
+#include "trace/traversal.h"
+
+namespace speculum::trace {
+
+struct GlossyRayOptions {
+  int rays_per_pixel = 30;  // N
+  std::uint32_t seed = 0;   // keys the per-pixel Cranley–Patterson rotation
+};
+
+// Rays of pixel k (k-th glossy pixel) occupy slots [k N, k N + N).
+struct GlossyRays {
+  int width = 0, height = 0;
+  int rays_per_pixel = 0;
+  std::vector<std::uint32_t> pixel;  // glossy pixel indices, ascending
+  std::vector<glm::vec3> fresnel;    // per glossy pixel: F(N·V) weight of the lobe average
+  RayStream rays;                    // below-horizon samples are inactive (tmin > tmax)
+  std::vector<float> solid_angle;    // Ω_s per ray, eq.5 (0 for inactive rays)
+  std::uint64_t below_horizon = 0;   // samples rejected: they contribute 0 (shading.h model)
+  std::size_t ray_count() const { return rays.size(); }
+};
+
+// The surfaces this node traces: opaque samples with a mirror or glossy Phong lobe.
+inline bool traces_glossy(const SurfaceParams& s) {
+  return !s.is_refractor() && (s.is_mirror_lobe() || s.is_glossy_lobe());
+}
+
+// Solid angle of one of N samples of the Phong lobe (exponent n) at polar cosine cos_theta
+// about R (YU eq.5). Its mean over the lobe's samples is 2π/N: the pdf is normalized over the
+// hemisphere about R (TECHNIQUES.md §1 correction of the paper's 4π/N).
+float sample_solid_angle(float cos_theta, float exponent, int n);
+
+// Kernel "glossy_rays". Buffers are the G-buffer's (world positions, unit shading normals,
+// surface parameters, object ids with kNoId for background); eye is the camera position.
+// Throws InputError when the buffers' sizes differ or rays_per_pixel is outside 1..4096.
+GlossyRays generate_glossy_rays(par::Executor& executor, const Buffer2D<glm::vec3>& positions,
+                                const Buffer2D<glm::vec3>& normals,
+                                const Buffer2D<SurfaceParams>& surface, const IdBuffer& object,
+                                const glm::vec3& eye, const GlossyRayOptions& options);
+
+}  // namespace speculum::trace

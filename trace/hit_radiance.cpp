@@ -1,0 +1,196 @@
+// Radiance bake and hit shading for the YU technique (see hit_radiance.h), eq.8–9.
+#include "trace/hit_radiance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+#include "core/optics.h"
+#include "core/sampling.h"
+#include "core/shading.h"
+
+namespace speculum::trace {
+
+namespace {
+
+glm::vec3 offset_point(const glm::vec3& p, const glm::vec3& ng) {
+  const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+  return p + ng * (1e-4f * m);
+}
+
+// The surface at barycentrics (u, v) of triangle t: position, geometric and shading
+// normals (not yet oriented), material.
+struct SurfacePoint {
+  glm::vec3 p, ng, n;
+  SurfaceParams s;
+};
+
+SurfacePoint surface_point(const Scene& scene, std::uint32_t t, float u, float v) {
+  const TriangleMesh& m = scene.mesh;
+  const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+  const float w0 = 1.0f - u - v;
+  SurfacePoint sp;
+  sp.p = m.positions[i0] * w0 + m.positions[i1] * u + m.positions[i2] * v;
+  glm::vec3 ng = glm::cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]);
+  const float len = glm::length(ng);
+  sp.ng = len > 0.0f ? ng / len : glm::vec3(0.0f, 1.0f, 0.0f);
+  sp.n = sp.ng;
+  if (m.normals.size() == m.positions.size()) {
+    const glm::vec3 s = m.normals[i0] * w0 + m.normals[i1] * u + m.normals[i2] * v;
+    if (glm::length(s) > 0.0f) sp.n = glm::normalize(s);
+  }
+  glm::vec2 uv(0.0f), uv1(0.0f);
+  if (m.uvs.size() == m.positions.size()) uv = m.uvs[i0] * w0 + m.uvs[i1] * u + m.uvs[i2] * v;
+  if (m.uvs1.size() == m.positions.size()) uv1 = m.uvs1[i0] * w0 + m.uvs1[i1] * u + m.uvs1[i2] * v;
+  const std::uint32_t mat = t < m.triangle_material.size() ? m.triangle_material[t] : 0u;
+  sp.s = surface_params(scene, mat, uv, uv1);
+  return sp;
+}
+
+}  // namespace
+
+TriangleLighting bake_triangle_lighting(par::Executor& ex, const Scene& scene, const Bvh& bvh,
+                                        const RadianceBakeOptions& opt) {
+  const std::size_t nt = scene.mesh.triangle_count();
+  TriangleLighting out;
+  out.light_count = scene.lights.size();
+  out.visibility.assign(nt * out.light_count, 0.0f);
+  out.environment_irradiance.assign(nt, glm::vec3(0.0f));
+  out.radiance.assign(nt, glm::vec3(0.0f));
+  const int ks = std::max(0, opt.environment_samples);
+  ex.parallel_for("radiance_bake", nt, 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t) {
+      const SurfacePoint sp = surface_point(scene, static_cast<std::uint32_t>(t), 1.0f / 3.0f, 1.0f / 3.0f);
+      // Orient the geometric normal to the shading normal's side (the side the mesh shows).
+      const glm::vec3 ng = glm::dot(sp.ng, sp.n) < 0.0f ? -sp.ng : sp.ng;
+      const glm::vec3 above = offset_point(sp.p, ng);
+      glm::vec3 lights_e(0.0f);
+      for (std::size_t l = 0; l < out.light_count; ++l) {
+        const LightSample ls = sample_light(scene.lights[l], sp.p);
+        if (ls.irradiance == glm::vec3(0.0f) || glm::dot(ng, ls.direction) <= 0.0f) continue;
+        Ray r;
+        r.origin = above;
+        r.direction = ls.direction;
+        r.tmax = std::isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : 3.0e38f;
+        if (any_hit(bvh, r)) continue;
+        out.visibility[t * out.light_count + l] = 1.0f;
+        lights_e += ls.irradiance * std::max(glm::dot(sp.n, ls.direction), 0.0f);
+      }
+      glm::vec3 env_e(0.0f);
+      if (ks > 0) {
+        const Onb frame(sp.n);
+        const glm::vec2 shift = random_float2(static_cast<std::uint32_t>(t), 0, 0, opt.seed);
+        for (int k = 0; k < ks; ++k) {
+          const glm::vec2 u = rotate_unit_square(hamersley(static_cast<std::uint32_t>(k),
+                                                           static_cast<std::uint32_t>(ks)), shift);
+          const glm::vec3 wi = frame.to_world(sample_cosine_hemisphere(u));
+          if (glm::dot(wi, ng) <= 0.0f) continue;
+          Ray r;
+          r.origin = above;
+          r.direction = wi;
+          if (!any_hit(bvh, r)) env_e += environment_radiance(scene.environment, wi);
+        }
+        env_e *= kPi / static_cast<float>(ks);  // E = π × mean radiance under cosine sampling
+      }
+      out.environment_irradiance[t] = env_e;
+      out.radiance[t] = sp.s.emissive + diffuse_albedo_over_pi(sp.s, 1.0f) * (lights_e + env_e) +
+                        specular_f0(sp.s) * (env_e / kPi);
+    }
+  });
+  return out;
+}
+
+float footprint_area(float distance, float solid_angle, float cos_incidence) {
+  return distance * distance * solid_angle / std::max(cos_incidence, 1e-3f);
+}
+
+float mip_level(float footprint, float texel_area) {
+  if (!(footprint > 0.0f) || !(texel_area > 0.0f)) return 0.0f;
+  return 0.5f * std::log2(footprint / texel_area);
+}
+
+glm::vec3 hit_radiance(const Scene& scene, const LodBvh& lod, const TriangleLighting& lighting,
+                       const glm::vec3& dir_in, float solid_angle, const LodHit& hit) {
+  const glm::vec3 dir = glm::normalize(dir_in);
+  if (!hit.hit()) return environment_radiance(scene.environment, dir);
+  if (hit.proxy != kNoHit) return lod.nodes[hit.proxy].radiance;
+  const std::uint32_t t = hit.triangle;
+  const SurfacePoint sp = surface_point(scene, t, hit.u, hit.v);
+  glm::vec3 ng = sp.ng, n = sp.n;
+  if (glm::dot(ng, dir) > 0.0f) ng = -ng;
+  if (glm::dot(n, ng) < 0.0f) n = -n;
+  const glm::vec3 v = -dir;
+  const float cos_nv = std::max(glm::dot(n, v), 0.0f);
+  // Level 0: the exact shading model at the hit, with the triangle's baked visibility.
+  glm::vec3 L = sp.s.emissive;
+  for (std::size_t l = 0; l < lighting.light_count; ++l) {
+    if (lighting.visibility[t * lighting.light_count + l] == 0.0f) continue;
+    const LightSample ls = sample_light(scene.lights[l], sp.p);
+    if (ls.irradiance == glm::vec3(0.0f) || glm::dot(ng, ls.direction) <= 0.0f) continue;
+    L += shade_light(sp.s, n, v, ls);
+  }
+  L += diffuse_albedo_over_pi(sp.s, cos_nv) * lighting.environment_irradiance[t];
+  if (!sp.s.is_refractor() && (sp.s.is_mirror_lobe() || sp.s.is_glossy_lobe()))
+    L += specular_fresnel(sp.s, cos_nv) * environment_radiance(scene.environment, reflect(dir, n));
+  // eq.8–9: a footprint larger than the triangle blends towards its ancestors' radiance.
+  const float texel = lod.triangle_area[t];
+  const float level = mip_level(footprint_area(hit.t * glm::length(dir_in), solid_angle,
+                                               std::fabs(glm::dot(sp.ng, dir))), texel);
+  if (level <= 0.0f) return L;
+  float prev_level = 0.0f;
+  glm::vec3 prev = L;
+  for (std::uint32_t node = lod.triangle_leaf[t]; node != kThreadEnd; node = lod.nodes[node].parent) {
+    const LodNode& ln = lod.nodes[node];
+    const float node_level = mip_level(ln.area, texel);
+    if (node_level >= level) {
+      if (node_level <= prev_level) return ln.radiance;
+      const float w = (level - prev_level) / (node_level - prev_level);
+      return prev * (1.0f - w) + ln.radiance * w;
+    }
+    if (node_level > prev_level) {
+      prev_level = node_level;
+      prev = ln.radiance;
+    }
+  }
+  return prev;
+}
+
+ImageRGBA glossy_reflection(par::Executor& ex, const Scene& scene, const LodBvh& lod,
+                            const TriangleLighting& lighting, const GlossyRays& rays,
+                            const std::vector<LodHit>& hits, HitRadianceStats* stats) {
+  ImageRGBA out(rays.width, rays.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  const std::size_t P = rays.pixel.size();
+  const std::size_t N = static_cast<std::size_t>(std::max(rays.rays_per_pixel, 1));
+  constexpr std::size_t kChunk = 64;
+  std::vector<HitRadianceStats> per_chunk((P + kChunk - 1) / kChunk);
+  ex.parallel_for("hit_radiance", P, kChunk, [&](std::size_t b, std::size_t e) {
+    HitRadianceStats st;
+    for (std::size_t k = b; k < e; ++k) {
+      glm::vec3 sum(0.0f);
+      for (std::size_t j = 0; j < N; ++j) {
+        const std::size_t slot = k * N + j;
+        const float omega = rays.solid_angle[slot];
+        if (!(omega > 0.0f)) continue;  // below the horizon: contributes 0
+        const LodHit& h = hits[slot];
+        if (!h.hit()) ++st.misses;
+        else if (h.proxy != kNoHit) ++st.proxy_hits;
+        else ++st.triangle_hits;
+        const glm::vec3 d(rays.rays.dx[slot], rays.rays.dy[slot], rays.rays.dz[slot]);
+        sum += hit_radiance(scene, lod, lighting, d, omega, h);
+      }
+      out.pixels[rays.pixel[k]] = glm::vec4(rays.fresnel[k] * (sum / static_cast<float>(N)), 1.0f);
+    }
+    per_chunk[b / kChunk] = st;
+  });
+  if (stats)
+    for (const auto& s : per_chunk) {
+      stats->triangle_hits += s.triangle_hits;
+      stats->proxy_hits += s.proxy_hits;
+      stats->misses += s.misses;
+    }
+  return out;
+}
+
+}  // namespace speculum::trace

@@ -1,0 +1,47 @@
+// The LOD data YU §3.2–3.4 attaches to a threaded BVH, for general triangle meshes: every
+// node gets approximate geometry and filtered radiance, built bottom-up from the Bvh
+// (bvh.h is read, never changed). Choice for general meshes (TECHNIQUES.md §1): a node whose
+// contents are roughly planar (area-weighted mean normal of length >= kPlanarity) is
+// approximated by one quad — the plane through the contents' area centroid perpendicular to
+// that mean normal, spanning the projection of the children's proxies (leaves: of their
+// triangles); any other node by its own box. Filtered radiance is the area-weighted mean of
+// the per-triangle radiance of trace/hit_radiance.h, so the ancestors of a triangle are the
+// coarser levels of a mip pyramid whose level-0 texels are the triangles (eq.9).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "trace/bvh.h"
+
+namespace speculum::trace {
+
+constexpr float kPlanarity = 0.7f;  // |Σ A n| / Σ A at or above: the quad proxy
+
+struct LodNode {
+  glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};  // quad: origin + s edge_u + t edge_v
+  glm::vec3 normal{0.0f};     // unit mean normal of a quad proxy (zero for box proxies)
+  float area = 0.0f;          // total triangle area of the subtree
+  float box_solid_angle_k = 0.0f;  // π |pmax - pmin|² / 4, the numerator of eq.6
+  glm::vec3 radiance{0.0f};   // filtered (area-weighted mean) radiance
+  std::uint32_t parent = kThreadEnd;
+  bool quad = false;
+};
+
+// Node i corresponds to bvh.threaded_nodes()[i].
+struct LodBvh {
+  std::vector<LodNode> nodes;
+  std::vector<std::uint32_t> triangle_leaf;  // original triangle index → its leaf node
+  std::vector<float> triangle_area;          // original triangle index → area
+};
+
+// `triangle_radiance` is indexed by original triangle (size bvh.triangle_count()); throws
+// InputError otherwise.
+LodBvh build_lod_bvh(const Bvh& bvh, const std::vector<glm::vec3>& triangle_radiance);
+
+// Box solid angle seen from x, YU eq.6: π |pmax - pmin|² / (4 |(pmax + pmin)/2 - x|²).
+float box_solid_angle(const Aabb& box, const glm::vec3& x);
+
+}  // namespace speculum::trace

@@ -1,0 +1,170 @@
+// The LOD traversal kernel (see lod_trace.h), YU §3.4 eq.6–7. The box and leaf tests are
+// those of trace/traversal.cpp (same slab widening, same watertight test, same tie rule:
+// equal t goes to the lower triangle index), so with LOD off the hits equal
+// closest_hit_threaded's bit for bit.
+#include "trace/lod_trace.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "trace/ray_triangle.h"
+
+namespace speculum::trace {
+
+namespace {
+
+constexpr float kFarWiden = 1.0f + 8.0f * 5.96e-8f;
+constexpr float kNearShrink = 1.0f - 8.0f * 5.96e-8f;
+
+struct RayPrep {
+  glm::vec3 o, d, inv;
+  float tmin, tmax;
+  RayShear shear;
+  explicit RayPrep(const Ray& r)
+      : o(r.origin), d(r.direction), tmin(r.tmin), tmax(r.tmax), shear(r.origin, r.direction) {
+    for (int a = 0; a < 3; ++a) {
+      const float c = std::fabs(d[a]) < 1e-30f ? std::copysign(1e-30f, d[a]) : d[a];
+      inv[a] = 1.0f / c;
+    }
+  }
+};
+
+bool valid_ray(const Ray& r) {
+  const glm::vec3& d = r.direction;
+  return (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f) && std::isfinite(d.x) && std::isfinite(d.y) &&
+         std::isfinite(d.z) && std::isfinite(r.origin.x) && std::isfinite(r.origin.y) &&
+         std::isfinite(r.origin.z) && !(r.tmin > r.tmax);
+}
+
+inline bool box_hit(const RayPrep& r, const Aabb& b, float tmax, float& tnear) {
+  float t0 = r.tmin, t1 = tmax;
+  for (int a = 0; a < 3; ++a) {
+    float lo = (b.lo[a] - r.o[a]) * r.inv[a];
+    float hi = (b.hi[a] - r.o[a]) * r.inv[a];
+    if (lo > hi) std::swap(lo, hi);
+    lo = lo > 0.0f ? lo * kNearShrink : lo * kFarWiden;
+    t0 = lo > t0 ? lo : t0;
+    t1 = hi * kFarWiden < t1 ? hi * kFarWiden : t1;
+  }
+  tnear = t0;
+  return t0 <= t1 && !b.empty();
+}
+
+inline bool inside(const Aabb& b, const glm::vec3& p) {
+  return p.x >= b.lo.x && p.y >= b.lo.y && p.z >= b.lo.z && p.x <= b.hi.x && p.y <= b.hi.y &&
+         p.z <= b.hi.z;
+}
+
+// The proxy of node n: its quad (both faces), or its box entry point. Accepts t in
+// (tmin, tmax).
+inline bool intersect_proxy(const RayPrep& r, const LodNode& n, const Aabb& box, float tmax,
+                            float& t_out, float& s_out, float& w_out) {
+  if (n.quad) {
+    const float denom = glm::dot(r.d, n.normal);
+    if (std::fabs(denom) < 1e-12f) return false;
+    const float t = glm::dot(n.origin - r.o, n.normal) / denom;
+    if (!(t > r.tmin && t < tmax)) return false;
+    const glm::vec3 p = r.o + t * r.d - n.origin;
+    const float uu = glm::dot(n.edge_u, n.edge_u), vv = glm::dot(n.edge_v, n.edge_v);
+    const float s = uu > 0.0f ? glm::dot(p, n.edge_u) / uu : 0.0f;
+    const float w = vv > 0.0f ? glm::dot(p, n.edge_v) / vv : 0.0f;
+    if (s < 0.0f || s > 1.0f || w < 0.0f || w > 1.0f) return false;
+    t_out = t;
+    s_out = s;
+    w_out = w;
+    return true;
+  }
+  float tnear;
+  if (!box_hit(r, box, tmax, tnear) || !(tnear > r.tmin) || !(tnear < tmax)) return false;
+  t_out = tnear;
+  s_out = w_out = 0.0f;
+  return true;
+}
+
+}  // namespace
+
+LodHit closest_hit_lod(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float solid_angle,
+                       const LodOptions& opt, LodCounters* counters) {
+  LodCounters c;
+  c.traversal.rays = 1;
+  LodHit best;
+  best.t = ray.tmax;
+  const auto& nodes = bvh.threaded_nodes();
+  const auto& tris = bvh.leaf_triangles();
+  const auto& ids = bvh.triangle_ids();
+  // eq.7 as Ω_box ≤ α² Ω_s, with eq.6's division moved to the right-hand side.
+  const float budget = opt.alpha * opt.alpha * solid_angle;
+  const bool lod_on = opt.enabled && budget > 0.0f && lod.nodes.size() == nodes.size();
+  if (valid_ray(ray) && !nodes.empty()) {
+    const RayPrep r(ray);
+    std::uint32_t i = 0;
+    while (i != kThreadEnd) {
+      const ThreadedNode& n = nodes[i];
+      ++c.traversal.nodes_visited;
+      float tnear;
+      if (!box_hit(r, n.box, best.t, tnear)) {
+        i = n.miss;
+        continue;
+      }
+      if (lod_on && n.count == 0) {
+        const LodNode& ln = lod.nodes[i];
+        const glm::vec3 to_center = n.box.center() - r.o;
+        if (ln.box_solid_angle_k <= budget * glm::dot(to_center, to_center) && !inside(n.box, r.o)) {
+          ++c.lod_stops;
+          float t, s, w;
+          if (intersect_proxy(r, ln, n.box, best.t, t, s, w)) {
+            best.t = t;
+            best.u = s;
+            best.v = w;
+            best.triangle = kNoHit;
+            best.proxy = i;
+          }
+          i = n.miss;
+          continue;
+        }
+      }
+      for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
+        ++c.traversal.triangle_tests;
+        TriangleHit h;
+        if (!intersect_triangle_watertight(r.shear, tris[k].a, tris[k].b, tris[k].c, r.tmin, best.t, h))
+          continue;
+        const std::uint32_t id = ids[k];
+        if (h.t < best.t || id < best.triangle) {
+          best.t = h.t;
+          best.u = h.u;
+          best.v = h.v;
+          best.triangle = id;
+          best.proxy = kNoHit;
+        }
+      }
+      i = n.hit;
+    }
+  }
+  if (!best.hit()) best = LodHit{};
+  if (best.proxy != kNoHit) ++c.proxy_hits;
+  if (counters) counters->add(c);
+  return best;
+}
+
+void closest_hit_lod_stream(const Bvh& bvh, const LodBvh& lod, const RayStream& rays,
+                            const std::vector<float>& solid_angle, const LodOptions& opt,
+                            std::vector<LodHit>& hits, par::Executor& ex, LodCounters* counters) {
+  const std::size_t n = rays.size();
+  hits.resize(n);
+  const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
+  std::vector<LodCounters> per_chunk(chunks);
+  ex.parallel_for("lod_trace", n, kRayChunk, [&](std::size_t b, std::size_t e) {
+    LodCounters c;
+    for (std::size_t i = b; i < e; ++i) {
+      const float omega = i < solid_angle.size() ? solid_angle[i] : 0.0f;
+      hits[i] = closest_hit_lod(bvh, lod, rays.get(i), omega, opt, &c);
+    }
+    per_chunk[b / kRayChunk] = c;
+  });
+  if (counters)
+    for (const auto& c : per_chunk) counters->add(c);
+}
+
+}  // namespace speculum::trace
