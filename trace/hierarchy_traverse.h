@@ -1,0 +1,59 @@
+// The ray-hierarchy traversal of ROGER ch.3 (TECHNIQUES.md §4.2) on the hierarchical stream
+// reduction of ROGER ch.4 (§4.3, parallel/compact.h): a stream of (node, triangle) pairs
+// refined one quad-tree level per kernel, then exact watertight tests and the closest hit
+// per ray by a segmented min. No scene structure: every triangle starts at the root.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "parallel/executor.h"
+#include "trace/ray_hierarchy.h"
+#include "trace/traversal.h"
+
+namespace speculum::trace {
+
+struct HierarchyTraverseOptions {
+  // Fixed capacity of the pair buffer, counted in pairs of the 4-way expanded stream (the
+  // thesis's 2048² texels). When a level would need more, the triangle batch is split in
+  // two halves and each is traversed on its own; the closest hits are merged in triangle
+  // order, so the result does not change. Raised to at least 4·side² (one triangle can
+  // reach every leaf, so a single-triangle batch always fits).
+  std::size_t pair_capacity = std::size_t(2048) * 2048;
+  std::size_t block_size = 64;  // s of the hierarchical compaction (ROGER §4.3.2)
+};
+
+// Integer counters summed over batches (deterministic), and stage wall times (not).
+struct HierarchyTraverseStats {
+  std::vector<std::uint64_t> pairs_per_level;  // [l]: pairs entering level l's pass; [levels]: candidates
+  std::uint64_t cone_sphere_tests = 0;         // 4 per pair per level pass
+  std::uint64_t candidates = 0;                // pairs reaching the exact tests
+  std::uint64_t active_rays = 0;               // non-empty leaves
+  std::uint64_t level_passes = 0;              // level kernels launched (levels per finished batch)
+  std::uint64_t batches = 0;                   // triangle batches traversed to the leaves
+  std::uint64_t overflow_batches = 0;          // attempts abandoned on overflow (then split)
+  std::uint64_t hits = 0;
+  double tests_ms = 0, compaction_ms = 0, exact_ms = 0;
+  double candidates_per_ray() const { return active_rays ? double(candidates) / double(active_rays) : 0.0; }
+};
+
+// Closest hit (t >= tmin, t <= tmax; ties to the lower triangle index, exactly as
+// closest_hit_oracle) of every ray of `rays` (the rays the hierarchy was built over, row-
+// major width × height) against the triangles (positions, indices). Rays that are empty
+// leaves get Hit{} (no hit). Kernels: "hierarchy_spheres", per level
+// "hierarchy_level_<l>" (tests) + compaction + "hierarchy_gather_<l>", then
+// "hierarchy_exact_tests", the segmented min "hierarchy_closest" and "hierarchy_merge".
+void hierarchy_closest_hits(par::Executor& executor, const std::vector<glm::vec3>& positions,
+                            const std::vector<std::uint32_t>& indices, const RayHierarchy& hierarchy,
+                            const RayStream& rays, HitStream& hits,
+                            const HierarchyTraverseOptions& options = {},
+                            HierarchyTraverseStats* stats = nullptr);
+
+// The bounding sphere of every triangle (kernel "hierarchy_spheres").
+std::vector<BoundingSphere> triangle_bounding_spheres(par::Executor& executor,
+                                                      const std::vector<glm::vec3>& positions,
+                                                      const std::vector<std::uint32_t>& indices);
+
+}  // namespace speculum::trace

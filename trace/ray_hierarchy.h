@@ -1,0 +1,89 @@
+// The screen-space ray hierarchy of ROGER ch.3 (TECHNIQUES.md §4.2): a quad-tree of
+// cone-spheres over one ray per pixel, built bottom-up one level per kernel, and the
+// cone-sphere / bounding-sphere test of ROGER eq.3.1 that its traversal uses.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "parallel/executor.h"
+#include "trace/traversal.h"
+
+namespace speculum::trace {
+
+// One node, 8 floats (ROGER §3.2): a sphere (c, r) bounding the ray origins and a cone
+// (d unit, half-angle alpha <= π) bounding their directions. Leaves: r = 0, alpha = 0.
+// An empty node (no ray below it) has r < 0.
+struct ConeSphere {
+  glm::vec3 c{0.0f};
+  float r = -1.0f;
+  glm::vec3 d{0.0f, 0.0f, 1.0f};
+  float alpha = 0.0f;
+  bool empty() const { return r < 0.0f; }
+};
+static_assert(sizeof(ConeSphere) == 8 * sizeof(float));
+
+constexpr float kHalfPi = 1.57079632679f;
+
+// A triangle's bounding sphere (centroid, radius to the farthest vertex, widened so float
+// rounding never leaves a vertex outside).
+struct BoundingSphere {
+  glm::vec3 p{0.0f};
+  float rho = 0.0f;
+};
+
+// ROGER eq.3.1 with CH = (P-C)·d, HP = |P - C - CH d|: the sphere (P, rho) can meet a ray
+// of the node iff CH tanα + (rho + r)/cosα >= HP, written multiplied by cosα (> 0) as
+// CH sinα + (rho + r) >= HP cosα; α >= π/2 always intersects. The test is the distance to
+// the cone's slanted generatrix line, which never exceeds the true distance to the
+// Minkowski sum of origin-sphere and cone, so it is conservative also behind the apex.
+// A relative margin covers the rounding of the products (conservative by construction).
+inline bool cone_sphere_intersects(const ConeSphere& n, float sin_a, float cos_a, const BoundingSphere& s) {
+  if (n.alpha >= kHalfPi) return true;
+  const glm::vec3 q = s.p - n.c;
+  const float ch = glm::dot(q, n.d);
+  const glm::vec3 h = q - ch * n.d;
+  const float hp = std::sqrt(glm::dot(h, h));
+  const float R = s.rho + n.r;
+  const float scale = std::fabs(ch) + hp + R +
+                      std::fmax(std::fmax(std::fabs(n.c.x), std::fabs(n.c.y)), std::fabs(n.c.z)) * 0.1f;
+  return ch * sin_a + R + 1e-5f * scale >= hp * cos_a;
+}
+inline bool cone_sphere_intersects(const ConeSphere& n, const BoundingSphere& s) {
+  return cone_sphere_intersects(n, std::sin(n.alpha), std::cos(n.alpha), s);
+}
+
+// The parent of up to 4 children (TECHNIQUES.md §4.2; the thesis gives no formula):
+// d = normalize(Σ d_i), α = min(π, max_i(∠(d, d_i) + α_i)), C = mean(C_i),
+// r = max_i(|C - C_i| + r_i), over the non-empty children only (all empty → empty). Angles
+// by atan2(|d×d_i|, d·d_i) (acos loses ~3e-4 rad near 0) and every bound widened slightly,
+// so the parent encloses its children despite rounding.
+ConeSphere parent_cone_sphere(const ConeSphere* children, int count);
+
+// The quad-tree over a side × side grid of leaves (side a power of two), level 0 = root,
+// level `levels` = leaves (side = 2^levels). Node (x, y) of level l is nodes[l][y·2^l + x];
+// its children are (2x + i, 2y + j) of level l + 1. sin/cos of every α are stored beside
+// the nodes (the traversal needs them for every test).
+struct RayHierarchy {
+  int width = 0, height = 0;  // the ray grid (pixels); leaves outside it are empty
+  int side = 0;               // next power of two >= max(width, height): the padding
+  int levels = 0;             // log2(side)
+  std::vector<std::vector<ConeSphere>> nodes;
+  std::vector<std::vector<float>> sin_alpha, cos_alpha;
+};
+
+// Smallest power of two >= max(width, height) (>= 1).
+int hierarchy_side(int width, int height);
+
+// Builds the hierarchy over `rays` (width × height, row-major; rays with active[i] == 0 or
+// invalid values are empty leaves). Kernels "ray_hierarchy_leaves" then one
+// "ray_hierarchy_level_<l>" per level, bottom-up. Width and height need not be powers of
+// two: the grid is padded with empty leaves to side × side.
+RayHierarchy build_ray_hierarchy(par::Executor& executor, const RayStream& rays,
+                                 const std::vector<std::uint8_t>& active, int width, int height);
+
+}  // namespace speculum::trace

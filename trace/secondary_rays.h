@@ -1,0 +1,80 @@
+// Secondary ray generations for the ray-hierarchy technique (ROGER §3.1, TECHNIQUES.md
+// §4.2): one reflected or refracted ray per specular pixel of a G-buffer, the next bounce
+// from the closest hits, shadow rays reversed to start at a point light, and the shading
+// of a generation's hits with the shared model (core/shading.h). Kernels over core types
+// only (no raster/ types), so the recipe in apps/ wires them to the G-buffer.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/image.h"
+#include "core/scene.h"
+#include "core/shading.h"
+#include "parallel/executor.h"
+#include "trace/traversal.h"
+
+namespace speculum::trace {
+
+// One generation of rays on the pixel grid (row-major width × height): pixel i carries a
+// ray when active[i]; weight[i] is the factor its radiance is multiplied by in the pixel
+// (Fresnel × the throughput of earlier bounces).
+struct SecondaryRays {
+  int width = 0, height = 0;
+  RayStream rays;
+  std::vector<std::uint8_t> active;
+  std::vector<glm::vec3> weight;
+  std::uint64_t count = 0;  // active rays
+};
+
+// The surfaces that get a secondary ray: mirror and glossy lobes (roughness <
+// kGlossyRoughness) and refractors (the test raster::is_specular uses).
+inline bool has_secondary_ray(const SurfaceParams& s) {
+  return s.is_refractor() || s.roughness < kGlossyRoughness;
+}
+
+// Offsets p along the unit normal n by 1e-4 × max(1, |p|∞) (as the reference tracer).
+glm::vec3 offset_point(const glm::vec3& p, const glm::vec3& n);
+
+// From G-buffer planes (object id kNoId = background): mirror/glossy pixels get the mirror
+// ray R = reflect(V, N) with weight F (Schlick, specular_fresnel); glossy surfaces trace
+// the lobe's axis only (no lobe sampling). Refractors get the refracted ray with weight
+// transmission (1 - F) base_color (exact dielectric Fresnel), or the reflected ray with
+// weight transmission on total internal reflection; their Fresnel-reflected part is not
+// traced (one ray per pixel). Kernel "secondary_rays".
+SecondaryRays secondary_rays(par::Executor& executor, const Buffer2D<glm::vec3>& position,
+                             const Buffer2D<glm::vec3>& normal, const Buffer2D<SurfaceParams>& surface,
+                             const IdBuffer& object, const glm::vec3& eye);
+
+// The surface at a closest hit: position from the barycentrics, geometric and interpolated
+// shading normal (both facing the incident side), material at the hit's uv.
+struct HitSurface {
+  glm::vec3 p{0.0f}, ng{0.0f, 0.0f, 1.0f}, n{0.0f, 0.0f, 1.0f};
+  SurfaceParams s;
+  bool entering = true;  // the ray arrived on the front (geometric-normal) side
+};
+HitSurface hit_surface(const Scene& scene, const Hit& hit, const glm::vec3& ray_direction);
+
+// The next generation: every hit on a specular surface spawns its reflected/refracted ray
+// (the same rules as secondary_rays), weight multiplied. Kernel "bounce_rays".
+SecondaryRays bounce_rays(par::Executor& executor, const Scene& scene, const SecondaryRays& in,
+                          const HitStream& hits);
+
+// Shadow rays towards `light` for the hits of `gen` the light can reach: for point and spot
+// lights reversed, starting at the light and ending just before the surface point
+// (origin = light, direction = point - light, t in [0, 1 - 1e-4]), so every ray of the
+// hierarchy shares one origin (ROGER §3.4); directional lights get forward rays from the
+// surface. Kernel "shadow_rays".
+SecondaryRays shadow_rays(par::Executor& executor, const Scene& scene, const Light& light,
+                          const SecondaryRays& gen, const HitStream& hits);
+
+// Radiance of generation `gen` per pixel, added to `out` (width × height): weight × (the
+// environment on a miss; emission + every light's shade_light where unshadowed otherwise).
+// shadow_hits[l] are the closest hits of shadow_rays(..., lights[l], ...): a hit = shadowed.
+// Kernel "shade_hits".
+void shade_hits(par::Executor& executor, const Scene& scene, const SecondaryRays& gen, const HitStream& hits,
+                const std::vector<HitStream>& shadow_hits, ImageRGBA& out);
+
+}  // namespace speculum::trace
