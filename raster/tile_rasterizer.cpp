@@ -8,6 +8,8 @@
 #include <limits>
 #include <utility>
 
+#include <immintrin.h>
+
 #include "parallel/lanes.h"
 
 namespace speculum::raster {
@@ -17,6 +19,11 @@ constexpr int kBlock = 8;  // coverage block side: blocks whose corners all fail
 constexpr int kTilePixels = kTileSize * kTileSize;
 constexpr int kPad = 16;  // lanes may read/write past a row's end (never past the arrays)
 constexpr std::uint32_t kNoRef = 0xffffffffu;
+constexpr int kBlocksPerSide = kTileSize / kBlock;
+constexpr int kBlocksPerTile = kBlocksPerSide * kBlocksPerSide;
+// Interpolated 1/w = Σ λ_i/w_i may exceed the largest vertex 1/w by rounding (a few ulps of
+// three products and two sums); the rejection test widens the vertex maximum by far more.
+constexpr float kHizMargin = 1.0f + 1.0f / 4096.0f;
 
 // The winner so far of every sample of one tile (the early depth test's state). All 32-bit
 // so a row of W samples is tested and updated as W lanes.
@@ -27,7 +34,13 @@ struct TileScratch {
   std::uint32_t triangle[kTilePixels + kPad];
   std::uint32_t ref[kTilePixels + kPad];  // index into the tile's triangle refs
   std::uint32_t coverage[kTilePixels + kPad];
+  // Hierarchical depth: per 8×8 block, the farthest winner (smallest 1/w; 0 while any
+  // sample of the block is empty). A triangle whose nearest vertex is farther than that
+  // cannot win any sample of the block and skips it. Off when counting coverage (every
+  // covering triangle must then be rasterized).
+  alignas(32) float block_min[kBlocksPerTile];
   bool count_coverage;
+  bool hiz;
   std::vector<const SetupTriangle*> setup;  // per ref
   std::vector<const ClipMap*> clip_map;     // per ref
 };
@@ -87,8 +100,9 @@ inline Weights weights(const Edges& e, std::int64_t e0, std::int64_t e1, std::in
 // Coverage + early depth test over the pixel rectangle [x0,x1]×[y0,y1] (inclusive,
 // absolute pixels inside the tile at (ox, oy)), W pixels of a row at a time.
 template <int W>
-void raster_rect_wide(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
+bool raster_rect_wide(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
                       int x1, int y1, int ox, int oy, TileScratch& s) {
+  bool won = false;
   const std::int64_t step0 = e.a[0] * kSubpixelOne, step1 = e.a[1] * kSubpixelOne,
                      step2 = e.a[2] * kSubpixelOne;
   // Per-lane offsets built by additions (AVX2 has no 64-bit multiply).
@@ -132,10 +146,12 @@ void raster_rect_wide(const Edges& e, const SetupTriangle& t, std::uint32_t ref,
           s.p2[idx] = w.p2;
           s.triangle[idx] = t.triangle;
           s.ref[idx] = ref;
+          won = true;
         }
       }
     }
   }
+  return won;
 }
 
 // The same with 32-bit edge values in Lanes<W> (AVX2 has no 64-bit multiply or int64→float
@@ -143,8 +159,9 @@ void raster_rect_wide(const Edges& e, const SetupTriangle& t, std::uint32_t ref,
 // integers are equal to the 64-bit ones and the float operations are the same, in the same
 // order, so both paths give the same bits.
 template <int W>
-void raster_rect_lanes(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
+bool raster_rect_lanes(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
                        int x1, int y1, int ox, int oy, TileScratch& s) {
+  bool won = false;
   using L = par::Lanes<W>;
   using I = typename L::i32;
   using U = typename L::u32;
@@ -190,15 +207,17 @@ void raster_rect_lanes(const Edges& e, const SetupTriangle& t, std::uint32_t ref
       L::store(L::select(win, p2, L::load(&s.p2[idx])), &s.p2[idx]);
       L::store(L::select(win, tri, best_tri), &s.triangle[idx]);
       L::store(L::select(win, refs, U(L::load(&s.ref[idx]))), &s.ref[idx]);
+      won = true;
     }
   }
+  return won;
 }
 
 // Picks the 32-bit lane path for small triangles (see make_edges) or when |E| stays below
 // 2^30 over the rectangle widened to whole groups of W lanes (E is linear: its extremes are
 // at the corners).
 template <int W>
-void raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
+bool raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
                  int x1, int y1, int ox, int oy, TileScratch& s) {
   const int xw = x0 + ((x1 - x0) / W + 1) * W - 1;
   constexpr std::int64_t kLimit = std::int64_t(1) << 30;
@@ -208,36 +227,72 @@ void raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int 
       const std::int64_t v = edge_at(e, i, px, py);
       narrow &= v < kLimit && v > -kLimit;
     }
-  if (narrow && W > 1) raster_rect_lanes<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
-  else raster_rect_wide<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
+  if (narrow && W > 1) return raster_rect_lanes<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
+  return raster_rect_wide<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
+}
+
+// Recomputes the farthest winner of block (bx, by) after a triangle won samples in it.
+inline void update_block_min(TileScratch& s, int bx, int by) {
+  const float* row = &s.inv_w[(by * kBlock) * kTileSize + bx * kBlock];
+  __m256 m = _mm256_loadu_ps(row);
+  for (int r = 1; r < kBlock; ++r) m = _mm256_min_ps(m, _mm256_loadu_ps(row + r * kTileSize));
+  __m128 h = _mm_min_ps(_mm256_castps256_ps128(m), _mm256_extractf128_ps(m, 1));
+  h = _mm_min_ps(h, _mm_movehl_ps(h, h));
+  h = _mm_min_ss(h, _mm_shuffle_ps(h, h, 1));
+  s.block_min[by * kBlocksPerSide + bx] = _mm_cvtss_f32(h);
+}
+
+// Updates the blocks overlapped by the tile-relative pixel rectangle [x0,x1]×[y0,y1].
+inline void update_block_mins(TileScratch& s, int x0, int y0, int x1, int y1) {
+  for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+    for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) update_block_min(s, bx, by);
 }
 
 // Hierarchical coverage: small triangles go straight to pixels; larger ones are walked in
-// 8×8 blocks and a block is skipped when one edge is negative at all four corner samples
-// (E is linear, so its maximum over the block is at a corner).
+// the tile's 8×8 blocks and a block is skipped when one edge is negative at all four corner
+// samples (E is linear, so its maximum over the block is at a corner) or when the hierarchical
+// depth shows the triangle is behind everything already drawn there.
 template <int W>
 void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0, int tx1,
                      int ty1, TileScratch& s) {
   const int x0 = std::max(t.px0, tx0), x1 = std::min(t.px1, tx1);
   const int y0 = std::max(t.py0, ty0), y1 = std::min(t.py1, ty1);
   if (x0 > x1 || y0 > y1) return;
+  // Block range of the clipped bounding box, tile-relative.
+  const int bx0 = (x0 - tx0) / kBlock, bx1 = (x1 - tx0) / kBlock;
+  const int by0 = (y0 - ty0) / kBlock, by1 = (y1 - ty0) / kBlock;
+  // 1/w is affine on the triangle: its maximum is at a vertex.
+  const float nearest = std::max({t.inv_w[0], t.inv_w[1], t.inv_w[2]}) * kHizMargin;
+  auto hidden = [&](int bx, int by) {
+    return s.hiz && nearest < s.block_min[by * kBlocksPerSide + bx];
+  };
+  if (s.hiz) {
+    bool any_visible = false;
+    for (int by = by0; by <= by1 && !any_visible; ++by)
+      for (int bx = bx0; bx <= bx1 && !any_visible; ++bx) any_visible = !hidden(bx, by);
+    if (!any_visible) return;
+  }
   const Edges e = make_edges(t);
   if (x1 - x0 < kBlock && y1 - y0 < kBlock) {
-    raster_rect<W>(e, t, ref, x0, y0, x1, y1, tx0, ty0, s);
+    if (raster_rect<W>(e, t, ref, x0, y0, x1, y1, tx0, ty0, s) && s.hiz)
+      update_block_mins(s, x0 - tx0, y0 - ty0, x1 - tx0, y1 - ty0);
     return;
   }
-  for (int by = y0; by <= y1; by += kBlock) {
-    const int by1 = std::min(by + kBlock - 1, y1);
-    for (int bx = x0; bx <= x1; bx += kBlock) {
-      const int bx1 = std::min(bx + kBlock - 1, x1);
+  for (int by = by0; by <= by1; ++by) {
+    const int ry0 = std::max(y0, ty0 + by * kBlock), ry1 = std::min(y1, ty0 + by * kBlock + kBlock - 1);
+    for (int bx = bx0; bx <= bx1; ++bx) {
+      if (hidden(bx, by)) continue;
+      const int rx0 = std::max(x0, tx0 + bx * kBlock);
+      const int rx1 = std::min(x1, tx0 + bx * kBlock + kBlock - 1);
       bool rejected = false;
       for (int i = 0; i < 3 && !rejected; ++i) {
         const std::int64_t m =
-            std::max({edge_at(e, i, bx, by), edge_at(e, i, bx1, by), edge_at(e, i, bx, by1),
-                      edge_at(e, i, bx1, by1)});
+            std::max({edge_at(e, i, rx0, ry0), edge_at(e, i, rx1, ry0), edge_at(e, i, rx0, ry1),
+                      edge_at(e, i, rx1, ry1)});
         rejected = m < e.threshold[i];
       }
-      if (!rejected) raster_rect<W>(e, t, ref, bx, by, bx1, by1, tx0, ty0, s);
+      if (!rejected && raster_rect<W>(e, t, ref, rx0, ry0, rx1, ry1, tx0, ty0, s) && s.hiz)
+        update_block_min(s, bx, by);
     }
   }
 }
@@ -257,6 +312,8 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
   s.setup.clear();
   s.clip_map.clear();
   s.count_coverage = !out.coverage.empty();
+  s.hiz = !s.count_coverage;
+  std::fill(std::begin(s.block_min), std::end(s.block_min), 0.0f);
   if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
 
   for (const BinnedChunk& chunk : chunks) {
