@@ -34,6 +34,7 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global);
 
 // `experiment` parent (apps/cmd_experiment.cpp) and its children, one per cmd_experiment_*.cpp.
 void add_experiment_command(CLI::App& app, GlobalOptions& global);
+void add_experiment_yu_fig9_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_survey_subcommand(CLI::App& experiment, GlobalOptions& global);
 
 }  // namespace speculum::cli

@@ -57,7 +57,8 @@ void run_render(const RenderOptions& o, const GlobalOptions& global) {
   if (global.lanes != 0) par::set_default_lanes(global.lanes);
   const pipeline::Technique& technique = pipeline::find_technique(o.technique);
   const int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
-  if (o.spp < 1 || (k * k != o.spp && technique.name != "reference"))
+  if (o.spp < 1 || (k * k != o.spp && technique.name != "reference" &&
+                     technique.name != "yu-lod"))
     throw InputError("--spp", "must be a square (1, 4, 9, 16, ...) for k×k supersampling, got " +
                                   std::to_string(o.spp));
   // About 200 bytes per sample pass through the feed-forward pipeline: refuse sizes that

@@ -3,6 +3,7 @@
 
 #include "apps/pipeline_planar_mirror.h"
 #include "apps/pipeline_distance_map.h"
+#include "apps/pipeline_yu_lod.h"
 #include "core/error.h"
 
 namespace speculum::pipeline {
@@ -27,6 +28,10 @@ const std::vector<Technique>& techniques() {
        "each mirror plane, scene clipped at the plane, recursive to --param depth=3; other "
        "specular surfaces as envmap",
        add_planar_mirror_passes},
+      {"yu-lod",
+       "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
+       "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",
+       add_yu_lod_passes},
   };
   return table;
 }
