@@ -1,0 +1,37 @@
+// Inter-object multiple reflections (SURVEY §4.3, TECHNIQUES.md §2.3): every specular
+// object's colour + distance cube map is re-rendered with the reflectors it sees shaded by
+// a distance-map search in the *current* maps of the others, so each round adds one
+// bounce. Rounds are Jacobi-style (all maps of round k read round k−1's), which makes a
+// round exactly one bounce and makes the frame-lagged variant (one round per frame from
+// the previous frame's maps) equal to the same number of in-frame rounds.
+#pragma once
+
+#include <vector>
+
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "raster/distance_map_reflect.h"
+#include "raster/environment.h"
+#include "raster/reflector_maps.h"
+#include "raster/shadow_map.h"
+
+namespace speculum::raster {
+
+// One round: the maps of `current` re-rendered at the same reference points and sizes,
+// reflectors in view shaded by direct light + distance_map_reflect(current).
+ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scene,
+                                      const std::vector<ShadowMap>& shadows,
+                                      const EnvironmentMap& env, const ReflectorMaps& current,
+                                      const DistanceSearchOptions& options,
+                                      DistanceReflectStats* stats = nullptr);
+
+// `rounds` ≥ 1 rounds: round 1 is render_reflector_maps (direct light only: one bounce
+// once looked up from the camera), each further round one rerender.
+ReflectorMaps render_multi_reflection_maps(par::Executor& executor, const Scene& scene,
+                                           const std::vector<ShadowMap>& shadows,
+                                           const EnvironmentMap& env, int size,
+                                           const GBuffer* camera_view, int rounds,
+                                           const DistanceSearchOptions& options,
+                                           DistanceReflectStats* stats = nullptr);
+
+}  // namespace speculum::raster
