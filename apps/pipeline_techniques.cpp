@@ -23,6 +23,11 @@ const std::vector<Technique>& techniques() {
        "sample; --param parallax|linear|secant=0/1, parallax_steps=1, linear_steps=16, "
        "secant_steps=4",
        add_distance_map_passes},
+      {"multi-reflection",
+       "inter-object reflections (SURVEY §4.3): reflector distance maps rebuilt in rounds, one "
+       "bounce each; --param rounds=3, lagged=0/1 (one round per frame from the previous "
+       "frame's maps), plus the distance-map search params",
+       add_multi_reflection_passes},
       {"planar-mirror",
        "planar mirrors by geometry transformation (SURVEY §5): the camera reflected about "
        "each mirror plane, scene clipped at the plane, recursive to --param depth=3; other "
