@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -41,6 +42,86 @@ void ensure_size(Buffer2D<T>& b, int width, int height) {
   if (b.width != width || b.height != height) b = Buffer2D<T>(width, height);
 }
 
+struct SampleContext {
+  const Scene& scene;
+  const TriangleMesh& m;
+  const VisibilityBuffer& vis;
+  const glm::vec3& eye;
+  const std::vector<SurfaceParams>& constant_params;
+  const std::vector<std::uint8_t>& textured;
+  const std::vector<std::uint8_t>& normal_mapped;
+};
+
+// Resolves visibility sample i into g (only the ids on background).
+inline void resolve_sample(const SampleContext& c, std::size_t i, GBuffer& g) {
+  const std::uint32_t t = c.vis.triangle.pixels[i];
+  const std::uint32_t object = c.vis.object.pixels[i];
+  g.object.pixels[i] = object;
+  if (t == kNoId) {
+    g.reflector.pixels[i] = kNoId;
+    return;
+  }
+  const TriangleMesh& m = c.m;
+  const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+  const glm::vec2 b = c.vis.bary.pixels[i];
+  const float b0 = 1.0f - b.x - b.y;
+  auto lerp3 = [&](const auto& a) { return b0 * a[i0] + b.x * a[i1] + b.y * a[i2]; };
+  const glm::vec3 p = lerp3(m.positions);
+  glm::vec3 n = lerp3(m.normals);
+  const float nl = glm::length(n);
+  if (nl > 1e-12f) {
+    n = n / nl;
+  } else {  // degenerate interpolated normal: fall back to the face normal
+    n = glm::normalize(
+        glm::cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]));
+  }
+  const glm::vec2 uv = lerp3(m.uvs);
+  const std::uint32_t mat = m.triangle_material[t];
+  const bool textured = c.textured[mat] != 0, normal_mapped = c.normal_mapped[mat] != 0;
+  const glm::vec2 uv1 =
+      (textured || normal_mapped) && !m.uvs1.empty() ? lerp3(m.uvs1) : glm::vec2(0.0f);
+  if (normal_mapped)
+    n = apply_normal_map(c.scene, c.scene.materials[mat], n, lerp3(m.tangents), uv, uv1);
+  SurfaceParams& sp = g.surface.pixels[i];
+  sp = textured ? surface_params(c.scene, mat, uv, uv1) : c.constant_params[mat];
+  // Opaque surfaces are shaded on the side the camera sees (double-sided or not, a visible
+  // back face would otherwise shade black); refractors keep their orientation so the
+  // reflection node knows whether the ray enters or leaves. Only the sign of N·V matters,
+  // so V is not normalized.
+  if (!sp.is_refractor() && glm::dot(n, c.eye - p) < 0.0f) n = -n;
+  g.position.pixels[i] = p;
+  g.normal.pixels[i] = n;
+  g.uv.pixels[i] = uv;
+  g.reflector.pixels[i] = is_specular(sp) ? object : kNoId;
+}
+
+// The visible triangles of neighbouring samples are scattered through the mesh (random for
+// small triangles), so the resolve is bound by the latency of gathering their vertices.
+// Two-stage software prefetch: the index triple of the triangle kFar samples ahead, then the
+// vertex attributes of the triangle kNear samples ahead (its indices are cached by then).
+inline void prefetch_sample(const SampleContext& c, std::size_t i, std::size_t end) {
+  constexpr std::size_t kFar = 16, kNear = 8;
+  const TriangleMesh& m = c.m;
+  if (i + kFar < end) {
+    const std::uint32_t t = c.vis.triangle.pixels[i + kFar];
+    if (t != kNoId) {
+      __builtin_prefetch(&m.indices[3 * t]);
+      __builtin_prefetch(&m.triangle_material[t]);
+    }
+  }
+  if (i + kNear < end) {
+    const std::uint32_t t = c.vis.triangle.pixels[i + kNear];
+    if (t != kNoId) {
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = m.indices[3 * t + k];
+        __builtin_prefetch(&m.positions[v]);
+        __builtin_prefetch(&m.normals[v]);
+        if (!m.uvs.empty()) __builtin_prefetch(&m.uvs[v]);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
@@ -63,55 +144,21 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visibili
   ensure_size(g.surface, w, h);
   ensure_size(g.reflector, w, h);
   const TriangleMesh& m = scene.mesh;
-  const bool has_uv1 = !m.uvs1.empty();
-  const bool has_tangents = !m.tangents.empty();
   // Untextured materials have the same parameters everywhere: evaluate them once.
   std::vector<SurfaceParams> constant_params;
-  std::vector<std::uint8_t> textured;
+  std::vector<std::uint8_t> textured, normal_mapped;
   for (const Material& mat : scene.materials) {
     constant_params.push_back(surface_params(mat));
     textured.push_back(mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
                        mat.emissive_texture.valid() || mat.transmission_texture.valid());
+    normal_mapped.push_back(!m.tangents.empty() && mat.normal_texture.valid());
   }
+  const SampleContext ctx{scene, m, vis, eye, constant_params, textured, normal_mapped};
   executor.parallel_for("gbuffer.resolve", vis.triangle.size(), kPixelChunk,
                         [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      const std::uint32_t t = vis.triangle.pixels[i];
-      g.object.pixels[i] = vis.object.pixels[i];
-      if (t == kNoId) {
-        g.reflector.pixels[i] = kNoId;
-        continue;
-      }
-      const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1],
-                          i2 = m.indices[3 * t + 2];
-      const glm::vec2 b = vis.bary.pixels[i];
-      const float b0 = 1.0f - b.x - b.y;
-      auto lerp3 = [&](const auto& a) { return b0 * a[i0] + b.x * a[i1] + b.y * a[i2]; };
-      const glm::vec3 p = lerp3(m.positions);
-      glm::vec3 n = lerp3(m.normals);
-      const float nl = glm::length(n);
-      const glm::vec3 face = glm::cross(m.positions[i1] - m.positions[i0],
-                                        m.positions[i2] - m.positions[i0]);
-      n = nl > 1e-12f ? n / nl : glm::normalize(face);
-      const glm::vec2 uv = lerp3(m.uvs);
-      const glm::vec2 uv1 = has_uv1 ? lerp3(m.uvs1) : glm::vec2(0.0f);
-      const std::uint32_t mat = m.triangle_material[t];
-      const Material& material = scene.materials[mat];
-      if (has_tangents) n = apply_normal_map(scene, material, n, lerp3(m.tangents), uv, uv1);
-      const glm::vec3 to_eye = eye - p;
-      const float dl = glm::length(to_eye);
-      const glm::vec3 v = dl > 0.0f ? to_eye / dl : glm::vec3(0, 0, 1);
-      const SurfaceParams s =
-          textured[mat] ? surface_params(scene, mat, uv, uv1) : constant_params[mat];
-      // Opaque surfaces are shaded on the side the camera sees (double-sided or not, a
-      // visible back face would otherwise shade black); refractors keep their orientation
-      // so the reflection node knows whether the ray enters or leaves.
-      if (!s.is_refractor() && glm::dot(n, v) < 0.0f) n = -n;
-      g.position.pixels[i] = p;
-      g.normal.pixels[i] = n;
-      g.uv.pixels[i] = uv;
-      g.surface.pixels[i] = s;
-      g.reflector.pixels[i] = is_specular(s) ? vis.object.pixels[i] : kNoId;
+      prefetch_sample(ctx, i, end);
+      resolve_sample(ctx, i, g);
     }
   });
 }

@@ -14,15 +14,15 @@ void bin_chunk(BinnedChunk& chunk, const TileGrid& grid) {
       for (int tx = tx0; tx <= tx1; ++tx) ++chunk.tile_offsets[ty * grid.tiles_x + tx + 1];
   }
   for (std::size_t i = 0; i < tiles; ++i) chunk.tile_offsets[i + 1] += chunk.tile_offsets[i];
-  chunk.tile_list.resize(chunk.tile_offsets[tiles]);
+  // Reuses the previous frame's memory when the size is unchanged.
+  chunk.binned.resize(chunk.tile_offsets[tiles]);
   // Pass 2: fill in triangle order, using a cursor per tile.
   std::vector<std::uint32_t> cursor(chunk.tile_offsets.begin(), chunk.tile_offsets.end() - 1);
-  for (std::uint32_t i = 0; i < chunk.triangles.size(); ++i) {
-    const SetupTriangle& t = chunk.triangles[i];
+  for (const SetupTriangle& t : chunk.triangles) {
     const int tx0 = t.px0 >> kTileShift, tx1 = t.px1 >> kTileShift;
     const int ty0 = t.py0 >> kTileShift, ty1 = t.py1 >> kTileShift;
     for (int ty = ty0; ty <= ty1; ++ty)
-      for (int tx = tx0; tx <= tx1; ++tx) chunk.tile_list[cursor[ty * grid.tiles_x + tx]++] = i;
+      for (int tx = tx0; tx <= tx1; ++tx) chunk.binned[cursor[ty * grid.tiles_x + tx]++] = t;
   }
 }
 

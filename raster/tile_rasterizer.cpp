@@ -319,11 +319,7 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
   for (const BinnedChunk& chunk : chunks) {
     const std::uint32_t begin = chunk.tile_offsets[tile], end = chunk.tile_offsets[tile + 1];
     for (std::uint32_t k = begin; k < end; ++k) {
-      // A tile's triangles are scattered through the chunk: fetch a few ahead.
-      constexpr std::uint32_t kPrefetchDistance = 8;
-      if (k + kPrefetchDistance < end)
-        __builtin_prefetch(&chunk.triangles[chunk.tile_list[k + kPrefetchDistance]]);
-      const SetupTriangle& t = chunk.triangles[chunk.tile_list[k]];
+      const SetupTriangle& t = chunk.binned[k];
       const auto ref = static_cast<std::uint32_t>(s.setup.size());
       s.setup.push_back(&t);
       s.clip_map.push_back(t.clip_map >= 0 ? &chunk.clip_maps[t.clip_map] : nullptr);
@@ -335,6 +331,11 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
   for (int y = ty0; y <= ty1; ++y) {
     for (int x = tx0; x <= tx1; ++x) {
       const int idx = (y - ty0) * kTileSize + (x - tx0);
+      // The winners' object ids are scattered through the mesh: fetch a few samples ahead
+      // (idx + kPrefetchAhead stays inside the padded arrays; any valid ref is harmless).
+      constexpr int kPrefetchAhead = 8;
+      if (const std::uint32_t ahead = s.ref[idx + kPrefetchAhead]; ahead != kNoRef)
+        __builtin_prefetch(&triangle_object[s.setup[ahead]->triangle]);
       const std::uint32_t ref = s.ref[idx];
       const SetupTriangle* t = ref == kNoRef ? nullptr : s.setup[ref];
       const std::size_t o = static_cast<std::size_t>(y) * vp.width + x;
