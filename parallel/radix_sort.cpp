@@ -289,9 +289,19 @@ void sort_bucket(E* src, std::size_t m, unsigned lo_bit, unsigned bits, std::uin
   tb.counts.assign(passes * radix, 0u);
   std::uint32_t* const count = tb.counts.data();
   // One read counts every pass's digit (counts do not depend on the order).
-  for (std::size_t i = 0; i < m; ++i) {
-    const std::uint32_t k = Packed<E>::key(src[i]);
-    for (unsigned p = 0; p < passes; ++p) ++count[p * radix + ((k >> (lo_bit + p * digit_bits)) & mask)];
+  if (passes == 2) {  // the common case (16M uniform keys), unrolled
+    std::uint32_t* const c1 = count + radix;
+    const unsigned s0 = lo_bit, s1 = lo_bit + digit_bits;
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::uint32_t k = Packed<E>::key(src[i]);
+      ++count[(k >> s0) & mask];
+      ++c1[(k >> s1) & mask];
+    }
+  } else {
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::uint32_t k = Packed<E>::key(src[i]);
+      for (unsigned p = 0; p < passes; ++p) ++count[p * radix + ((k >> (lo_bit + p * digit_bits)) & mask)];
+    }
   }
   unsigned active[32];
   unsigned n_active = 0;
@@ -335,7 +345,10 @@ void msd_sort32(Executor& ex, std::string_view name, std::span<std::uint32_t> ke
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>& s,
                 std::size_t chunk, unsigned lo_bit, unsigned bits) {
   const std::size_t n = keys.size();
-  const unsigned top_bits = std::min(bits, kMaxDigitBits);
+  // Top digit: buckets of ~8-16K elements on average (sorted in L2), and no more than 22
+  // bits left for them (two in-cache passes of <= 11 bits): 10 bits for 16M 32-bit keys.
+  const unsigned cache_top = std::clamp(unsigned(std::bit_width(n)), 16u, 26u) - 15;
+  const unsigned top_bits = std::min({bits, kMaxDigitBits, std::max(cache_top, bits > 22 ? bits - 22 : 0u)});
   const unsigned local_bits = bits - top_bits;
   const unsigned shift = lo_bit + local_bits;
   const std::size_t buckets = std::size_t(1) << top_bits;

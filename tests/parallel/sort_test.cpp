@@ -50,6 +50,12 @@ void check_radix(std::size_t n, Key mask, int threads) {
   radix_sort(executor(threads), "radix", std::span(sorted), std::span(idx));
   ASSERT_EQ(idx, ref) << n << " t=" << threads;
   for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(sorted[i], keys[ref[i]]);
+  // Keys only (no payload): the 32-bit path scatters bare keys instead of packed pairs.
+  auto bare = keys;
+  radix_sort(executor(threads), "radix_keys", std::span(bare), {});
+  auto ref_keys = keys;
+  std::sort(ref_keys.begin(), ref_keys.end());
+  ASSERT_EQ(bare, ref_keys) << n << " t=" << threads;
 }
 
 TEST(RadixSort, Keys32And64WithPayloadEqualStableSort) {
@@ -57,6 +63,7 @@ TEST(RadixSort, Keys32And64WithPayloadEqualStableSort) {
     for (int t : kThreadCounts) {
       check_radix<std::uint32_t>(n, 0xffffffffu, t);
       check_radix<std::uint32_t>(n, 0x3ffu, t);  // many ties; constant high digits skipped
+      check_radix<std::uint32_t>(n, 0xfff0u, t);  // varying bits not starting at bit 0
       check_radix<std::uint64_t>(n, ~std::uint64_t(0), t);
     }
   std::vector<std::uint32_t> k = {3, 1, 2};
@@ -66,26 +73,54 @@ TEST(RadixSort, Keys32And64WithPayloadEqualStableSort) {
   EXPECT_THROW(radix_sort(executor(1), "bad", std::span(k), std::span(p)), std::invalid_argument);
 }
 
+// Most keys share the top digit: one bucket would hold ~94 % of the array, so the sort
+// takes its whole-array LSD path; the result is still the stable order.
+TEST(RadixSort, SkewedTopDigitEqualsStableSort) {
+  const std::size_t n = 300000;
+  std::vector<std::uint32_t> keys(n);
+  for (std::size_t i = 0; i < n; ++i) keys[i] = i % 16 == 0 ? hash32(i) : hash32(i) & 0xffu;
+  std::vector<std::uint32_t> ref(n);
+  std::iota(ref.begin(), ref.end(), 0u);
+  std::stable_sort(ref.begin(), ref.end(), [&](auto a, auto b) { return keys[a] < keys[b]; });
+  for (int t : kThreadCounts) {
+    auto sorted = keys;
+    std::vector<std::uint32_t> idx(n);
+    std::iota(idx.begin(), idx.end(), 0u);
+    radix_sort(executor(t), "skewed", std::span(sorted), std::span(idx));
+    ASSERT_EQ(idx, ref) << "t=" << t;
+    auto bare = keys;
+    radix_sort(executor(t), "skewed_keys", std::span(bare), {});
+    for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(bare[i], keys[ref[i]]);
+  }
+}
+
 TEST(RadixSort, SixteenMillion32BitKeys) {
   const std::size_t n = std::size_t(16) << 20;
-  std::vector<std::uint32_t> keys(n), payload(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    keys[i] = hash32(i) & 0xfffffu;  // many duplicates: stability is visible
-    payload[i] = std::uint32_t(i);
-  }
-  const auto original = keys;
-  RadixSortScratch<std::uint32_t> scratch;
-  radix_sort(executor(2), "radix16M", std::span(keys), std::span(payload), &scratch);
-  // Sorted, stable, and payload is a permutation mapping back to the original keys.
-  std::vector<bool> seen(n, false);
-  for (std::size_t i = 0; i < n; ++i) {
-    ASSERT_EQ(keys[i], original[payload[i]]);
-    ASSERT_FALSE(seen[payload[i]]);
-    seen[payload[i]] = true;
-    if (i) {
-      ASSERT_LE(keys[i - 1], keys[i]);
-      if (keys[i - 1] == keys[i]) ASSERT_LT(payload[i - 1], payload[i]);
+  // 20-bit keys: many duplicates, stability is visible; 32-bit keys: two in-cache passes
+  // per bucket after the top-digit scatter.
+  for (std::uint32_t mask : {0xfffffu, 0xffffffffu}) {
+    std::vector<std::uint32_t> keys(n), payload(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      keys[i] = hash32(i) & mask;
+      payload[i] = std::uint32_t(i);
     }
+    const auto original = keys;
+    RadixSortScratch<std::uint32_t> scratch;
+    radix_sort(executor(2), "radix16M", std::span(keys), std::span(payload), &scratch);
+    // Sorted, stable, and payload is a permutation mapping back to the original keys.
+    std::vector<bool> seen(n, false);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(keys[i], original[payload[i]]);
+      ASSERT_FALSE(seen[payload[i]]);
+      seen[payload[i]] = true;
+      if (i) {
+        ASSERT_LE(keys[i - 1], keys[i]);
+        if (keys[i - 1] == keys[i]) ASSERT_LT(payload[i - 1], payload[i]);
+      }
+    }
+    auto bare = original;  // keys only: the same keys in the same order
+    radix_sort(executor(2), "radix16M_keys", std::span(bare), {}, &scratch);
+    ASSERT_EQ(bare, keys) << std::hex << mask;
   }
 }
 
