@@ -38,10 +38,14 @@ struct BoundingSphere {
 
 // ROGER eq.3.1 with CH = (P-C)·d, HP = |P - C - CH d|: the sphere (P, rho) can meet a ray
 // of the node iff CH tanα + (rho + r)/cosα >= HP, written multiplied by cosα (> 0) as
-// CH sinα + (rho + r) >= HP cosα; α >= π/2 always intersects. The test is the distance to
-// the cone's slanted generatrix line, which never exceeds the true distance to the
-// Minkowski sum of origin-sphere and cone, so it is conservative also behind the apex.
-// A relative margin covers the rounding of the products (conservative by construction).
+// CH sinα + (rho + r) >= HP cosα; α >= π/2 always intersects. Eq.3.1 is the distance to
+// the cone's slanted generatrix *line*; where P - C lies behind the apex beyond the
+// generatrix's normal (CH cosα + HP sinα < 0) the true distance to the cone is |P - C|, so
+// there the test is |P - C| <= rho + r. Together this is the exact distance from P to the
+// Minkowski sum of the origin sphere and the cone (the union of the node's rays), hence
+// conservative, and it drops spheres behind a ray's origin that the line test keeps (at a
+// leaf, α = 0, eq.3.1 alone accepts every sphere the infinite line meets). A relative margin
+// covers the rounding of the products.
 inline bool cone_sphere_intersects(const ConeSphere& n, float sin_a, float cos_a, const BoundingSphere& s) {
   if (n.alpha >= kHalfPi) return true;
   const glm::vec3 q = s.p - n.c;
@@ -51,7 +55,12 @@ inline bool cone_sphere_intersects(const ConeSphere& n, float sin_a, float cos_a
   const float R = s.rho + n.r;
   const float scale = std::fabs(ch) + hp + R +
                       std::fmax(std::fmax(std::fabs(n.c.x), std::fabs(n.c.y)), std::fabs(n.c.z)) * 0.1f;
-  return ch * sin_a + R + 1e-5f * scale >= hp * cos_a;
+  const float margin = 1e-5f * scale;
+  if (ch * cos_a + hp * sin_a < -margin) {
+    const float Rm = R + margin;
+    return glm::dot(q, q) <= Rm * Rm;
+  }
+  return ch * sin_a + R + margin >= hp * cos_a;
 }
 inline bool cone_sphere_intersects(const ConeSphere& n, const BoundingSphere& s) {
   return cone_sphere_intersects(n, std::sin(n.alpha), std::cos(n.alpha), s);
