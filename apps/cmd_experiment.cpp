@@ -10,6 +10,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
   cmd->require_subcommand(1);
   cmd->fallthrough();
   // One line per experiment (apps/cmd_experiment_*.cpp):
+  add_experiment_ray_hierarchy_subcommand(*cmd, global);
   add_experiment_yu_fig9_subcommand(*cmd, global);
   (void)global;
 }

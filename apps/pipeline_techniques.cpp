@@ -2,6 +2,7 @@
 #include "apps/pipeline_techniques.h"
 
 #include "apps/pipeline_planar_mirror.h"
+#include "apps/pipeline_ray_hierarchy.h"
 #include "apps/pipeline_distance_map.h"
 #include "apps/pipeline_yu_lod.h"
 #include "core/error.h"
@@ -37,6 +38,11 @@ const std::vector<Technique>& techniques() {
        "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
        "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",
        add_yu_lod_passes},
+      {"ray-hierarchy",
+       "ROGER ch.3 ray hierarchy: one reflected/refracted ray per specular pixel through a "
+       "screen-space cone-sphere quad-tree over stream compaction, exact closest hits; "
+       "--bounces B; --param pair_capacity=4194304, block=64",
+       add_ray_hierarchy_passes},
   };
   return table;
 }
