@@ -4,7 +4,9 @@
 // contents are roughly planar (area-weighted mean normal of length >= kPlanarity) is
 // approximated by one quad — the plane through the contents' area centroid perpendicular to
 // that mean normal, spanning the projection of the children's proxies (leaves: of their
-// triangles); any other node by its own box. Filtered radiance is the area-weighted mean of
+// triangles); any other node has no approximate geometry (the LOD traversal descends it,
+// like YU's geometry-image patches that only stop where two triangles fit the surface).
+// Filtered radiance is the area-weighted mean of
 // the per-triangle radiance of trace/hit_radiance.h, so the ancestors of a triangle are the
 // coarser levels of a mip pyramid whose level-0 texels are the triangles (eq.9).
 #pragma once
@@ -22,7 +24,7 @@ constexpr float kPlanarity = 0.7f;  // |Σ A n| / Σ A at or above: the quad pro
 
 struct LodNode {
   glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};  // quad: origin + s edge_u + t edge_v
-  glm::vec3 normal{0.0f};     // unit mean normal of a quad proxy (zero for box proxies)
+  glm::vec3 normal{0.0f};     // unit mean normal of a quad proxy (zero without one)
   float area = 0.0f;          // total triangle area of the subtree
   float box_solid_angle_k = 0.0f;  // π |pmax - pmin|² / 4, the numerator of eq.6
   glm::vec3 radiance{0.0f};   // filtered (area-weighted mean) radiance

@@ -57,29 +57,21 @@ inline bool inside(const Aabb& b, const glm::vec3& p) {
          p.z <= b.hi.z;
 }
 
-// The proxy of node n: its quad (both faces), or its box entry point. Accepts t in
-// (tmin, tmax).
-inline bool intersect_proxy(const RayPrep& r, const LodNode& n, const Aabb& box, float tmax,
-                            float& t_out, float& s_out, float& w_out) {
-  if (n.quad) {
-    const float denom = glm::dot(r.d, n.normal);
-    if (std::fabs(denom) < 1e-12f) return false;
-    const float t = glm::dot(n.origin - r.o, n.normal) / denom;
-    if (!(t > r.tmin && t < tmax)) return false;
-    const glm::vec3 p = r.o + t * r.d - n.origin;
-    const float uu = glm::dot(n.edge_u, n.edge_u), vv = glm::dot(n.edge_v, n.edge_v);
-    const float s = uu > 0.0f ? glm::dot(p, n.edge_u) / uu : 0.0f;
-    const float w = vv > 0.0f ? glm::dot(p, n.edge_v) / vv : 0.0f;
-    if (s < 0.0f || s > 1.0f || w < 0.0f || w > 1.0f) return false;
-    t_out = t;
-    s_out = s;
-    w_out = w;
-    return true;
-  }
-  float tnear;
-  if (!box_hit(r, box, tmax, tnear) || !(tnear > r.tmin) || !(tnear < tmax)) return false;
-  t_out = tnear;
-  s_out = w_out = 0.0f;
+// The quad proxy of node n, both faces; accepts t in (tmin, tmax).
+inline bool intersect_proxy(const RayPrep& r, const LodNode& n, float tmax, float& t_out,
+                            float& s_out, float& w_out) {
+  const float denom = glm::dot(r.d, n.normal);
+  if (std::fabs(denom) < 1e-12f) return false;
+  const float t = glm::dot(n.origin - r.o, n.normal) / denom;
+  if (!(t > r.tmin && t < tmax)) return false;
+  const glm::vec3 p = r.o + t * r.d - n.origin;
+  const float uu = glm::dot(n.edge_u, n.edge_u), vv = glm::dot(n.edge_v, n.edge_v);
+  const float s = uu > 0.0f ? glm::dot(p, n.edge_u) / uu : 0.0f;
+  const float w = vv > 0.0f ? glm::dot(p, n.edge_v) / vv : 0.0f;
+  if (s < 0.0f || s > 1.0f || w < 0.0f || w > 1.0f) return false;
+  t_out = t;
+  s_out = s;
+  w_out = w;
   return true;
 }
 
@@ -111,10 +103,11 @@ LodHit closest_hit_lod(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float 
       if (lod_on && n.count == 0) {
         const LodNode& ln = lod.nodes[i];
         const glm::vec3 to_center = n.box.center() - r.o;
-        if (ln.box_solid_angle_k <= budget * glm::dot(to_center, to_center) && !inside(n.box, r.o)) {
+        if (ln.quad && ln.box_solid_angle_k <= budget * glm::dot(to_center, to_center) &&
+            !inside(n.box, r.o)) {
           ++c.lod_stops;
           float t, s, w;
-          if (intersect_proxy(r, ln, n.box, best.t, t, s, w)) {
+          if (intersect_proxy(r, ln, best.t, t, s, w)) {
             best.t = t;
             best.u = s;
             best.v = w;

@@ -39,8 +39,9 @@ struct LodCounters {
   }
 };
 
-// One ray with solid angle `solid_angle` (Ω_s of eq.5). A box that contains the ray origin
-// is never approximated (eq.6 has no meaning there).
+// One ray with solid angle `solid_angle` (Ω_s of eq.5). Only nodes with a quad proxy stop
+// (a non-planar node has no faithful two-triangle approximation: it always descends), and a
+// box that contains the ray origin is never approximated (eq.6 has no meaning there).
 LodHit closest_hit_lod(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float solid_angle,
                        const LodOptions& options, LodCounters* counters = nullptr);
 
