@@ -8,6 +8,8 @@ namespace speculum::cli {
 
 void add_bench_command(CLI::App& app, GlobalOptions& global) {
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks: trace (BVH vs Embree), ...");
+  bench->footer("Example: speculum bench raster bench:spheres-room --repeat 5\n"
+                "         speculum bench trace --help   (ray files and meshes for the trace benchmark)");
   bench->require_subcommand(1);
   add_bench_trace_subcommand(*bench, global);
   add_bench_raster_subcommand(*bench, global);

@@ -108,6 +108,7 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global) {
   auto* cmd = bench.add_subcommand(
       "raster", "Time visibility + gbuffer on a mesh, scene or yardstick workload "
                 "(bench:spheres-room, bench:random-triangles)");
+  cmd->footer("Example: speculum --threads 2 bench raster bench:spheres-room --width 1920 --height 1080 --repeat 5 --json");
   // Global options (--threads, --lanes) may follow the subcommand: let them fall through
   // `raster` and `bench` to the top-level app.
   cmd->fallthrough();

@@ -328,6 +328,7 @@ void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global) {
       "  speculum bench trace --make-mesh spheres:100 -o spheres.ply\n"
       "  speculum bench trace spheres.ply --emit-rays primary -o primary.spry\n"
       "  speculum --threads 2 bench trace spheres.ply --rays primary.spry --repeat 5 --json");
+  cmd->footer("Example: the three commands above make a mesh, emit primary rays and time them.");
   cmd->add_option("mesh", opt->mesh, "Mesh file (PLY, OBJ, OFF, STL) or built-in scene");
   cmd->add_option("--rays", opt->rays, "SPRY ray file to trace");
   cmd->add_option("--repeat", opt->repeat, "Runs; medians are reported")->check(CLI::Range(1, 1000))->capture_default_str();

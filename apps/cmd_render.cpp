@@ -11,6 +11,7 @@
 #include "apps/cli.h"
 #include "apps/pipeline_camera_options.h"
 #include "apps/pipeline_techniques.h"
+#include "apps/progress.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
 #include "parallel/lanes.h"
@@ -87,7 +88,14 @@ void run_render(const RenderOptions& o, const GlobalOptions& global) {
   technique.add_passes(graph, &scene, f);
   const bool exr = ends_with(o.output, ".exr");
   graph.request(exr ? pipeline::kRadiance : pipeline::kDisplay);
-  const par::RunReport report = graph.run(executor);
+  // Progress per finished node (a node's first captured output), only for long renders.
+  graph.compile();
+  Progress progress("render " + technique.name, graph.order().size(), global.quiet);
+  std::string last_node;
+  const par::RunReport report = graph.run(executor, [&](const par::CapturedOutput& out) {
+    if (out.node != last_node) progress.step(out.node), last_node = out.node;
+  });
+  progress.finish();
   write_image(o.output, graph.get<ImageRGBA>(exr ? pipeline::kRadiance : pipeline::kDisplay));
   if (!global.quiet)
     std::fprintf(stderr, "speculum: %s %s %dx%d spp %d in %.1f ms\n", technique.name.c_str(),
@@ -103,6 +111,9 @@ void run_render(const RenderOptions& o, const GlobalOptions& global) {
 void add_render_command(CLI::App& app, GlobalOptions& global) {
   auto opts = std::make_shared<RenderOptions>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one technique to PNG or EXR");
+  cmd->footer(
+      "Example: speculum render glossy-plane --technique envmap --width 800 --height 600 --spp 4 -o out.png\n"
+      "         speculum render sphere-in-room --technique reference --spp 64 -o ref.exr");
   cmd->fallthrough();  // accept --threads/--lanes after the subcommand too
   cmd->add_option("scene", opts->scene, "glTF/OBJ/PLY file or built-in scene name (default: "
                                         "the default built-in scene)");

@@ -35,8 +35,10 @@ void list_scenes() {
 
 void add_scenes_command(CLI::App& app, GlobalOptions& global) {
   auto* cmd = app.add_subcommand("scenes", "List or export the built-in procedural scenes");
+  cmd->footer("Example: speculum scenes list\n         speculum scenes export glossy-plane plane.glb");
   cmd->require_subcommand(1);
   auto* list = cmd->add_subcommand("list", "List the built-in scenes with descriptions and sizes");
+  list->footer("Example: speculum scenes list");
   list->callback(list_scenes);
 
   auto opts = std::make_shared<ExportOptions>();

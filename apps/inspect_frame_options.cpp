@@ -15,7 +15,7 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
       ->capture_default_str();
   cmd.add_option("--width", o.width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd.add_option("--height", o.height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
-  cmd.add_option("--spp", o.spp, "Samples per pixel (k×k supersampling: 1, 4, 9, 16)")
+  cmd.add_option("--spp", o.spp, "Samples per pixel (a square is k×k supersampling for feed-forward techniques)")
       ->check(CLI::Range(1, 65536))->capture_default_str();
   cmd.add_option("--seed", o.seed, "Random seed")->capture_default_str();
   cmd.add_option("--exposure", o.exposure, "Exposure multiplier before tone mapping")
@@ -34,10 +34,10 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
 }
 
 pipeline::FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
-  const int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
-  if (k * k != o.spp && o.technique != "reference")
-    throw InputError("--spp", "must be a square (1, 4, 9, 16, ...) for k×k supersampling, got " +
-                                  std::to_string(o.spp));
+  // A square spp is k×k supersampling for feed-forward techniques; any other count only
+  // reaches sample-based techniques (reference, yu-lod) through FrameSettings::spp.
+  int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
+  if (k * k != o.spp) k = 1;
   if (double(o.width) * o.height * o.spp > double(1 << 26))
     throw InputError("--width/--height/--spp", "more than 67M samples");
   pipeline::FrameSettings f;

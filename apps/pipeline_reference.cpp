@@ -19,11 +19,13 @@ void add_reference_passes(par::Graph& g, const Scene* scene, const FrameSettings
      c.count("camera_rays", stats.camera_rays);
      c.count("shadow_rays", stats.shadow_rays);
      c.count("specular_rays", stats.specular_rays);
-   }).writes<ImageRGBA>(kRadiance).param("spp", f.spp).param("seed", f.seed);
+   }).writes<ImageRGBA>(kRadiance).param("spp", f.spp).param("seed", f.seed)
+     .describe("Ground truth: ray tracing in the original geometry on the BVH, with camera, shadow and specular/glossy rays and spp jittered samples per pixel (SURVEY §2).");
 
   g.add("tonemap", [f](par::NodeContext& c) {
      c.set_output(kDisplay, raster::tonemap(c.executor(), c.input<ImageRGBA>(kRadiance), f.exposure));
-   }).reads<ImageRGBA>(kRadiance).writes<ImageRGBA>(kDisplay).param("exposure", f.exposure);
+   }).reads<ImageRGBA>(kRadiance).writes<ImageRGBA>(kDisplay).param("exposure", f.exposure)
+     .describe("Exposure, then the ACES filmic curve: the display image a PNG stores (DESIGN.md, Data and formats; the same for every technique).");
 }
 
 }  // namespace speculum::pipeline

@@ -1,0 +1,193 @@
+// `speculum inspect`: manifest.json lists every executed node in execution order with its
+// outputs, every listed file exists, the final image equals `render`'s, and index.html loads
+// every image without console errors in headless Chromium (issue 9 "inspect").
+#include <regex>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/inspect_frame_options.h"
+#include "apps/pipeline_techniques.h"
+#include "core/image.h"
+#include "core/image_metrics.h"
+#include "core/scene_loader.h"
+#include "tests/apps/speculum_run.h"
+
+namespace speculum {
+namespace {
+
+namespace fs = std::filesystem;
+using test::sh_quote;
+using test::run_shell;
+using test::run_speculum;
+
+constexpr const char* kScene = "sphere-in-room";
+constexpr const char* kSmall = "--width 40 --height 30 --cube-size 16 --shadow-size 32";
+
+nlohmann::json read_json(const fs::path& p) { return nlohmann::json::parse(test::slurp(p)); }
+
+// The nodes render_frame runs for `technique` with inspect's defaults and kSmall, in order.
+std::vector<std::string> expected_order(const std::string& technique) {
+  inspect::FrameOptions o;
+  o.technique = technique;
+  o.width = 40, o.height = 30, o.cube_map_size = 16, o.shadow_map_size = 32;
+  const Scene scene = load_scene(kScene);
+  const pipeline::FrameSettings f = inspect::make_frame_settings(o, scene);
+  par::Graph g;
+  pipeline::find_technique(technique).add_passes(g, &scene, f);
+  g.request(pipeline::kRadiance);
+  g.request(pipeline::kDisplay);
+  g.compile();
+  return g.order();
+}
+
+void expect_complete_manifest(const fs::path& dir, const std::string& technique) {
+  const nlohmann::json m = read_json(dir / "manifest.json");
+  EXPECT_EQ(m["technique"], technique);
+  std::vector<std::string> names;
+  for (const auto& n : m["nodes"]) names.push_back(n["name"]);
+  EXPECT_EQ(names, expected_order(technique));
+  std::set<std::string> files;
+  for (const auto& f : m["files"]) files.insert(f.get<std::string>());
+  for (const auto& f : files) EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
+  EXPECT_TRUE(files.count("index.html") && files.count("manifest.json") && files.count("graph.dot"));
+  bool display_drawn = false;
+  for (const auto& n : m["nodes"]) {
+    SCOPED_TRACE(n["name"].get<std::string>());
+    EXPECT_GE(n["time_ms"].get<double>(), 0.0);
+    EXPECT_FALSE(n["outputs"].empty());
+    for (const auto& out : n["outputs"]) {
+      EXPECT_FALSE(out["type"].get<std::string>().empty());
+      if (out["drawable"].get<bool>()) EXPECT_FALSE(out["images"].empty()) << out["resource"];
+      for (const auto& im : out["images"]) {
+        EXPECT_TRUE(files.count(im["png"].get<std::string>())) << im["png"];
+        EXPECT_TRUE(files.count(im["exr"].get<std::string>())) << im["exr"];
+        const ImageRGBA png = read_image((dir / im["png"].get<std::string>()).string());
+        EXPECT_GT(png.width, 0);
+      }
+      display_drawn = display_drawn || (out["resource"] == pipeline::kDisplay && !out["images"].empty());
+    }
+  }
+  EXPECT_TRUE(display_drawn);
+}
+
+TEST(Inspect, ManifestListsEveryExecutedNodeOfEveryTechnique) {
+  const fs::path root = test::scratch_dir();
+  for (const auto& t : pipeline::techniques()) {
+    SCOPED_TRACE(t.name);
+    const fs::path dir = root / t.name;
+    const auto r = run_speculum("-q inspect " + std::string(kScene) + " --technique " + t.name +
+                                    " --spp 1 --no-svg " + kSmall + " -o " + sh_quote(dir.string()),
+                                dir.parent_path());
+    ASSERT_EQ(r.status, 0) << r.err;
+    expect_complete_manifest(dir, t.name);
+  }
+  fs::remove_all(root);
+}
+
+TEST(Inspect, FinalImageEqualsRender) {
+  const fs::path dir = test::scratch_dir();
+  const std::string size = "--width 48 --height 36";
+  auto r = run_speculum("-q inspect " + std::string(kScene) + " --no-svg " + size + " -o " +
+                            sh_quote((dir / "insp").string()),
+                        dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run_speculum("-q render " + std::string(kScene) + " " + size + " -o " +
+                       sh_quote((dir / "render.png").string()),
+                   dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json m = read_json(dir / "insp" / "manifest.json");
+  std::string display_png;
+  for (const auto& n : m["nodes"])
+    for (const auto& out : n["outputs"])
+      if (out["resource"] == pipeline::kDisplay) display_png = out["images"][0]["png"];
+  ASSERT_FALSE(display_png.empty());
+  const ImageError e = image_error(read_image((dir / "insp" / display_png).string()),
+                                   read_image((dir / "render.png").string()));
+  EXPECT_EQ(e.max8, 0.0);
+  fs::remove_all(dir);
+}
+
+TEST(Inspect, BadInputExitsTwo) {
+  const fs::path dir = test::scratch_dir();
+  EXPECT_EQ(run_speculum("inspect no-such-scene -o " + sh_quote((dir / "o").string()), dir).status, 2);
+  EXPECT_EQ(run_speculum("inspect --technique no-such -o " + sh_quote((dir / "o").string()), dir).status, 2);
+  EXPECT_EQ(run_speculum("inspect --param nonsense -o " + sh_quote((dir / "o").string()), dir).status, 2);
+  fs::remove_all(dir);
+}
+
+// What the page's own script wrote into #inspect-status after the load event.
+struct PageStatus {
+  std::string state, failed;
+  int images = -1, loaded = -1;
+  std::string console;  // Chromium's CONSOLE log lines (any is an error: the page logs nothing)
+};
+
+std::string attribute(const std::string& tag, const std::string& name) {
+  std::smatch m;
+  if (std::regex_search(tag, m, std::regex(" " + name + "=\"([^\"]*)\""))) return m[1];
+  return "";
+}
+
+PageStatus open_in_chromium(const fs::path& page, const fs::path& work) {
+  const fs::path profile = work / ("chromium-profile-" + std::to_string(std::rand()));
+  const std::string cmd =
+      "timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking "
+      "--disable-component-update --disable-sync --no-first-run --no-default-browser-check "
+      "--user-data-dir=" + sh_quote(profile.string()) +
+      " --enable-logging=stderr --v=0 --dump-dom " + sh_quote("file://" + fs::absolute(page).string());
+  const auto r = run_shell(cmd, work);
+  fs::remove_all(profile);
+  PageStatus s;
+  std::smatch m;
+  if (std::regex_search(r.out, m, std::regex("<p id=\"inspect-status\"[^>]*>"))) {
+    const std::string tag = m[0];
+    s.state = attribute(tag, "data-state");
+    s.failed = attribute(tag, "data-failed");
+    const std::string images = attribute(tag, "data-images"), loaded = attribute(tag, "data-loaded");
+    if (!images.empty()) s.images = std::stoi(images);
+    if (!loaded.empty()) s.loaded = std::stoi(loaded);
+  }
+  std::istringstream err(r.err);
+  for (std::string line; std::getline(err, line);)
+    if (line.find(":CONSOLE") != std::string::npos) s.console += line + "\n";
+  return s;
+}
+
+TEST(Inspect, EveryImageLoadsInHeadlessChromium) {
+  if (run_shell("command -v chromium", fs::temp_directory_path()).status != 0)
+    GTEST_SKIP() << "chromium is not installed (Debian package `chromium`; .ci/setup.sh installs it)";
+  const fs::path dir = test::scratch_dir();
+  const fs::path out = dir / "insp";
+  const auto r = run_speculum("-q inspect " + std::string(kScene) + " " + kSmall + " -o " +
+                                  sh_quote(out.string()),
+                              dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json m = read_json(out / "manifest.json");
+  int pictures = m["graph"]["svg"].get<std::string>().empty() ? 0 : 1;
+  std::string first_png;
+  for (const auto& n : m["nodes"])
+    for (const auto& o : n["outputs"])
+      for (const auto& im : o["images"]) {
+        ++pictures;
+        if (first_png.empty()) first_png = im["png"];
+      }
+  ASSERT_GT(pictures, 10);
+
+  const PageStatus good = open_in_chromium(out / "index.html", dir);
+  EXPECT_EQ(good.state, "ok") << "failed: " << good.failed;
+  EXPECT_EQ(good.images, pictures);
+  EXPECT_EQ(good.loaded, pictures);
+  EXPECT_EQ(good.console, "");
+
+  // The check must notice a missing picture.
+  fs::remove(out / first_png);
+  const PageStatus broken = open_in_chromium(out / "index.html", dir);
+  EXPECT_EQ(broken.state, "error");
+  EXPECT_EQ(broken.loaded, pictures - 1);
+  EXPECT_NE(broken.failed.find(first_png), std::string::npos) << broken.failed;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace speculum
