@@ -8,6 +8,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
   auto* cmd = app.add_subcommand(
       "experiment", "Reproduce a paper's measurements: sweeps that print a table (or --json rows)");
   cmd->require_subcommand(1);
+  cmd->footer("Example: speculum experiment NAME --help   (NAME: one of the subcommands above)");
   cmd->fallthrough();
   // One line per experiment (apps/cmd_experiment_*.cpp):
   add_experiment_ray_hierarchy_subcommand(*cmd, global);
