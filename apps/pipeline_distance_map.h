@@ -24,7 +24,9 @@ void add_distance_map_passes(par::Graph& graph, const Scene* scene, const FrameS
 // --technique multi-reflection (SURVEY §4.3).
 void add_multi_reflection_passes(par::Graph& graph, const Scene* scene,
                                  const FrameSettings& settings);
-// --technique layered-distance-map (SURVEY §4.5).
+// --technique layered-distance-map (SURVEY §4.5); describe_layered: its steps column
+// ("layers=3 linear=16 secant=4 bounces=2").
+std::string describe_layered(const FrameSettings& settings);
 void add_layered_distance_map_passes(par::Graph& graph, const Scene* scene,
                                      const FrameSettings& settings);
 
