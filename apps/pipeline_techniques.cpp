@@ -29,6 +29,11 @@ const std::vector<Technique>& techniques() {
        "bounce each; --param rounds=3, lagged=0/1 (one round per frame from the previous "
        "frame's maps), plus the distance-map search params",
        add_multi_reflection_passes},
+      {"layered-distance-map",
+       "layered distance maps (SURVEY §4.5): the scene depth-peeled into cube layers, "
+       "recursive linear+secant tracer; --param layers=3, layer_size=128, linear_steps=16, "
+       "secant_steps=4, bounces=2",
+       add_layered_distance_map_passes},
       {"planar-mirror",
        "planar mirrors by geometry transformation (SURVEY §5): the camera reflected about "
        "each mirror plane, scene clipped at the plane, recursive to --param depth=3; other "
