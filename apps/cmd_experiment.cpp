@@ -11,6 +11,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
   cmd->footer("Example: speculum experiment NAME --help   (NAME: one of the subcommands above)");
   cmd->fallthrough();
   // One line per experiment (apps/cmd_experiment_*.cpp):
+  add_experiment_survey_subcommand(*cmd, global);
   add_experiment_ray_hierarchy_subcommand(*cmd, global);
   add_experiment_yu_fig9_subcommand(*cmd, global);
   (void)global;
