@@ -95,33 +95,6 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, GBuffer& g) {
   g.reflector.pixels[i] = is_specular(sp) ? object : kNoId;
 }
 
-// The visible triangles of neighbouring samples are scattered through the mesh (random for
-// small triangles), so the resolve is bound by the latency of gathering their vertices.
-// Two-stage software prefetch: the index triple of the triangle kFar samples ahead, then the
-// vertex attributes of the triangle kNear samples ahead (its indices are cached by then).
-inline void prefetch_sample(const SampleContext& c, std::size_t i, std::size_t end) {
-  constexpr std::size_t kFar = 16, kNear = 8;
-  const TriangleMesh& m = c.m;
-  if (i + kFar < end) {
-    const std::uint32_t t = c.vis.triangle.pixels[i + kFar];
-    if (t != kNoId) {
-      __builtin_prefetch(&m.indices[3 * t]);
-      __builtin_prefetch(&m.triangle_material[t]);
-    }
-  }
-  if (i + kNear < end) {
-    const std::uint32_t t = c.vis.triangle.pixels[i + kNear];
-    if (t != kNoId) {
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t v = m.indices[3 * t + k];
-        __builtin_prefetch(&m.positions[v]);
-        __builtin_prefetch(&m.normals[v]);
-        if (!m.uvs.empty()) __builtin_prefetch(&m.uvs[v]);
-      }
-    }
-  }
-}
-
 }  // namespace
 
 GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
@@ -156,10 +129,7 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visibili
   const SampleContext ctx{scene, m, vis, eye, constant_params, textured, normal_mapped};
   executor.parallel_for("gbuffer.resolve", vis.triangle.size(), kPixelChunk,
                         [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      prefetch_sample(ctx, i, end);
-      resolve_sample(ctx, i, g);
-    }
+    for (std::size_t i = begin; i < end; ++i) resolve_sample(ctx, i, g);
   });
 }
 

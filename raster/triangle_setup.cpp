@@ -141,13 +141,14 @@ void clip_and_emit(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenV
 
 }  // namespace
 
-ScreenVertex make_screen_vertex(const glm::vec4& clip, const Viewport& vp) {
+namespace {
+
+inline ScreenVertex screen_vertex(const glm::vec4& clip, const Viewport& vp, const GuardBand& g) {
   ScreenVertex v;
   v.clip = clip;
   const float w = clip.w;
   v.outcode = (clip.x < -w ? 1u : 0u) | (clip.x > w ? 2u : 0u) | (clip.y < -w ? 4u : 0u) |
               (clip.y > w ? 8u : 0u) | (clip.z < -w ? 16u : 0u) | (clip.z > w ? 32u : 0u);
-  const GuardBand g = guard_band(vp);
   bool inside = w > 0.0f;
   for (int plane = 0; plane < kClipPlanes && inside; ++plane)
     inside = plane_distance(plane, clip, g) >= 0.0f;
@@ -157,6 +158,19 @@ ScreenVertex make_screen_vertex(const glm::vec4& clip, const Viewport& vp) {
   }
   if (!project_and_snap(clip, vp, v.x, v.y, v.inv_w)) v.outcode |= kNeedsClip;
   return v;
+}
+
+}  // namespace
+
+ScreenVertex make_screen_vertex(const glm::vec4& clip, const Viewport& vp) {
+  return screen_vertex(clip, vp, guard_band(vp));
+}
+
+void make_screen_vertices(const glm::mat4& view_projection, const glm::vec3* positions,
+                          std::size_t count, const Viewport& vp, ScreenVertex* out) {
+  const GuardBand g = guard_band(vp);
+  for (std::size_t i = 0; i < count; ++i)
+    out[i] = screen_vertex(view_projection * glm::vec4(positions[i], 1.0f), vp, g);
 }
 
 void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenVertex& v2,

@@ -2,6 +2,7 @@
 // clipping, fixed-point snapping (8 sub-pixel bits) and orientation (issue 4 "Rasterizer").
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -51,6 +52,11 @@ struct Viewport {
 
 // Transforms and snaps one vertex (a pure function, so shared vertices snap identically).
 ScreenVertex make_screen_vertex(const glm::vec4& clip, const Viewport& viewport);
+
+// The vertex stage over a range: out[i] = make_screen_vertex(view_projection · (positions[i], 1))
+// with the same bits, the viewport constants computed once per call.
+void make_screen_vertices(const glm::mat4& view_projection, const glm::vec3* positions,
+                          std::size_t count, const Viewport& viewport, ScreenVertex* out);
 
 // Sets up triangle `triangle` from its three screen vertices and appends 0..7 triangles to
 // `out` (more than one only when it was clipped; those also append a ClipMap).

@@ -111,9 +111,8 @@ void render_visibility(par::Executor& executor, const Scene& scene, const Camera
   vertices.resize(mesh.vertex_count());
   executor.parallel_for("raster.vertices", vertices.size(), kVertexChunk,
                         [&](std::size_t begin, std::size_t end) {
-                          for (std::size_t i = begin; i < end; ++i)
-                            vertices[i] = make_screen_vertex(
-                                view_projection * glm::vec4(mesh.positions[i], 1.0f), vp);
+                          make_screen_vertices(view_projection, &mesh.positions[begin],
+                                               end - begin, vp, &vertices[begin]);
                         });
   rasterize_screen_vertices(executor, vertices, mesh.indices, mesh.triangle_object, width, height,
                             options, workspace.chunks, out);
