@@ -19,14 +19,19 @@ std::vector<std::uint32_t> count_ids_per_chunk(Executor& ex, std::string_view na
   std::vector<std::uint32_t> counts(chunks * bins, 0);
   std::vector<std::uint8_t> bad(chunks, 0);  // one flag per chunk: no shared writes
   ex.parallel_for(launch_name(name, phase), n, chunk, [&](std::size_t b, std::size_t e) {
-    std::uint32_t* count = counts.data() + (b / chunk) * bins;
+    // Locals, and no branch per element: an out-of-range id is counted in slot 0 (the call
+    // throws anyway) and flagged, so the loop is a plain increment stream.
+    std::uint32_t* const count = counts.data() + (b / chunk) * bins;
+    const std::uint32_t* const id = ids.data();
+    const std::size_t limit = bins;
+    std::uint32_t out_of_range = 0;
     for (std::size_t i = b; i < e; ++i) {
-      if (ids[i] >= bins) {
-        bad[b / chunk] = 1;
-        return;
-      }
-      ++count[ids[i]];
+      const std::uint32_t v = id[i];
+      const bool bad_id = v >= limit;
+      out_of_range |= bad_id;
+      ++count[bad_id ? 0 : v];
     }
+    bad[b / chunk] = std::uint8_t(out_of_range);
   });
   if (std::find(bad.begin(), bad.end(), 1) != bad.end())
     throw std::invalid_argument(std::string(what) + ": a " + std::string(id_kind) +

@@ -27,8 +27,11 @@ void partition_stable(Executor& ex, std::string_view name, std::span<const std::
   }
   bucket_begin[p] = std::uint32_t(running);
   ex.parallel_for(launch_name(name, "bucket_scatter"), n, chunk, [&](std::size_t b, std::size_t e) {
-    std::uint32_t* offset = counts.data() + (b / chunk) * p;
-    for (std::size_t i = b; i < e; ++i) out[offset[bucket[i]]++] = std::uint32_t(i);
+    // Locals: through the spans every store to out could alias offset and force reloads.
+    std::uint32_t* const offset = counts.data() + (b / chunk) * p;
+    const std::uint32_t* const id = bucket.data();
+    std::uint32_t* const dst = out.data();
+    for (std::size_t i = b; i < e; ++i) dst[offset[id[i]]++] = std::uint32_t(i);
   });
 }
 

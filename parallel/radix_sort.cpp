@@ -319,50 +319,58 @@ void sort_bucket(E* src, std::size_t m, unsigned lo_bit, unsigned bits, std::uin
   if (n_active == 0) return unpack_all(src);
   if (tb.tmp.size() < m) tb.tmp.resize(m);
   E* const tmp = tb.tmp.data();
-  const E* cur = src;
+  // Every pass scatters packed words within cache; the output arrays are then written in
+  // order (scattering straight into them would miss on a line of each per store).
+  E* cur = src;
   for (unsigned a = 0; a < n_active; ++a) {
-    const unsigned p = active[a];
-    const unsigned shift = lo_bit + p * digit_bits;
-    std::uint32_t* const offset = count + p * radix;
-    if (a + 1 < n_active) {
-      E* const dst = cur == src ? tmp : src;
-      for (std::size_t i = 0; i < m; ++i) {
-        const E x = cur[i];
-        dst[offset[(Packed<E>::key(x) >> shift) & mask]++] = x;
-      }
-      cur = dst;
-    } else {
-      for (std::size_t i = 0; i < m; ++i) {
-        const E x = cur[i];
-        Packed<E>::unpack(x, keys, payload, offset[(Packed<E>::key(x) >> shift) & mask]++);
-      }
+    const unsigned shift = lo_bit + active[a] * digit_bits;
+    std::uint32_t* const offset = count + active[a] * radix;
+    E* const dst = cur == src ? tmp : src;
+    for (std::size_t i = 0; i < m; ++i) {
+      const E x = cur[i];
+      dst[offset[(Packed<E>::key(x) >> shift) & mask]++] = x;
     }
+    cur = dst;
   }
+  unpack_all(cur);
 }
 
+// Top digit [shift, shift + top_bits) of the 32-bit path: buckets of ~8-16K elements on
+// average (sorted in L2), and no more than 22 bits left for them (two in-cache passes of
+// <= 11 bits): bits [22, 32) for 16M arbitrary 32-bit keys.
+struct TopDigit {
+  unsigned shift, bits;
+};
+TopDigit top_digit(std::size_t n, unsigned lo_bit, unsigned bits) {
+  const unsigned cache_top = std::clamp(unsigned(std::bit_width(n)), 16u, 26u) - 15;
+  const unsigned top = std::min({bits, kMaxDigitBits, std::max(cache_top, bits > 22 ? bits - 22 : 0u)});
+  return {lo_bit + bits - top, top};
+}
+
+// s.counts already holds the per-chunk counts of the top digit when `counted`.
 template <class E>
 void msd_sort32(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>& s,
-                std::size_t chunk, unsigned lo_bit, unsigned bits) {
+                std::size_t chunk, unsigned lo_bit, unsigned bits, bool counted) {
   const std::size_t n = keys.size();
-  // Top digit: buckets of ~8-16K elements on average (sorted in L2), and no more than 22
-  // bits left for them (two in-cache passes of <= 11 bits): 10 bits for 16M 32-bit keys.
-  const unsigned cache_top = std::clamp(unsigned(std::bit_width(n)), 16u, 26u) - 15;
-  const unsigned top_bits = std::min({bits, kMaxDigitBits, std::max(cache_top, bits > 22 ? bits - 22 : 0u)});
+  const TopDigit top = top_digit(n, lo_bit, bits);
+  const unsigned top_bits = top.bits;
   const unsigned local_bits = bits - top_bits;
-  const unsigned shift = lo_bit + local_bits;
+  const unsigned shift = top.shift;
   const std::size_t buckets = std::size_t(1) << top_bits;
   const std::uint32_t mask = std::uint32_t(buckets - 1);
   const std::size_t chunks = Executor::chunk_count(n, chunk);
   s.counts.resize(chunks * buckets);
-  ex.parallel_for(launch_name(name, "top_counts"), n, chunk, [&](std::size_t b, std::size_t e) {
-    std::uint32_t* const count = s.counts.data() + (b / chunk) * buckets;
-    const std::uint32_t* const in = keys.data();
-    const unsigned sh = shift;
-    const std::uint32_t m = mask;
-    std::fill(count, count + buckets, 0u);
-    for (std::size_t i = b; i < e; ++i) ++count[(in[i] >> sh) & m];
-  });
+  if (!counted) {
+    ex.parallel_for(launch_name(name, "top_counts"), n, chunk, [&](std::size_t b, std::size_t e) {
+      std::uint32_t* const count = s.counts.data() + (b / chunk) * buckets;
+      const std::uint32_t* const in = keys.data();
+      const unsigned sh = shift;
+      const std::uint32_t m = mask;
+      std::fill(count, count + buckets, 0u);
+      for (std::size_t i = b; i < e; ++i) ++count[(in[i] >> sh) & m];
+    });
+  }
   const auto totals = chunk_offsets(s.counts, chunks, buckets);
   if (local_bits > 0 && *std::max_element(totals.begin(), totals.end()) > kMaxLocalBucket)
     return lsd_sort(ex, name, keys, payload, s, chunk, lo_bit, bits);
@@ -400,19 +408,47 @@ void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
     throw std::invalid_argument("radix_sort: payload size differs from key count");
   if (n <= 1) return;
   if (chunk == 0) chunk = 1;
-  // Only the bits that differ between keys need sorting: [lowest, highest] varying bit.
-  const Key varying = varying_bits<Key>(ex, name, keys, chunk);
-  if (varying == 0) return;  // all keys equal: a stable sort leaves everything in place
-  const unsigned lo_bit = unsigned(std::countr_zero(varying));
-  const unsigned bits = unsigned(std::bit_width(varying)) - lo_bit;
   RadixSortScratch<Key> own;
   RadixSortScratch<Key>& s = scratch ? *scratch : own;
   if constexpr (sizeof(Key) == 4) {
+    // One read finds the varying bits and counts the top digit that arbitrary keys of this
+    // n get (bits [22, 32) for 16M); the count is redone only if the keys pick another.
+    const TopDigit guess = top_digit(n, 0, 32);
+    const std::size_t buckets = std::size_t(1) << guess.bits;
+    const std::size_t chunks = Executor::chunk_count(n, chunk);
+    s.counts.resize(chunks * buckets);
+    const Key first = keys[0];
+    const Key varying = ex.parallel_reduce(
+        launch_name(name, "varying_bits_top_counts"), n, chunk, Key{0},
+        [&](std::size_t b, std::size_t e) {
+          std::uint32_t* const count = s.counts.data() + (b / chunk) * buckets;
+          const std::uint32_t* const in = keys.data();
+          const unsigned sh = guess.shift;
+          const std::uint32_t m = std::uint32_t(buckets - 1);
+          std::fill(count, count + buckets, 0u);
+          Key v = 0;
+          for (std::size_t i = b; i < e; ++i) {
+            v |= in[i] ^ first;
+            ++count[(in[i] >> sh) & m];
+          }
+          return v;
+        },
+        [](Key a, Key b) { return Key(a | b); });
+    if (varying == 0) return;  // all keys equal: a stable sort leaves everything in place
+    const unsigned lo_bit = unsigned(std::countr_zero(varying));
+    const unsigned bits = unsigned(std::bit_width(varying)) - lo_bit;
+    const TopDigit top = top_digit(n, lo_bit, bits);
+    const bool counted = top.shift == guess.shift && top.bits == guess.bits;
     if (with_payload)
-      msd_sort32<std::uint64_t>(ex, name, keys, payload, s, chunk, lo_bit, bits);
+      msd_sort32<std::uint64_t>(ex, name, keys, payload, s, chunk, lo_bit, bits, counted);
     else
-      msd_sort32<std::uint32_t>(ex, name, keys, payload, s, chunk, lo_bit, bits);
+      msd_sort32<std::uint32_t>(ex, name, keys, payload, s, chunk, lo_bit, bits, counted);
   } else {
+    // Only the bits that differ between keys need sorting: [lowest, highest] varying bit.
+    const Key varying = varying_bits<Key>(ex, name, keys, chunk);
+    if (varying == 0) return;  // all keys equal: a stable sort leaves everything in place
+    const unsigned lo_bit = unsigned(std::countr_zero(varying));
+    const unsigned bits = unsigned(std::bit_width(varying)) - lo_bit;
     lsd_sort(ex, name, keys, payload, s, chunk, lo_bit, bits);
   }
 }
