@@ -4,13 +4,14 @@
 // independently in a fixed task order and spliced depth-first, so node indices never
 // depend on the schedule. Primitive references carry their boxes, so every pass streams
 // memory contiguously. See bvh.h.
+#include <immintrin.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 
 #include "core/error.h"
-#include "parallel/lanes.h"
 #include "trace/bvh.h"
 
 namespace speculum::trace {
@@ -23,7 +24,6 @@ float Aabb::half_area() const {
 
 namespace {
 
-namespace stdx = std::experimental;
 constexpr int kMaxBins = 32;
 constexpr std::size_t kParallelRange = 1u << 15;  // ranges above this are split at top level
 constexpr std::size_t kBinChunk = 1u << 14;
@@ -46,16 +46,17 @@ struct TempNode {
   std::int64_t left_task = -1, right_task = -1;  // or the root of a subtree task's list
 };
 
-// A bin's box as lanes (x, y, z, unused) so growing it is two vector min/max.
-using L4 = par::Lanes<4>;
+// A bin's box as SSE lanes (x, y, z, unused) so growing it is two vector min/max. SSE
+// intrinsics (the build targets x86-64-v3) rather than Lanes<4>: fixed_size simd emitted
+// out-of-line min/max calls in these loops (perf). Values are never NaN in lanes 0-2.
 struct Bin {
-  L4::f32 lo = L4::f32(3.0e38f);
-  L4::f32 hi = L4::f32(-3.0e38f);
+  __m128 lo = _mm_set1_ps(3.0e38f);
+  __m128 hi = _mm_set1_ps(-3.0e38f);
   std::uint32_t count = 0;
   Aabb box() const {
     float l[4], h[4];
-    L4::store(lo, l);
-    L4::store(hi, h);
+    _mm_storeu_ps(l, lo);
+    _mm_storeu_ps(h, hi);
     Aabb b;
     if (count) b = {glm::vec3(l[0], l[1], l[2]), glm::vec3(h[0], h[1], h[2])};
     return b;
@@ -83,21 +84,22 @@ struct Binner {
 void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
   // Lane 3 of a ref's lo/hi holds the id/pad bits: it is zeroed before the bin index is
   // formed, and ignored in the bin boxes. Lanes 0-2 do exactly Binner::bin's operations.
-  // Hardware min/max (stdx) instead of the select-based Lanes ones: the values are never
-  // NaN in lanes 0-2, where both agree.
-  const L4::f32 blo([&](int a) { return a < 3 ? b.lo[a] : 0.0f; });
-  const L4::f32 scale([&](int a) { return a < 3 ? b.scale[a] : 0.0f; });
-  const auto xyz = L4::to_float(L4::iota(0)) < L4::f32(3.0f);
-  const L4::i32 top(b.bins - 1), bottom(0);
+  const __m128 blo = _mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, 0.0f);
+  const __m128 scale = _mm_setr_ps(b.scale.x, b.scale.y, b.scale.z, 0.0f);
+  const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+  const __m128i top = _mm_set1_epi32(b.bins - 1), bottom = _mm_setzero_si128();
   for (std::size_t i = 0; i < n; ++i) {
-    const L4::f32 lo = L4::load(&refs[i].lo.x);
-    const L4::f32 hi = L4::load(&refs[i].hi.x);
-    const L4::f32 c = L4::select(xyz, lo + hi, L4::f32(0.0f));
-    const L4::i32 idx = stdx::min(stdx::max(L4::to_int((c - blo) * scale), bottom), top);
+    const __m128 lo = _mm_loadu_ps(&refs[i].lo.x);
+    const __m128 hi = _mm_loadu_ps(&refs[i].hi.x);
+    const __m128 c = _mm_and_ps(xyz, _mm_add_ps(lo, hi));
+    // Truncation toward zero, as static_cast<int> in Binner::bin.
+    const __m128i idx = _mm_min_epi32(_mm_max_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, blo), scale)), bottom), top);
+    alignas(16) std::int32_t k[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(k), idx);
     for (int a = 0; a < 3; ++a) {
-      Bin& bin = out[a][idx[a]];
-      bin.lo = stdx::min(bin.lo, lo);
-      bin.hi = stdx::max(bin.hi, hi);
+      Bin& bin = out[a][k[a]];
+      bin.lo = _mm_min_ps(bin.lo, lo);
+      bin.hi = _mm_max_ps(bin.hi, hi);
       ++bin.count;
     }
   }
@@ -109,9 +111,9 @@ struct Split {
   float cost = 3.0e38f;
 };
 
-inline float half_area_of(const L4::f32& lo, const L4::f32& hi) {
+inline float half_area_of(__m128 lo, __m128 hi) {
   float e[4];
-  L4::store(hi - lo, e);
+  _mm_storeu_ps(e, _mm_sub_ps(hi, lo));
   return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
 }
 
@@ -121,26 +123,26 @@ Split best_split(const Bins& bins, const Aabb& cbox, std::size_t n, const BvhBui
   for (int a = 0; a < 3; ++a) {
     if (!(cbox.hi[a] - cbox.lo[a] > 0.0f)) continue;
     float right_cost[kMaxBins];
-    L4::f32 lo(3.0e38f), hi(-3.0e38f);
+    __m128 lo = _mm_set1_ps(3.0e38f), hi = _mm_set1_ps(-3.0e38f);
     std::uint32_t cnt = 0;
     float area = 0.0f;
     for (int i = nb - 1; i > 0; --i) {
       if (bins[a][i].count) {  // an empty bin changes neither the box nor the count
-        lo = stdx::min(lo, bins[a][i].lo);
-        hi = stdx::max(hi, bins[a][i].hi);
+        lo = _mm_min_ps(lo, bins[a][i].lo);
+        hi = _mm_max_ps(hi, bins[a][i].hi);
         cnt += bins[a][i].count;
         area = half_area_of(lo, hi);
       }
       right_cost[i] = area * static_cast<float>(cnt);
     }
-    lo = L4::f32(3.0e38f);
-    hi = L4::f32(-3.0e38f);
+    lo = _mm_set1_ps(3.0e38f);
+    hi = _mm_set1_ps(-3.0e38f);
     cnt = 0;
     area = 0.0f;
     for (int i = 0; i < nb - 1; ++i) {
       if (bins[a][i].count) {
-        lo = stdx::min(lo, bins[a][i].lo);
-        hi = stdx::max(hi, bins[a][i].hi);
+        lo = _mm_min_ps(lo, bins[a][i].lo);
+        hi = _mm_max_ps(hi, bins[a][i].hi);
         cnt += bins[a][i].count;
         area = half_area_of(lo, hi);
       }
@@ -156,19 +158,19 @@ Split best_split(const Bins& bins, const Aabb& cbox, std::size_t n, const BvhBui
 // returns the two child ranges with their bounds, computed in the same pass.
 // Box and centroid bounds accumulated in lanes (lane 3 ignored).
 struct LaneBounds {
-  L4::f32 lo = L4::f32(3.0e38f), hi = L4::f32(-3.0e38f);
-  L4::f32 clo = L4::f32(3.0e38f), chi = L4::f32(-3.0e38f);
+  __m128 lo = _mm_set1_ps(3.0e38f), hi = _mm_set1_ps(-3.0e38f);
+  __m128 clo = _mm_set1_ps(3.0e38f), chi = _mm_set1_ps(-3.0e38f);
   void grow(const PrimRef& r) {
-    const L4::f32 l = L4::load(&r.lo.x), h = L4::load(&r.hi.x);
-    const L4::f32 c = l + h;
-    lo = stdx::min(lo, l);
-    hi = stdx::max(hi, h);
-    clo = stdx::min(clo, c);
-    chi = stdx::max(chi, c);
+    const __m128 l = _mm_loadu_ps(&r.lo.x), h = _mm_loadu_ps(&r.hi.x);
+    const __m128 c = _mm_add_ps(l, h);
+    lo = _mm_min_ps(lo, l);
+    hi = _mm_max_ps(hi, h);
+    clo = _mm_min_ps(clo, c);
+    chi = _mm_max_ps(chi, c);
   }
   void to(Range& r) const {
     float a[4], b[4], c[4], d[4];
-    L4::store(lo, a); L4::store(hi, b); L4::store(clo, c); L4::store(chi, d);
+    _mm_storeu_ps(a, lo); _mm_storeu_ps(b, hi); _mm_storeu_ps(c, clo); _mm_storeu_ps(d, chi);
     if (r.end > r.begin) {
       r.box = {glm::vec3(a[0], a[1], a[2]), glm::vec3(b[0], b[1], b[2])};
       r.cbox = {glm::vec3(c[0], c[1], c[2]), glm::vec3(d[0], d[1], d[2])};
@@ -354,8 +356,8 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
       for (std::size_t c = 0; c < chunks; ++c)
         for (int a = 0; a < 3; ++a)
           for (int i = 0; i < opt.bins; ++i) {
-            bins[a][i].lo = L4::min(bins[a][i].lo, part[c][a][i].lo);
-            bins[a][i].hi = L4::max(bins[a][i].hi, part[c][a][i].hi);
+            bins[a][i].lo = _mm_min_ps(part[c][a][i].lo, bins[a][i].lo);
+            bins[a][i].hi = _mm_max_ps(part[c][a][i].hi, bins[a][i].hi);
             bins[a][i].count += part[c][a][i].count;
           }
       top[it.node].box = it.range.box;

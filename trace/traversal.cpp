@@ -21,22 +21,12 @@ struct RayPrep {
   glm::vec3 o, d, inv;
   float tmin, tmax;
   RayShear shear;
-  explicit RayPrep(const Ray& r) : o(r.origin), d(r.direction), tmin(r.tmin), tmax(r.tmax), shear(r.origin, r.direction) {
-    // A zero direction component becomes a huge reciprocal instead of inf, so (lo-o)*inv
-    // is never 0*inf = NaN; the slab then spans everything or nothing, as it should.
-    for (int a = 0; a < 3; ++a) {
-      const float c = std::fabs(d[a]) < 1e-30f ? std::copysign(1e-30f, d[a]) : d[a];
-      inv[a] = 1.0f / c;
-    }
-  }
+  explicit RayPrep(const Ray& r)
+      : o(r.origin), d(r.direction), inv(wide::safe_inverse(r.direction)), tmin(r.tmin), tmax(r.tmax),
+        shear(r.origin, r.direction) {}
 };
 
-inline bool valid_ray(const Ray& r) {
-  const glm::vec3& d = r.direction;
-  return (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f) && std::isfinite(d.x) && std::isfinite(d.y) &&
-         std::isfinite(d.z) && std::isfinite(r.origin.x) && std::isfinite(r.origin.y) &&
-         std::isfinite(r.origin.z) && !(r.tmin > r.tmax);
-}
+using wide::valid_ray;
 
 inline bool box_hit(const RayPrep& r, const Aabb& b, float tmax, float& tnear) {
   float t0 = r.tmin, t1 = tmax;
@@ -124,7 +114,7 @@ Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit, T
   best.t = ray.tmax;
   if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
     const RayPrep r(ray);
-    const wide::BoxRay br(r.o, r.inv, r.tmin);
+    const wide::BoxRay br(r.o, r.d, r.inv, r.tmin);
     const wide::PackRay pr(r.shear);
     const WideNode* nodes = bvh.wide_nodes().data();
     const TrianglePack* packs = bvh.triangle_packs().data();
@@ -197,7 +187,7 @@ bool any_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
   bool found = false;
   if (valid_ray(ray) && bvh.wide_root() != kEmptyChild) {
     const RayPrep r(ray);
-    const wide::BoxRay br(r.o, r.inv, r.tmin);
+    const wide::BoxRay br(r.o, r.d, r.inv, r.tmin);
     const wide::PackRay pr(r.shear);
     const auto& nodes = bvh.wide_nodes();
     const TrianglePack* packs = bvh.triangle_packs().data();

@@ -8,9 +8,11 @@
 
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
+#include "core/camera_rays.h"
 #include "trace/bvh.h"
 #include "trace/ray_triangle.h"
 
@@ -18,14 +20,50 @@ namespace speculum::trace::wide {
 
 constexpr float kWiden = 8.0f * 5.96e-8f;  // relative margin (> 2 gamma(3)) on entry and exit
 
+// A ray every traversal accepts: non-zero finite direction, finite origin, tmin <= tmax.
+inline bool valid_ray(const Ray& r) {
+  const glm::vec3& d = r.direction;
+  return (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f) && std::isfinite(d.x) && std::isfinite(d.y) &&
+         std::isfinite(d.z) && std::isfinite(r.origin.x) && std::isfinite(r.origin.y) &&
+         std::isfinite(r.origin.z) && !(r.tmin > r.tmax);
+}
+
+// 1/d per component; a zero component becomes a huge reciprocal instead of inf, so
+// (lo-o)*inv is never 0*inf = NaN: the slab then spans everything or nothing.
+inline glm::vec3 safe_inverse(const glm::vec3& d) {
+  glm::vec3 inv;
+  for (int a = 0; a < 3; ++a) {
+    const float c = std::fabs(d[a]) < 1e-30f ? std::copysign(1e-30f, d[a]) : d[a];
+    inv[a] = 1.0f / c;
+  }
+  return inv;
+}
+
+// True when some direction component is so small that safe_inverse clamps it.
+inline bool has_clamped_axis(const glm::vec3& d) {
+  return std::fabs(d.x) < 1e-30f || std::fabs(d.y) < 1e-30f || std::fabs(d.z) < 1e-30f;
+}
+
 // A ray prepared for the box kernel: broadcast origin and reciprocal direction, and the
 // byte offsets of the near/far planes in a WideNode picked by the direction's signs.
+// On an axis the ray does not move along (clamped reciprocal), an origin exactly on a box
+// plane would give (plane - o) * inv = 0 and cull the box; there the near and far planes
+// see the origin moved outward by a relative 2^-20 (at least 2^-60), so the slab spans
+// everything (or nothing) as it should. Other axes use the origin unchanged.
 struct BoxRay {
-  __m256 ox, oy, oz, ix, iy, iz, tmin;
+  __m256 onx, ony, onz, ofx, ofy, ofz, ix, iy, iz, tmin;
   std::uint32_t near_x, near_y, near_z, far_x, far_y, far_z;
 
-  BoxRay(const glm::vec3& o, const glm::vec3& inv, float t0) {
-    ox = _mm256_set1_ps(o.x); oy = _mm256_set1_ps(o.y); oz = _mm256_set1_ps(o.z);
+  BoxRay(const glm::vec3& o, const glm::vec3& d, const glm::vec3& inv, float t0) {
+    glm::vec3 on = o, of = o;
+    for (int a = 0; a < 3; ++a) {
+      if (!(std::fabs(d[a]) < 1e-30f)) continue;
+      const float delta = std::copysign(std::max(std::fabs(o[a]) * 0x1p-20f, 0x1p-60f), inv[a]);
+      on[a] = o[a] + delta;
+      of[a] = o[a] - delta;
+    }
+    onx = _mm256_set1_ps(on.x); ony = _mm256_set1_ps(on.y); onz = _mm256_set1_ps(on.z);
+    ofx = _mm256_set1_ps(of.x); ofy = _mm256_set1_ps(of.y); ofz = _mm256_set1_ps(of.z);
     ix = _mm256_set1_ps(inv.x); iy = _mm256_set1_ps(inv.y); iz = _mm256_set1_ps(inv.z);
     tmin = _mm256_set1_ps(t0);
     constexpr std::uint32_t row = kWideArity * sizeof(float), hi = 3 * row;
@@ -45,12 +83,12 @@ struct BoxRay {
 [[gnu::always_inline]] inline unsigned box_hits(const WideNode& n, const BoxRay& r, float tmax, __m256& tnear) {
   const char* base = reinterpret_cast<const char*>(&n);
   auto plane = [base](std::uint32_t off) { return _mm256_load_ps(reinterpret_cast<const float*>(base + off)); };
-  const __m256 nx = _mm256_mul_ps(_mm256_sub_ps(plane(r.near_x), r.ox), r.ix);
-  const __m256 ny = _mm256_mul_ps(_mm256_sub_ps(plane(r.near_y), r.oy), r.iy);
-  const __m256 nz = _mm256_mul_ps(_mm256_sub_ps(plane(r.near_z), r.oz), r.iz);
-  const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(plane(r.far_x), r.ox), r.ix);
-  const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(plane(r.far_y), r.oy), r.iy);
-  const __m256 fz = _mm256_mul_ps(_mm256_sub_ps(plane(r.far_z), r.oz), r.iz);
+  const __m256 nx = _mm256_mul_ps(_mm256_sub_ps(plane(r.near_x), r.onx), r.ix);
+  const __m256 ny = _mm256_mul_ps(_mm256_sub_ps(plane(r.near_y), r.ony), r.iy);
+  const __m256 nz = _mm256_mul_ps(_mm256_sub_ps(plane(r.near_z), r.onz), r.iz);
+  const __m256 fx = _mm256_mul_ps(_mm256_sub_ps(plane(r.far_x), r.ofx), r.ix);
+  const __m256 fy = _mm256_mul_ps(_mm256_sub_ps(plane(r.far_y), r.ofy), r.iy);
+  const __m256 fz = _mm256_mul_ps(_mm256_sub_ps(plane(r.far_z), r.ofz), r.iz);
   const __m256 big = _mm256_set1_ps(3.0e38f), eps = _mm256_set1_ps(kWiden);
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
   const __m256 entry = _mm256_min_ps(_mm256_max_ps(_mm256_max_ps(nx, ny), nz), big);

@@ -1,0 +1,273 @@
+// 8-ray packet traversal of the 8-wide BVH (see packet_traversal.h). Culling is
+// conservative by monotonicity: every float operation of the single-ray slab test is
+// monotone in its operands, so the same operations applied to the packet's extreme
+// origins and reciprocals bound every ray's computed entry (from below) and exit (from
+// above); a box any ray would enter, the packet enters. Leaves then use each ray's own
+// box test and the watertight pack test, so hits equal closest_hit's bit for bit.
+#include "trace/packet_traversal.h"
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "trace/ray_triangle.h"
+#include "trace/wide_kernels.h"
+
+namespace speculum::trace {
+
+namespace {
+
+// A packet's directions must agree in sign per axis (the near plane is then the same
+// for all rays) and be close: the interval bounds of a wide fan cull little.
+constexpr float kMaxDirectionSpread = 0.05f;  // per component of the normalized direction
+
+struct Packet {
+  int count = 0;
+  // Per ray (lanes), for the per-ray leaf box test.
+  alignas(32) float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
+  alignas(32) float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];
+  alignas(32) float tmin[kPacketSize], best_t[kPacketSize];
+  RayShear shear[kPacketSize];
+  // Packet bounds for the interval node test.
+  __m256 near_o[3], far_o[3], inv_lo[3], inv_hi[3], tmin_lo;
+  std::uint32_t near_off[3], far_off[3];  // plane rows of a WideNode picked by the signs
+};
+
+// Interval test of the packet against a node's 8 children: bit k when some ray may enter
+// child k before max_t; tnear gets a lower bound of the rays' widened entries.
+[[gnu::always_inline]] inline unsigned packet_box_hits(const WideNode& n, const Packet& p, float max_t,
+                                                       __m256& tnear) {
+  const char* base = reinterpret_cast<const char*>(&n);
+  auto plane = [base](std::uint32_t off) { return _mm256_load_ps(reinterpret_cast<const float*>(base + off)); };
+  __m256 entry = _mm256_set1_ps(-3.0e38f), exit = _mm256_set1_ps(3.0e38f);
+  for (int a = 0; a < 3; ++a) {
+    const __m256 dn = _mm256_sub_ps(plane(p.near_off[a]), p.near_o[a]);
+    const __m256 df = _mm256_sub_ps(plane(p.far_off[a]), p.far_o[a]);
+    entry = _mm256_max_ps(entry, _mm256_min_ps(_mm256_mul_ps(dn, p.inv_lo[a]), _mm256_mul_ps(dn, p.inv_hi[a])));
+    exit = _mm256_min_ps(exit, _mm256_max_ps(_mm256_mul_ps(df, p.inv_lo[a]), _mm256_mul_ps(df, p.inv_hi[a])));
+  }
+  const __m256 big = _mm256_set1_ps(3.0e38f), eps = _mm256_set1_ps(2.0f * wide::kWiden);
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  entry = _mm256_min_ps(entry, big);
+  exit = _mm256_max_ps(exit, _mm256_sub_ps(_mm256_setzero_ps(), big));
+  const __m256 near = _mm256_max_ps(_mm256_sub_ps(entry, _mm256_mul_ps(_mm256_and_ps(entry, abs_mask), eps)), p.tmin_lo);
+  const __m256 far = _mm256_min_ps(_mm256_add_ps(exit, _mm256_mul_ps(_mm256_and_ps(exit, abs_mask), eps)),
+                                   _mm256_set1_ps(max_t));
+  tnear = near;
+  return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ)));
+}
+
+// Child k's box against each ray (lanes) with its own best t: the single-ray box test of
+// wide_kernels.h, transposed. Bit r when ray r enters the box.
+[[gnu::always_inline]] inline unsigned rays_box_hits(const WideNode& n, int k, const Packet& p) {
+  const float* rows = n.lo_x;
+  auto bcast = [&](std::uint32_t off) {
+    return _mm256_set1_ps(*reinterpret_cast<const float*>(reinterpret_cast<const char*>(rows) + off + 4u * k));
+  };
+  const __m256 o[3] = {_mm256_load_ps(p.ox), _mm256_load_ps(p.oy), _mm256_load_ps(p.oz)};
+  const __m256 inv[3] = {_mm256_load_ps(p.ix), _mm256_load_ps(p.iy), _mm256_load_ps(p.iz)};
+  __m256 entry = _mm256_set1_ps(-3.0e38f), exit = _mm256_set1_ps(3.0e38f);
+  for (int a = 0; a < 3; ++a) {
+    entry = _mm256_max_ps(entry, _mm256_mul_ps(_mm256_sub_ps(bcast(p.near_off[a]), o[a]), inv[a]));
+    exit = _mm256_min_ps(exit, _mm256_mul_ps(_mm256_sub_ps(bcast(p.far_off[a]), o[a]), inv[a]));
+  }
+  const __m256 big = _mm256_set1_ps(3.0e38f), eps = _mm256_set1_ps(wide::kWiden);
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  entry = _mm256_min_ps(entry, big);
+  exit = _mm256_max_ps(exit, _mm256_sub_ps(_mm256_setzero_ps(), big));
+  const __m256 near = _mm256_max_ps(_mm256_sub_ps(entry, _mm256_mul_ps(_mm256_and_ps(entry, abs_mask), eps)),
+                                    _mm256_load_ps(p.tmin));
+  const __m256 far = _mm256_min_ps(_mm256_add_ps(exit, _mm256_mul_ps(_mm256_and_ps(exit, abs_mask), eps)),
+                                   _mm256_load_ps(p.best_t));
+  return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ)));
+}
+
+inline float lane_max(const float (&v)[kPacketSize]) {
+  float m = v[0];
+  for (int i = 1; i < kPacketSize; ++i) m = v[i] > m ? v[i] : m;
+  return m;
+}
+
+// Fills the packet; false when the rays are not coherent enough (or not all valid).
+bool prepare(const Ray* rays, int count, Packet& p) {
+  p.count = count;
+  glm::vec3 dlo(3.0e38f), dhi(-3.0e38f), olo(3.0e38f), ohi(-3.0e38f), ilo(3.0e38f), ihi(-3.0e38f);
+  float tmin_lo = 3.0e38f;
+  for (int r = 0; r < kPacketSize; ++r) {
+    const Ray& ray = rays[r < count ? r : 0];
+    // Axes a ray does not move along need the single-ray origin shift (wide_kernels.h).
+    if (!wide::valid_ray(ray) || wide::has_clamped_axis(ray.direction)) return false;
+    const glm::vec3 inv = wide::safe_inverse(ray.direction);
+    const glm::vec3 dn = ray.direction / std::sqrt(ray.direction.x * ray.direction.x +
+                                                   ray.direction.y * ray.direction.y + ray.direction.z * ray.direction.z);
+    dlo = glm::min(dlo, dn);
+    dhi = glm::max(dhi, dn);
+    olo = glm::min(olo, ray.origin);
+    ohi = glm::max(ohi, ray.origin);
+    ilo = glm::min(ilo, inv);
+    ihi = glm::max(ihi, inv);
+    tmin_lo = std::min(tmin_lo, ray.tmin);
+    p.ox[r] = ray.origin.x; p.oy[r] = ray.origin.y; p.oz[r] = ray.origin.z;
+    p.ix[r] = inv.x; p.iy[r] = inv.y; p.iz[r] = inv.z;
+    p.tmin[r] = ray.tmin;
+    // Lanes past count copy ray 0 but can never be entered (best t below everything).
+    p.best_t[r] = r < count ? ray.tmax : -3.0e38f;
+    p.shear[r] = RayShear(ray.origin, ray.direction);
+  }
+  constexpr std::uint32_t row = kWideArity * sizeof(float), hi = 3 * row;
+  for (int a = 0; a < 3; ++a) {
+    if (std::signbit(ilo[a]) != std::signbit(ihi[a])) return false;  // mixed signs
+    if (dhi[a] - dlo[a] > kMaxDirectionSpread) return false;
+    const bool neg = std::signbit(ilo[a]);
+    p.near_off[a] = static_cast<std::uint32_t>(a) * row + (neg ? hi : 0);
+    p.far_off[a] = static_cast<std::uint32_t>(a) * row + (neg ? 0 : hi);
+    // Entry (near plane - o) * inv is smallest for the origin farthest along the ray's
+    // travel; exit is largest for the nearest one.
+    p.near_o[a] = _mm256_set1_ps(neg ? olo[a] : ohi[a]);
+    p.far_o[a] = _mm256_set1_ps(neg ? ohi[a] : olo[a]);
+    p.inv_lo[a] = _mm256_set1_ps(ilo[a]);
+    p.inv_hi[a] = _mm256_set1_ps(ihi[a]);
+  }
+  p.tmin_lo = _mm256_set1_ps(tmin_lo);
+  return true;
+}
+
+struct Entry {
+  std::uint32_t ref;
+  float tnear;
+};
+
+}  // namespace
+
+bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, TraversalCounters* counters) {
+  count = std::clamp(count, 0, kPacketSize);
+  Packet p;
+  if (count < 2 || bvh.wide_root() == kEmptyChild || (bvh.wide_root() & kLeafBit) || !prepare(rays, count, p)) {
+    for (int r = 0; r < count; ++r) out[r] = closest_hit(bvh, rays[r], counters);
+    return false;
+  }
+  TraversalCounters c;
+  c.rays = static_cast<std::uint64_t>(count);
+  Hit best[kPacketSize];
+  for (int r = 0; r < count; ++r) best[r].t = p.best_t[r];
+  const WideNode* nodes = bvh.wide_nodes().data();
+  const TrianglePack* packs = bvh.triangle_packs().data();
+  float max_t = lane_max(p.best_t);
+  Entry stack[kTraversalStackSize];
+  int sp = 0;
+  std::uint32_t cur = bvh.wide_root();
+  while (true) {
+    ++c.nodes_visited;
+    const WideNode& n = nodes[cur];
+    __m256 tnv;
+    unsigned bits = packet_box_hits(n, p, max_t, tnv);
+    alignas(32) float tn[kWideArity];
+    _mm256_store_ps(tn, tnv);
+    // Leaf children now, each ray against its box, then its triangles.
+    unsigned leaves = 0;
+    for (unsigned b = bits; b; b &= b - 1) {
+      const int k = __builtin_ctz(b);
+      if (n.child[k] & kLeafBit) leaves |= 1u << k;
+    }
+    bits &= ~leaves;
+    bool improved = false;
+    while (leaves) {
+      const int k = __builtin_ctz(leaves);
+      leaves &= leaves - 1;
+      const std::uint32_t ref = n.child[k];
+      const std::uint32_t first = (ref & ~kLeafBit) >> 2, npacks = (ref & 3u) + 1;
+      for (unsigned rb = rays_box_hits(n, k, p); rb; rb &= rb - 1) {
+        const int r = __builtin_ctz(rb);
+        const wide::PackRay pr(p.shear[r]);
+        for (std::uint32_t q = first; q < first + npacks; ++q) {
+          const TrianglePack& pk = packs[q];
+          c.triangle_tests += 4;
+          float t[4], u[4], v[4];
+          unsigned hit = wide::intersect_pack(pk, pr, p.tmin[r], best[r].t, t, u, v);
+          while (hit) {
+            const int l = __builtin_ctz(hit);
+            hit &= hit - 1;
+            if (t[l] < best[r].t || (t[l] == best[r].t && pk.id[l] < best[r].triangle)) {
+              best[r] = {t[l], u[l], v[l], pk.id[l]};
+              p.best_t[r] = t[l];
+              improved = true;
+            }
+          }
+        }
+      }
+    }
+    if (improved) max_t = lane_max(p.best_t);
+    // Inner children: descend into the nearest, push the others far-to-near.
+    if (bits) {
+      Entry hits[kWideArity];
+      int m = 0;
+      for (; bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        if (!(tn[k] <= max_t)) continue;
+        const Entry e{n.child[k], tn[k]};
+        int j = m++;
+        while (j > 0 && hits[j - 1].tnear < e.tnear) {
+          hits[j] = hits[j - 1];
+          --j;
+        }
+        hits[j] = e;
+      }
+      if (m > 0) {
+        for (int i = 0; i + 1 < m; ++i) {
+          if (sp == kTraversalStackSize) {
+            ++c.stack_overflows;
+            continue;
+          }
+          stack[sp++] = hits[i];
+        }
+        cur = hits[m - 1].ref;
+        continue;
+      }
+    }
+    bool found = false;
+    while (sp > 0) {
+      const Entry e = stack[--sp];
+      if (e.tnear <= max_t) {
+        cur = e.ref;
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+  }
+  for (int r = 0; r < count; ++r) out[r] = best[r].hit() ? best[r] : Hit{};
+  if (counters) counters->add(c);
+  return true;
+}
+
+void closest_hit_stream_packets(const Bvh& bvh, const RayStream& rays, HitStream& hits, par::Executor& ex,
+                                TraversalCounters* counters) {
+  static_assert(kRayChunk % kPacketSize == 0, "packets never straddle chunks");
+  const std::size_t n = rays.size();
+  hits.resize(n);
+  const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
+  std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
+  ex.parallel_for("trace_closest_packets", n, kRayChunk, [&](std::size_t b, std::size_t e) {
+    TraversalCounters c;
+    for (std::size_t i = b; i < e; i += kPacketSize) {
+      const int count = static_cast<int>(std::min<std::size_t>(kPacketSize, e - i));
+      Ray r[kPacketSize];
+      Hit h[kPacketSize];
+      for (int k = 0; k < count; ++k) r[k] = rays.get(i + static_cast<std::size_t>(k));
+      closest_hit_packet(bvh, r, count, h, &c);
+      for (int k = 0; k < count; ++k) {
+        const std::size_t j = i + static_cast<std::size_t>(k);
+        hits.t[j] = h[k].t;
+        hits.u[j] = h[k].u;
+        hits.v[j] = h[k].v;
+        hits.triangle[j] = h[k].triangle;
+      }
+    }
+    if (counters) per_chunk[b / kRayChunk] = c;
+  });
+  if (counters)
+    for (const auto& c : per_chunk) counters->add(c);
+}
+
+}  // namespace speculum::trace
