@@ -87,15 +87,20 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
   const double frame_median = median(frame_ms);
   ResultTable table(o.json);
   nlohmann::json nodes = nlohmann::json::array();
+  std::size_t name_width = 5;  // the text table sizes columns from its first row
+  for (const auto& n : last.nodes) name_width = std::max(name_width, n.name.size());
+  auto padded = [&](const std::string& name) {
+    return o.json ? name : name + std::string(name_width - name.size(), ' ');
+  };
   for (const auto& n : last.nodes) {  // execution order
     const double ms = median(node_ms[n.name]);
     const double share = frame_median > 0 ? ms / frame_median : 0.0;
-    table.cell("node", n.name).cell("median_ms", ms, 3).cell("share_pct", 100.0 * share, 1)
+    table.cell("node", padded(n.name)).cell("median_ms", ms, 3).cell("share_pct", 100.0 * share, 1)
         .cell("counters", counters_text(n.counters));
     table.end_row();
     nodes.push_back({{"name", n.name}, {"median_ms", ms}, {"share", share}, {"counters", n.counters}});
   }
-  table.cell("node", "frame").cell("median_ms", frame_median, 3).cell("share_pct", 100.0, 1)
+  table.cell("node", padded("frame")).cell("median_ms", frame_median, 3).cell("share_pct", 100.0, 1)
       .cell("counters", "repeat=" + std::to_string(o.repeat));
   table.end_row();
   if (!global.quiet)
