@@ -278,9 +278,9 @@ void sort_bucket(E* src, std::size_t m, unsigned lo_bit, unsigned bits, std::uin
     }
     return unpack_all(src);
   }
-  // Digits no wider than log2(m) - 1 bits: the count tables stay small next to the bucket.
+  // Digits of at most ~log2(m) + 1 bits: the count tables stay about as small as the bucket.
   const unsigned max_bits =
-      std::clamp(unsigned(std::bit_width(m)) - 1, 4u, kMaxDigitBits);
+      std::clamp(unsigned(std::bit_width(m)) + 1, 4u, kMaxDigitBits);
   const unsigned passes = (bits + max_bits - 1) / max_bits;
   const unsigned digit_bits = (bits + passes - 1) / passes;
   const std::size_t radix = std::size_t(1) << digit_bits;
