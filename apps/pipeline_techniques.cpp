@@ -3,6 +3,7 @@
 
 #include "apps/pipeline_planar_mirror.h"
 #include "apps/pipeline_ray_hierarchy.h"
+#include "apps/pipeline_refraction.h"
 #include "apps/pipeline_distance_map.h"
 #include "apps/pipeline_yu_lod.h"
 #include "core/error.h"
@@ -39,6 +40,11 @@ const std::vector<Technique>& techniques() {
        "each mirror plane, scene clipped at the plane, recursive to --param depth=3; other "
        "specular surfaces as envmap",
        add_planar_mirror_passes},
+      {"refraction",
+       "refraction (SURVEY §4.4): --param method=0 single interface, 1 two-face (default), "
+       "2 distance impostors; exit refracted or totally internally reflected, looked up in "
+       "the refractor's colour+distance cube (linear_steps=16, secant_steps=4)",
+       add_refraction_passes},
       {"yu-lod",
        "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
        "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",
