@@ -18,6 +18,7 @@
 #include "core/sampling.h"
 #include "core/scene_loader.h"
 #include "trace/bvh.h"
+#include "trace/packet_traversal.h"
 #include "trace/ray_file.h"
 #include "trace/ray_generation.h"
 #include "trace/traversal.h"
@@ -42,6 +43,7 @@ struct BenchTraceOptions {
   std::uint32_t seed = 1;
   bool json = false;
   bool no_embree = false;
+  std::string kernel = "packet";
 };
 
 double median(std::vector<double> v) {
@@ -274,6 +276,8 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
     return;
   }
   if (o.rays.empty()) throw InputError("bench trace", "no --rays FILE given (or use --emit-rays)");
+  if (o.kernel != "packet" && o.kernel != "single")
+    throw InputError("--kernel", "expected packet or single, got '" + o.kernel + "'");
   const trace::RayStream rays = trace::read_ray_file(o.rays);
   const int repeat = std::max(1, o.repeat);
 
@@ -288,17 +292,18 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
   trace::TraversalCounters counters;
   for (int k = 0; k < repeat; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
-    trace::closest_hit_stream(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
+    if (o.kernel == "packet") trace::closest_hit_stream_packets(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
+    else trace::closest_hit_stream(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
     trace_ms.push_back(ms_since(t0));
   }
   const Checksum sum = checksum(hits);
   // Guarded so an empty ray file prints 0, never inf (which is not JSON).
   const double mrays = static_cast<double>(rays.size()) / (std::max(median(trace_ms), 1e-6) * 1e3);
   std::printf("{\"mesh\": \"%s\", \"rays_file\": \"%s\", \"triangles\": %zu, \"rays\": %zu, \"threads\": %d, "
-              "\"repeat\": %d, \"build_ms\": %.3f, \"mrays_per_s\": %.3f, \"hits\": %llu, \"prim_sum\": %llu, "
+              "\"repeat\": %d, \"kernel\": \"%s\", \"build_ms\": %.3f, \"mrays_per_s\": %.3f, \"hits\": %llu, \"prim_sum\": %llu, "
               "\"t_sum\": %.6f, \"nodes_per_ray\": %.2f, \"triangle_tests_per_ray\": %.2f, \"stack_overflows\": %llu",
               o.mesh.c_str(), o.rays.c_str(), scene.mesh.triangle_count(), rays.size(), ex.threads(), repeat,
-              median(build_ms), mrays, static_cast<unsigned long long>(sum.hits),
+              o.kernel.c_str(), median(build_ms), mrays, static_cast<unsigned long long>(sum.hits),
               static_cast<unsigned long long>(sum.prim_sum), sum.t_sum,
               static_cast<double>(counters.nodes_visited) / std::max<double>(1.0, rays.size()),
               static_cast<double>(counters.triangle_tests) / std::max<double>(1.0, rays.size()),
@@ -344,6 +349,9 @@ void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global) {
   cmd->add_option("--fov", opt->fov, "Vertical field of view, degrees")->check(CLI::Range(0.01, 179.0))->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the secondary ray directions")->capture_default_str();
   cmd->add_flag("--no-embree", opt->no_embree, "Skip the Embree comparison");
+  cmd->add_option("--kernel", opt->kernel,
+                  "Our closest-hit kernel: packet (8-ray packets, single-ray fallback when incoherent) or single")
+      ->capture_default_str();
   cmd->callback([opt, &global] { run_bench_trace(*opt, global); });
 }
 

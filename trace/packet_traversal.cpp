@@ -92,17 +92,25 @@ inline float lane_max(const float (&v)[kPacketSize]) {
 // Fills the packet; false when the rays are not coherent enough (or not all valid).
 bool prepare(const Ray* rays, int count, Packet& p) {
   p.count = count;
-  glm::vec3 dlo(3.0e38f), dhi(-3.0e38f), olo(3.0e38f), ohi(-3.0e38f), ilo(3.0e38f), ihi(-3.0e38f);
+  // Coherence first (cheap, and most incoherent packets stop here): valid rays, no
+  // clamped axis (those need the single-ray origin shift of wide_kernels.h), direction
+  // signs equal per axis and normalized directions within kMaxDirectionSpread.
+  glm::vec3 dlo(3.0e38f), dhi(-3.0e38f);
+  for (int r = 0; r < count; ++r) {
+    const Ray& ray = rays[r];
+    if (!wide::valid_ray(ray) || wide::has_clamped_axis(ray.direction)) return false;
+    const glm::vec3& d = ray.direction;
+    const glm::vec3 dn = d / std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    dlo = glm::min(dlo, dn);
+    dhi = glm::max(dhi, dn);
+  }
+  for (int a = 0; a < 3; ++a)
+    if (dhi[a] - dlo[a] > kMaxDirectionSpread || (dlo[a] < 0.0f) != (dhi[a] < 0.0f)) return false;
+  glm::vec3 olo(3.0e38f), ohi(-3.0e38f), ilo(3.0e38f), ihi(-3.0e38f);
   float tmin_lo = 3.0e38f;
   for (int r = 0; r < kPacketSize; ++r) {
     const Ray& ray = rays[r < count ? r : 0];
-    // Axes a ray does not move along need the single-ray origin shift (wide_kernels.h).
-    if (!wide::valid_ray(ray) || wide::has_clamped_axis(ray.direction)) return false;
     const glm::vec3 inv = wide::safe_inverse(ray.direction);
-    const glm::vec3 dn = ray.direction / std::sqrt(ray.direction.x * ray.direction.x +
-                                                   ray.direction.y * ray.direction.y + ray.direction.z * ray.direction.z);
-    dlo = glm::min(dlo, dn);
-    dhi = glm::max(dhi, dn);
     olo = glm::min(olo, ray.origin);
     ohi = glm::max(ohi, ray.origin);
     ilo = glm::min(ilo, inv);
@@ -117,8 +125,7 @@ bool prepare(const Ray* rays, int count, Packet& p) {
   }
   constexpr std::uint32_t row = kWideArity * sizeof(float), hi = 3 * row;
   for (int a = 0; a < 3; ++a) {
-    if (std::signbit(ilo[a]) != std::signbit(ihi[a])) return false;  // mixed signs
-    if (dhi[a] - dlo[a] > kMaxDirectionSpread) return false;
+    if (std::signbit(ilo[a]) != std::signbit(ihi[a])) return false;  // mixed signs (±0 directions)
     const bool neg = std::signbit(ilo[a]);
     p.near_off[a] = static_cast<std::uint32_t>(a) * row + (neg ? hi : 0);
     p.far_off[a] = static_cast<std::uint32_t>(a) * row + (neg ? 0 : hi);
