@@ -1,6 +1,7 @@
-// BVH benchmarks (issue 5): build time and closest-hit throughput for primary and
-// reflect-cone30 rays on UV-spheres in a box room, 1 and 2 threads. The Embree comparison
-// lives in `speculum bench trace` (same run, same rays); these track our own trends.
+// BVH benchmarks (issue 5): build time and closest-hit throughput (single rays and 8-ray
+// packets) for primary and reflect-cone30 rays on UV-spheres in a box room, 1 and 2
+// threads. The Embree comparison lives in `speculum bench trace` (same run, same rays);
+// these track our own trends.
 // Counters: Mrays_s, nodes_per_ray, tris_per_ray.
 #include <benchmark/benchmark.h>
 
@@ -10,6 +11,7 @@
 #include "core/sampling.h"
 #include "core/scene.h"
 #include "trace/bvh.h"
+#include "trace/packet_traversal.h"
 #include "trace/ray_generation.h"
 #include "trace/traversal.h"
 
@@ -83,5 +85,18 @@ void BM_ClosestHit(benchmark::State& state) {
   state.SetLabel(state.range(1) == 0 ? "primary" : "reflect-cone30");
 }
 BENCHMARK(BM_ClosestHit)->Args({1, 0})->Args({2, 0})->Args({1, 1})->Args({2, 1})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same rays through closest_hit_stream_packets (incoherent packets fall back to single rays).
+void BM_ClosestHitPackets(benchmark::State& state) {
+  par::Executor& ex = executor(static_cast<int>(state.range(0)));
+  static const trace::Bvh bvh = trace::Bvh::build(mesh(), executor(2));
+  const auto kind = state.range(1) == 0 ? trace::RaySetKind::Primary : trace::RaySetKind::ReflectCone30;
+  const trace::RayStream rays = trace::generate_rays(kind, bvh, camera(), 512, 512, 1, executor(2));
+  trace::HitStream hits;
+  for (auto _ : state) trace::closest_hit_stream_packets(bvh, rays, hits, ex);
+  state.counters["Mrays_s"] = benchmark::Counter(double(rays.size()) * state.iterations() / 1e6, benchmark::Counter::kIsRate);
+  state.SetLabel(state.range(1) == 0 ? "primary" : "reflect-cone30");
+}
+BENCHMARK(BM_ClosestHitPackets)->Args({1, 0})->Args({2, 0})->Args({1, 1})->Args({2, 1})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
