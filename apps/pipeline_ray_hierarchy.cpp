@@ -33,6 +33,11 @@ void count_traversal(par::NodeContext& c, const trace::HierarchyTraverseStats& s
   c.count("overflow_batches", s.overflow_batches);
   c.count("batches", s.batches);
   c.count("hits", s.hits);
+  c.count("candidates_per_ray_x1000", static_cast<std::uint64_t>(s.candidates_per_ray() * 1000.0 + 0.5));
+  // Stage wall times (the thesis's split; not deterministic, like every *_ns counter).
+  c.count("tests_ns", static_cast<std::uint64_t>(s.tests_ms * 1e6));
+  c.count("compaction_ns", static_cast<std::uint64_t>(s.compaction_ms * 1e6));
+  c.count("exact_ns", static_cast<std::uint64_t>(s.exact_ms * 1e6));
 }
 
 }  // namespace
