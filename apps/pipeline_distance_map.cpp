@@ -46,18 +46,18 @@ void add_frame_passes(par::Graph& g, const Scene* scene, const FrameSettings& f)
   g.add("shadow_map", [scene, f](par::NodeContext& c) {
      c.set_output("shadow_maps", render_shadow_maps(c.executor(), *scene, f.shadow_map_size));
    }).writes<ShadowMaps>("shadow_maps").param("size", f.shadow_map_size)
-     .describe("one shadow map per light, for direct light in the frame and in cube maps");
+     .describe("one shadow map per light, for direct light in the frame and in the cube maps (SURVEY §4.2)");
 
   g.add("visibility", [scene, f, sw, sh](par::NodeContext& c) {
      c.set_output("visibility", render_visibility(c.executor(), *scene, f.camera, sw, sh));
    }).writes<VisibilityBuffer>("visibility").param("width", sw).param("height", sh)
-     .describe("primary visibility by rasterization");
+     .describe("primary visibility by rasterization: non-specular objects rendered normally (SURVEY §4.2)");
 
   g.add("gbuffer", [scene, f](par::NodeContext& c) {
      c.set_output("gbuffer", resolve_gbuffer(c.executor(), *scene,
                                              c.input<VisibilityBuffer>("visibility"), f.camera.eye));
    }).reads<VisibilityBuffer>("visibility").writes<GBuffer>("gbuffer")
-     .describe("surface attributes of the visible samples");
+     .describe("surface attributes of the visible samples: position, normal, material (SURVEY §4.2)");
 
   g.add("direct_light", [scene, f](par::NodeContext& c) {
      c.set_output("direct", direct_light(c.executor(), *scene, c.input<GBuffer>("gbuffer"),
@@ -65,24 +65,24 @@ void add_frame_passes(par::Graph& g, const Scene* scene, const FrameSettings& f)
                                          c.input<EnvironmentMap>("environment")));
    }).reads<GBuffer>("gbuffer").reads<ShadowMaps>("shadow_maps")
      .reads<EnvironmentMap>("environment").writes<ImageRGBA>("direct")
-     .describe("direct light + ambient of the visible samples");
+     .describe("direct light + ambient of the visible samples (SURVEY §4.2)");
 
   g.add("composite", [](par::NodeContext& c) {
      c.set_output("samples", composite(c.executor(), c.input<ImageRGBA>("direct"),
                                        c.input<ImageRGBA>("specular")));
    }).reads<ImageRGBA>("direct").reads<ImageRGBA>("specular").writes<ImageRGBA>("samples")
-     .describe("direct + specular layer");
+     .describe("direct + Fresnel-weighted specular layer (SURVEY §4.2, eq.2)");
 
   g.add("resolve", [f](par::NodeContext& c) {
      c.set_output(kRadiance, resolve_supersamples(c.executor(), c.input<ImageRGBA>("samples"),
                                                   f.supersample));
    }).reads<ImageRGBA>("samples").writes<ImageRGBA>(kRadiance).param("k", f.supersample)
-     .describe("k×k supersample box filter");
+     .describe("k×k supersample box filter (SURVEY §4.2 frame)");
 
   g.add("tonemap", [f](par::NodeContext& c) {
      c.set_output(kDisplay, tonemap(c.executor(), c.input<ImageRGBA>(kRadiance), f.exposure));
    }).reads<ImageRGBA>(kRadiance).writes<ImageRGBA>(kDisplay).param("exposure", f.exposure)
-     .describe("exposure + ACES fit");
+     .describe("exposure + ACES fit, as for every technique (SURVEY §4.2 frame)");
 }
 
 void add_distance_map_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
