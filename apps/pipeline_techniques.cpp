@@ -1,10 +1,10 @@
 // The technique table: see pipeline_techniques.h.
 #include "apps/pipeline_techniques.h"
 
+#include "apps/pipeline_distance_map.h"
 #include "apps/pipeline_planar_mirror.h"
 #include "apps/pipeline_ray_hierarchy.h"
 #include "apps/pipeline_refraction.h"
-#include "apps/pipeline_distance_map.h"
 #include "apps/pipeline_yu_lod.h"
 #include "core/error.h"
 
