@@ -95,6 +95,16 @@ inline bool test_leaf_any(const Bvh& bvh, const RayPrep& r, std::uint32_t first,
   return false;
 }
 
+// Touches the lines of a child (a wide node's 224 bytes, or its leaf's first pack).
+inline void prefetch_ref(const WideNode* nodes, const TrianglePack* packs, std::uint32_t ref) {
+  const char* p = (ref & kLeafBit) ? reinterpret_cast<const char*>(&packs[(ref & ~kLeafBit) >> 2])
+                                   : reinterpret_cast<const char*>(&nodes[ref]);
+  _mm_prefetch(p, _MM_HINT_T0);
+  _mm_prefetch(p + 64, _MM_HINT_T0);
+  _mm_prefetch(p + 128, _MM_HINT_T0);
+  if (!(ref & kLeafBit)) _mm_prefetch(p + 192, _MM_HINT_T0);
+}
+
 struct StackEntry {
   std::uint32_t ref;
   float tnear;
@@ -160,6 +170,9 @@ Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit, T
             }
             stack[sp++] = hits[i];
           }
+          // The runner-up is the likely next pop: start its cache lines now (prefetching
+          // every pushed child measured no better).
+          prefetch_ref(nodes, packs, hits[count - 2].ref);
           cur = hits[count - 1];
           continue;
         }
