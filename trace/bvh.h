@@ -1,8 +1,9 @@
 // The bounding volume hierarchy over the scene's triangle soup: a binned-SAH binary tree
 // built in parallel and deterministically (same bytes for any thread count), from which
-// two traversal layouts are derived: an 8-wide layout (children tested together in
-// Lanes<8>, leaves of up to 4 triangles tested together in Lanes<4>) and the threaded layout of YU §3 / [CHCH06] (hit and miss links, stackless
-// traversal in a fixed order) that the LOD tracer extends. Refit keeps the topology and
+// two traversal layouts are derived: an 8-wide layout (children tested together in one
+// 8-lane AVX2 register, leaves of up to 4 triangles tested together: trace/wide_kernels.h)
+// and the threaded layout of YU §3 / [CHCH06] (hit and miss links, stackless traversal in a
+// fixed order) that the LOD tracer extends. Refit keeps the topology and
 // recomputes the boxes for moved vertices.
 #pragma once
 

@@ -8,6 +8,10 @@
 
 #include <immintrin.h>
 
+#if !defined(__AVX2__) || !defined(__FMA__)
+#error "trace/wide_kernels.h needs AVX2: configure with SPECULUM_ISA=x86-64-v3 (default), x86-64-v4 or native"
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
