@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "apps/inspect_trace_images.h"
 #include "apps/pipeline_envmap.h"
 #include "core/shading.h"
 #include "raster/composite.h"
@@ -18,7 +19,7 @@
 
 namespace speculum::inspect {
 
-namespace {
+namespace draw {
 
 constexpr std::size_t kMaxListed = 8;  // cube maps / lights drawn per output
 
@@ -74,7 +75,7 @@ std::string ramp_encoding(Range r) {
                : "no finite values";
 }
 
-View scalar_view(std::string label, const ImageF& img, Mask mask = nullptr) {
+View scalar_view(std::string label, const ImageF& img, Mask mask) {
   const Range r = finite_range(img, mask);
   return {std::move(label), ramp_encoding(r), ramp(img, r, mask), {}, img};
 }
@@ -228,7 +229,9 @@ void draw_visibility(Drawing& d, const raster::VisibilityBuffer& v) {
 
 bool contains(const std::string& s, const char* part) { return s.find(part) != std::string::npos; }
 
-}  // namespace
+}  // namespace draw
+
+using namespace draw;
 
 glm::vec3 id_colour(std::uint32_t id) {
   if (id == kNoId) return glm::vec3(0.0f);
@@ -304,7 +307,7 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
     d.size = std::to_string(maps->cubes.size()) + " cube maps";
     for (std::size_t m = 0; m < maps->cubes.size() && m < kMaxListed; ++m)
       draw_cube(d, "map" + std::to_string(m) + ".", maps->cubes[m], executor);
-  } else {
+  } else if (!draw_trace_output(o, executor, d)) {
     d.drawable = false;
   }
   return d;

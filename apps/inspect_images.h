@@ -41,4 +41,18 @@ glm::vec3 id_colour(std::uint32_t id);
 // faces and the unused cells are black. All faces must have the same size.
 ImageRGBA cube_cross(const std::array<ImageRGBA, 6>& faces);
 
+// Helpers shared with the trace-side drawers (apps/inspect_trace_images.cpp).
+namespace draw {
+std::string dims(int w, int h);
+std::string fmt(double v);
+glm::vec4 from_srgb(glm::vec3 c);  // a linear picture colour from an sRGB colour
+// Grey ramp over the finite values outside `mask` (samples with mask id kNoId are black).
+View scalar_view(std::string label, const ImageF& img, const IdBuffer* mask = nullptr);
+View id_view(std::string label, const IdBuffer& ids);
+View colour_cross_view(std::string label, const std::array<ImageRGBA, 6>& faces, par::Executor& executor);
+View distance_cross_view(std::string label, const std::array<ImageF, 6>& faces);
+bool has_faces(const std::array<ImageRGBA, 6>& faces);
+bool has_faces(const std::array<ImageF, 6>& faces);
+}  // namespace draw
+
 }  // namespace speculum::inspect

@@ -1,6 +1,7 @@
 // `speculum inspect`: manifest.json lists every executed node in execution order with its
 // outputs, every listed file exists, the final image equals `render`'s, and index.html loads
 // every image without console errors in headless Chromium (issue 9 "inspect").
+#include <map>
 #include <regex>
 #include <set>
 
@@ -71,6 +72,30 @@ void expect_complete_manifest(const fs::path& dir, const std::string& technique)
   EXPECT_TRUE(display_drawn);
 }
 
+// The trace-side outputs (apps/inspect_trace_images.h) a technique must draw: each is
+// drawable, lists PNGs, and every PNG loads with the output's content.
+const std::map<std::string, std::vector<std::string>> kTraceOutputs = {
+    {"ray-hierarchy", {"rays_1", "hierarchy_1", "hits_1", "shadow_hits_1"}},
+    {"yu-lod", {"glossy_rays", "glossy_hits"}},
+    {"layered-distance-map", {"layered_map"}}};
+
+void expect_trace_outputs_drawn(const fs::path& dir, const std::string& technique) {
+  const auto wanted = kTraceOutputs.find(technique);
+  if (wanted == kTraceOutputs.end()) return;
+  const nlohmann::json m = read_json(dir / "manifest.json");
+  std::set<std::string> drawn;
+  for (const auto& n : m["nodes"])
+    for (const auto& out : n["outputs"]) {
+      if (!out["drawable"].get<bool>() || out["images"].empty()) continue;
+      for (const auto& im : out["images"]) {
+        const ImageRGBA png = read_image((dir / im["png"].get<std::string>()).string());
+        EXPECT_GT(png.width, 0) << im["png"];
+      }
+      drawn.insert(out["resource"].get<std::string>());
+    }
+  for (const auto& r : wanted->second) EXPECT_TRUE(drawn.count(r)) << technique << ": " << r << " not drawn";
+}
+
 TEST(Inspect, ManifestListsEveryExecutedNodeOfEveryTechnique) {
   const fs::path root = test::scratch_dir();
   for (const auto& t : pipeline::techniques()) {
@@ -81,6 +106,7 @@ TEST(Inspect, ManifestListsEveryExecutedNodeOfEveryTechnique) {
                                 dir.parent_path());
     ASSERT_EQ(r.status, 0) << r.err;
     expect_complete_manifest(dir, t.name);
+    expect_trace_outputs_drawn(dir, t.name);
   }
   fs::remove_all(root);
 }
