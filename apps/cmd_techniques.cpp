@@ -1,4 +1,5 @@
 // `speculum techniques`: one line per technique (name and summary).
+#include <algorithm>
 #include <cstdio>
 
 #include "apps/cli.h"
@@ -10,8 +11,10 @@ void add_techniques_command(CLI::App& app, GlobalOptions&) {
   auto* cmd = app.add_subcommand("techniques", "List the rendering techniques, one per line");
   cmd->footer("Example: speculum techniques   (then: speculum render --technique NAME)");
   cmd->callback([] {
+    int width = 0;  // names in one aligned column
+    for (const auto& t : pipeline::techniques()) width = std::max(width, int(t.name.size()));
     for (const auto& t : pipeline::techniques())
-      std::printf("%-12s %s\n", t.name.c_str(), t.summary.c_str());
+      std::printf("%-*s  %s\n", width, t.name.c_str(), t.summary.c_str());
   });
 }
 

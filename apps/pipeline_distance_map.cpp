@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "apps/pipeline_frame_passes.h"
 #include "raster/composite.h"
 #include "raster/direct_light.h"
 #include "raster/distance_map_reflect.h"
@@ -36,66 +37,13 @@ std::string describe_search(const DistanceSearchOptions& o) {
 }
 
 void add_frame_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
-  const int sw = f.width * f.supersample, sh = f.height * f.supersample;
-  g.add("environment", [scene, f](par::NodeContext& c) {
-     c.set_output("environment", build_environment(c.executor(), scene->environment,
-                                                   f.environment_size));
-   }).writes<EnvironmentMap>("environment").param("size", f.environment_size)
-     .describe("the scene's environment as a prefiltered cube (SURVEY §3.1)");
-
-  g.add("shadow_map", [scene, f](par::NodeContext& c) {
-     c.set_output("shadow_maps", render_shadow_maps(c.executor(), *scene, f.shadow_map_size));
-   }).writes<ShadowMaps>("shadow_maps").param("size", f.shadow_map_size)
-     .describe("one shadow map per light, for direct light in the frame and in the cube maps (SURVEY §4.2)");
-
-  g.add("visibility", [scene, f, sw, sh](par::NodeContext& c) {
-     c.set_output("visibility", render_visibility(c.executor(), *scene, f.camera, sw, sh));
-   }).writes<VisibilityBuffer>("visibility").param("width", sw).param("height", sh)
-     .describe("primary visibility by rasterization: non-specular objects rendered normally (SURVEY §4.2)");
-
-  g.add("gbuffer", [scene, f](par::NodeContext& c) {
-     c.set_output("gbuffer", resolve_gbuffer(c.executor(), *scene,
-                                             c.input<VisibilityBuffer>("visibility"), f.camera.eye));
-   }).reads<VisibilityBuffer>("visibility").writes<GBuffer>("gbuffer")
-     .describe("surface attributes of the visible samples: position, normal, material (SURVEY §4.2)");
-
-  g.add("direct_light", [scene, f](par::NodeContext& c) {
-     c.set_output("direct", direct_light(c.executor(), *scene, c.input<GBuffer>("gbuffer"),
-                                         f.camera, c.input<ShadowMaps>("shadow_maps"),
-                                         c.input<EnvironmentMap>("environment")));
-   }).reads<GBuffer>("gbuffer").reads<ShadowMaps>("shadow_maps")
-     .reads<EnvironmentMap>("environment").writes<ImageRGBA>("direct")
-     .describe("direct light + ambient of the visible samples (SURVEY §4.2)");
-
-  g.add("composite", [](par::NodeContext& c) {
-     c.set_output("samples", composite(c.executor(), c.input<ImageRGBA>("direct"),
-                                       c.input<ImageRGBA>("specular")));
-   }).reads<ImageRGBA>("direct").reads<ImageRGBA>("specular").writes<ImageRGBA>("samples")
-     .describe("direct + Fresnel-weighted specular layer (SURVEY §4.2, eq.2)");
-
-  g.add("resolve", [f](par::NodeContext& c) {
-     c.set_output(kRadiance, resolve_supersamples(c.executor(), c.input<ImageRGBA>("samples"),
-                                                  f.supersample));
-   }).reads<ImageRGBA>("samples").writes<ImageRGBA>(kRadiance).param("k", f.supersample)
-     .describe("k×k supersample box filter (SURVEY §4.2 frame)");
-
-  g.add("tonemap", [f](par::NodeContext& c) {
-     c.set_output(kDisplay, tonemap(c.executor(), c.input<ImageRGBA>(kRadiance), f.exposure));
-   }).reads<ImageRGBA>(kRadiance).writes<ImageRGBA>(kDisplay).param("exposure", f.exposure)
-     .describe("exposure + ACES fit, as for every technique (SURVEY §4.2 frame)");
+  add_surface_passes(g, scene, f);
+  add_output_passes(g, f);
 }
 
 void add_distance_map_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   add_frame_passes(g, scene, f);
-  g.add("reflector_cube_maps", [scene, f](par::NodeContext& c) {
-     auto& maps = c.output<ReflectorMaps>("reflector_maps");
-     maps = render_reflector_maps(c.executor(), *scene, c.input<ShadowMaps>("shadow_maps"),
-                                  c.input<EnvironmentMap>("environment"), f.cube_map_size,
-                                  &c.input<GBuffer>("gbuffer"));
-     c.count("cube_maps", maps.cubes.size());
-   }).reads<ShadowMaps>("shadow_maps").reads<EnvironmentMap>("environment").reads<GBuffer>("gbuffer")
-     .writes<ReflectorMaps>("reflector_maps").param("size", f.cube_map_size)
-     .describe("per reflector a colour + distance cube map at its reference point (SURVEY §4.2)");
+  add_reflector_cube_maps_pass(g, scene, f, "per reflector a colour + distance cube map at its reference point (SURVEY §4.2)");
 
   const DistanceSearchOptions o = distance_search_options(f);
   g.add("distance_map_reflect", [o](par::NodeContext& c) {

@@ -1,4 +1,5 @@
 // The ray-hierarchy technique's recipe: see pipeline_ray_hierarchy.h (ROGER ch.3).
+#include "apps/pipeline_frame_passes.h"
 #include "apps/pipeline_ray_hierarchy.h"
 
 #include <algorithm>
@@ -49,33 +50,11 @@ void add_ray_hierarchy_passes(par::Graph& g, const Scene* scene, const FrameSett
   topt.pair_capacity = static_cast<std::size_t>(std::max(1.0, f.param("pair_capacity", 2048.0 * 2048.0)));
   topt.block_size = static_cast<std::size_t>(std::max(1.0, f.param("block", 64.0)));
 
-  g.add("environment", [scene, f](par::NodeContext& c) {
-     c.set_output("environment", build_environment(c.executor(), scene->environment, f.environment_size));
-   }).writes<EnvironmentMap>("environment").param("size", f.environment_size)
-     .describe("prefiltered environment cube for the primary hits' ambient term (ROGER §3.5 set-up)");
-
-  g.add("shadow_map", [scene, f](par::NodeContext& c) {
-     c.set_output("shadow_maps", render_shadow_maps(c.executor(), *scene, f.shadow_map_size));
-   }).writes<ShadowMaps>("shadow_maps").param("size", f.shadow_map_size)
-     .describe("shadow maps of the punctual lights for the primary hits (ROGER §3.5 set-up)");
-
-  g.add("visibility", [scene, f, sw, sh](par::NodeContext& c) {
-     c.set_output("visibility", render_visibility(c.executor(), *scene, f.camera, sw, sh));
-   }).writes<VisibilityBuffer>("visibility").param("width", sw).param("height", sh)
-     .describe("primary visibility by rasterization (ROGER §3.1: rays start from the G-buffer)");
-
-  g.add("gbuffer", [scene, f](par::NodeContext& c) {
-     c.set_output("gbuffer", resolve_gbuffer(c.executor(), *scene, c.input<VisibilityBuffer>("visibility"),
-                                             f.camera.eye));
-   }).reads<VisibilityBuffer>("visibility").writes<GBuffer>("gbuffer")
-     .describe("positions, normals and materials of the visible samples (ROGER §3.1)");
-
-  g.add("direct_light", [scene, f](par::NodeContext& c) {
-     c.set_output("direct", direct_light(c.executor(), *scene, c.input<GBuffer>("gbuffer"), f.camera,
-                                         c.input<ShadowMaps>("shadow_maps"), c.input<EnvironmentMap>("environment")));
-   }).reads<GBuffer>("gbuffer").reads<ShadowMaps>("shadow_maps").reads<EnvironmentMap>("environment")
-     .writes<ImageRGBA>("direct")
-     .describe("direct light of the primary hits, shared shading model (ROGER §3.5 set-up)");
+  SurfacePassNotes notes;
+  notes.shadow_map = "shadow maps of the punctual lights for the primary hits (ROGER §3.5 set-up)";
+  notes.visibility = "primary visibility by rasterization (ROGER §3.1: rays start from the G-buffer)";
+  notes.gbuffer = "positions, normals and materials of the visible samples (ROGER §3.1)";
+  add_surface_passes(g, scene, f, notes);
 
   g.add("secondary_rays", [f](par::NodeContext& c) {
      const GBuffer& gb = c.input<GBuffer>("gbuffer");
@@ -158,20 +137,7 @@ void add_ray_hierarchy_passes(par::Graph& g, const Scene* scene, const FrameSett
   }
 
   const std::string last = "specular_" + std::to_string(bounces);
-  g.add("composite", [last](par::NodeContext& c) {
-     c.set_output("samples", composite(c.executor(), c.input<ImageRGBA>("direct"), c.input<ImageRGBA>(last)));
-   }).reads<ImageRGBA>("direct").reads<ImageRGBA>(last).writes<ImageRGBA>("samples")
-     .describe("direct light plus the traced specular layer (ROGER §3.5)");
-
-  g.add("resolve", [f](par::NodeContext& c) {
-     c.set_output(kRadiance, resolve_supersamples(c.executor(), c.input<ImageRGBA>("samples"), f.supersample));
-   }).reads<ImageRGBA>("samples").writes<ImageRGBA>(kRadiance).param("k", f.supersample)
-     .describe("k×k supersample box filter");
-
-  g.add("tonemap", [f](par::NodeContext& c) {
-     c.set_output(kDisplay, tonemap(c.executor(), c.input<ImageRGBA>(kRadiance), f.exposure));
-   }).reads<ImageRGBA>(kRadiance).writes<ImageRGBA>(kDisplay).param("exposure", f.exposure)
-     .describe("exposure and ACES tone curve");
+  add_output_passes(g, f, last);
 }
 
 }  // namespace speculum::pipeline

@@ -1,5 +1,6 @@
 // The refraction technique's recipe: see pipeline_refraction.h. It wires raster/ passes
 // with one trace/ kernel (the per-vertex thickness ray cast of the two-face method).
+#include "apps/pipeline_frame_passes.h"
 #include "apps/pipeline_refraction.h"
 
 #include "core/error.h"
@@ -87,46 +88,13 @@ void add_refraction_passes(par::Graph& g, const Scene* scene, const FrameSetting
     o->secant_steps = static_cast<int>(secant);
   }
 
-  g.add("environment", [scene, f](par::NodeContext& c) {
-     c.set_output("environment", build_environment(c.executor(), scene->environment,
-                                                   f.environment_size));
-   }).writes<EnvironmentMap>("environment").param("size", f.environment_size)
-     .describe("Mip-mapped, prefiltered environment cube (SURVEY §3.1).");
+  SurfacePassNotes notes;
+  notes.visibility = "Camera visibility buffer: the refractors' front faces (P1).";
+  notes.gbuffer = "Camera G-buffer: front-face positions and normals N1 (SURVEY §4.4).";
+  add_surface_passes(g, scene, f, notes);
 
-  g.add("shadow_map", [scene, f](par::NodeContext& c) {
-     c.set_output("shadow_maps", render_shadow_maps(c.executor(), *scene, f.shadow_map_size));
-   }).writes<ShadowMaps>("shadow_maps").param("size", f.shadow_map_size)
-     .describe("Shadow maps of the punctual lights.");
-
-  g.add("visibility", [scene, f, sw, sh](par::NodeContext& c) {
-     c.set_output("visibility", render_visibility(c.executor(), *scene, f.camera, sw, sh));
-   }).writes<VisibilityBuffer>("visibility").param("width", sw).param("height", sh)
-     .describe("Camera visibility buffer: the refractors' front faces (P1).");
-
-  g.add("gbuffer", [scene, f](par::NodeContext& c) {
-     c.set_output("gbuffer", resolve_gbuffer(c.executor(), *scene,
-                                             c.input<VisibilityBuffer>("visibility"), f.camera.eye));
-   }).reads<VisibilityBuffer>("visibility").writes<GBuffer>("gbuffer")
-     .describe("Camera G-buffer: front-face positions and normals N1 (SURVEY §4.4).");
-
-  g.add("reflector_cube_maps", [scene, f](par::NodeContext& c) {
-     auto& maps = c.output<ReflectorMaps>("reflector_maps");
-     maps = render_reflector_maps(c.executor(), *scene, c.input<ShadowMaps>("shadow_maps"),
-                                  c.input<EnvironmentMap>("environment"), f.cube_map_size,
-                                  &c.input<GBuffer>("gbuffer"));
-     c.count("cube_maps", maps.cubes.size());
-   }).reads<ShadowMaps>("shadow_maps").reads<EnvironmentMap>("environment").reads<GBuffer>("gbuffer")
-     .writes<ReflectorMaps>("reflector_maps").param("size", f.cube_map_size)
-     .describe("Colour + distance cube map around each specular object, itself left out: "
+  add_reflector_cube_maps_pass(g, scene, f, "Colour + distance cube map around each specular object, itself left out: "
                "the environment distance map the refracted rays search (SURVEY §4.1, §4.4).");
-
-  g.add("direct_light", [scene, f](par::NodeContext& c) {
-     c.set_output("direct", direct_light(c.executor(), *scene, c.input<GBuffer>("gbuffer"),
-                                         f.camera, c.input<ShadowMaps>("shadow_maps"),
-                                         c.input<EnvironmentMap>("environment")));
-   }).reads<GBuffer>("gbuffer").reads<ShadowMaps>("shadow_maps")
-     .reads<EnvironmentMap>("environment").writes<ImageRGBA>("direct")
-     .describe("Direct light (core/shading.h model, shadow maps).");
 
   g.add("envmap_reflect", [](par::NodeContext& c) {
      c.set_output("specular_envmap", envmap_reflect(c.executor(), c.input<GBuffer>("gbuffer"),
@@ -194,22 +162,7 @@ void add_refraction_passes(par::Graph& g, const Scene* scene, const FrameSetting
   else if (method == RefractionMethod::DistanceImpostor)
     node.reads<RefractorImpostors>("impostors");
 
-  g.add("composite", [](par::NodeContext& c) {
-     c.set_output("samples", composite(c.executor(), c.input<ImageRGBA>("direct"),
-                                       c.input<ImageRGBA>("specular")));
-   }).reads<ImageRGBA>("direct").reads<ImageRGBA>("specular").writes<ImageRGBA>("samples")
-     .describe("Direct + specular layers.");
-
-  g.add("resolve", [f](par::NodeContext& c) {
-     c.set_output(kRadiance, resolve_supersamples(c.executor(), c.input<ImageRGBA>("samples"),
-                                                  f.supersample));
-   }).reads<ImageRGBA>("samples").writes<ImageRGBA>(kRadiance).param("k", f.supersample)
-     .describe("Box-filter k×k supersamples to pixels.");
-
-  g.add("tonemap", [f](par::NodeContext& c) {
-     c.set_output(kDisplay, tonemap(c.executor(), c.input<ImageRGBA>(kRadiance), f.exposure));
-   }).reads<ImageRGBA>(kRadiance).writes<ImageRGBA>(kDisplay).param("exposure", f.exposure)
-     .describe("Exposure and sRGB encoding for display.");
+  add_output_passes(g, f);
 }
 
 }  // namespace speculum::pipeline

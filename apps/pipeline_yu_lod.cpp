@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "apps/pipeline_frame_passes.h"
 #include "raster/composite.h"
 #include "raster/direct_light.h"
 #include "raster/environment.h"
@@ -32,40 +33,18 @@ void add_yu_lod_passes(par::Graph& g, const Scene* scene, const FrameSettings& f
 
 void add_yu_lod_passes_prebuilt(par::Graph& g, const Scene* scene, const FrameSettings& f,
                                 std::shared_ptr<YuLodStatic> pre) {
-  const int w = f.width, h = f.height;
   const int n_rays = f.spp;
   const bool lod_on = f.alpha > 0.0f;
   const int env_samples = static_cast<int>(f.param("env_samples", 8));
 
-  g.add("environment", [scene, f](par::NodeContext& c) {
-     c.set_output("environment", build_environment(c.executor(), scene->environment,
-                                                   f.environment_size));
-   }).writes<EnvironmentMap>("environment").param("size", f.environment_size)
-     .describe("prefiltered environment cube for direct light's ambient term");
-
-  g.add("shadow_map", [scene, f](par::NodeContext& c) {
-     c.set_output("shadow_maps", render_shadow_maps(c.executor(), *scene, f.shadow_map_size));
-   }).writes<ShadowMaps>("shadow_maps").param("size", f.shadow_map_size)
-     .describe("shadow maps of the punctual lights (direct light of primary hits)");
-
-  g.add("visibility", [scene, f, w, h](par::NodeContext& c) {
-     c.set_output("visibility", render_visibility(c.executor(), *scene, f.camera, w, h));
-   }).writes<VisibilityBuffer>("visibility").param("width", w).param("height", h)
-     .describe("primary visibility by rasterization (YU §3.5 step 1)");
-
-  g.add("gbuffer", [scene, f](par::NodeContext& c) {
-     c.set_output("gbuffer", resolve_gbuffer(c.executor(), *scene,
-                                             c.input<VisibilityBuffer>("visibility"), f.camera.eye));
-   }).reads<VisibilityBuffer>("visibility").writes<GBuffer>("gbuffer")
-     .describe("positions, normals and materials of the visible samples (YU §3.5)");
-
-  g.add("direct_light", [scene, f](par::NodeContext& c) {
-     c.set_output("direct", direct_light(c.executor(), *scene, c.input<GBuffer>("gbuffer"),
-                                         f.camera, c.input<ShadowMaps>("shadow_maps"),
-                                         c.input<EnvironmentMap>("environment")));
-   }).reads<GBuffer>("gbuffer").reads<ShadowMaps>("shadow_maps")
-     .reads<EnvironmentMap>("environment").writes<ImageRGBA>("direct")
-     .describe("direct light and ambient of the visible samples");
+  // One sample per pixel: N is the number of glossy rays, not supersamples.
+  FrameSettings one = f;
+  one.supersample = 1;
+  SurfacePassNotes notes;
+  notes.shadow_map = "shadow maps of the punctual lights (direct light of primary hits)";
+  notes.visibility = "primary visibility by rasterization (YU §3.5 step 1)";
+  notes.gbuffer = "positions, normals and materials of the visible samples (YU §3.5)";
+  add_surface_passes(g, scene, one, notes);
 
   g.add("bvh_build", [scene, pre](par::NodeContext& c) {
      BvhPtr bvh = pre ? pre->bvh : nullptr;
@@ -158,21 +137,7 @@ void add_yu_lod_passes_prebuilt(par::Graph& g, const Scene* scene, const FrameSe
      .describe("radiance at each hit at the eq.8-9 level, environment on a miss; F × the "
                "mean of the N samples (YU §3.4-3.5)");
 
-  g.add("composite", [](par::NodeContext& c) {
-     c.set_output("samples", composite(c.executor(), c.input<ImageRGBA>("direct"),
-                                       c.input<ImageRGBA>("specular")));
-   }).reads<ImageRGBA>("direct").reads<ImageRGBA>("specular").writes<ImageRGBA>("samples")
-     .describe("direct + glossy layer");
-
-  g.add("resolve", [](par::NodeContext& c) {
-     c.set_output(kRadiance, resolve_supersamples(c.executor(), c.input<ImageRGBA>("samples"), 1));
-   }).reads<ImageRGBA>("samples").writes<ImageRGBA>(kRadiance).param("k", 1)
-     .describe("one sample per pixel: a copy");
-
-  g.add("tonemap", [f](par::NodeContext& c) {
-     c.set_output(kDisplay, tonemap(c.executor(), c.input<ImageRGBA>(kRadiance), f.exposure));
-   }).reads<ImageRGBA>(kRadiance).writes<ImageRGBA>(kDisplay).param("exposure", f.exposure)
-     .describe("exposure and ACES fit");
+  add_output_passes(g, one);
 }
 
 }  // namespace speculum::pipeline
