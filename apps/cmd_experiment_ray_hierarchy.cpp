@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "apps/cli.h"
+#include "apps/progress.h"
 #include "apps/result_table.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
@@ -123,6 +124,10 @@ void run_ray_hierarchy_experiment(const RayHierarchyExperimentOptions& o, const 
   par::Executor ex(global.threads);
   ResultTable table(o.json);
   const std::vector<std::string>& scenes = o.scenes.empty() ? kScenes : o.scenes;
+  std::size_t widths = 0;
+  for (int w = o.min_width; w <= o.max_width; w *= 2) ++widths;
+  Progress progress("ray-hierarchy", scenes.size() * widths, global.quiet);
+  table.set_progress(&progress);
   for (const std::string& name : scenes) {
     SceneOptions so;
     so.size = o.size;

@@ -14,6 +14,7 @@
 #include "apps/cli.h"
 #include "apps/pipeline_distance_map.h"
 #include "apps/pipeline_frame.h"
+#include "apps/progress.h"
 #include "apps/result_table.h"
 #include "core/error.h"
 #include "core/image_metrics.h"
@@ -99,6 +100,11 @@ void run_survey(const SurveyOptions& o, const GlobalOptions& global) {
       if (t.name == name) known.push_back(&t);
   par::Executor executor(global.threads);
   ResultTable table(o.json);
+  std::size_t rows = 0;
+  for (const std::string& scene_name : scenes)
+    for (const pipeline::Technique* t : known) rows += applies(t->name, scene_name) ? 1 : 0;
+  Progress progress("survey", rows, global.quiet);
+  table.set_progress(&progress);
   for (const std::string& scene_name : scenes) {
     const Scene scene = load_scene(scene_name);
     if (scene.cameras.empty()) throw InputError(scene_name, "the scene has no camera");

@@ -13,6 +13,7 @@
 #include "apps/cli.h"
 #include "apps/pipeline_frame.h"
 #include "apps/pipeline_yu_lod.h"
+#include "apps/progress.h"
 #include "apps/result_table.h"
 #include "core/error.h"
 #include "core/image_metrics.h"
@@ -131,6 +132,10 @@ void run_yu_fig9(const YuFig9Options& o, const GlobalOptions& global) {
   }
   par::Executor ex(global.threads);
   ResultTable table(o.json);
+  std::size_t resolutions = 0;
+  for (int res = o.min_res; res <= o.max_res; res *= 2) ++resolutions;
+  Progress progress("yu-fig9", resolutions * alphas.size(), global.quiet);
+  table.set_progress(&progress);
   for (int res = o.min_res; res <= o.max_res; res *= 2) {
     const Scene scene = fig9_scene(res);
     pipeline::FrameSettings f;

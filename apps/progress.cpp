@@ -78,4 +78,11 @@ void Progress::finish() {
   sink_("\r" + line_locked(elapsed()) + "\n");
 }
 
+void Progress::clear() {
+  std::lock_guard lock(mutex_);
+  if (!sink_ || !drawn_ || finished_) return;
+  sink_("\r\033[K");
+  last_draw_ = -1.0;  // the next step redraws at once
+}
+
 }  // namespace speculum::cli

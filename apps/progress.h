@@ -31,6 +31,9 @@ class Progress {
   void step(std::string_view detail = {});
   // Ends the bar: a last redraw and a newline, only if anything was drawn.
   void finish();
+  // Erases the drawn bar from its line (the next step redraws it), so a caller can print a
+  // line of its own — e.g. an experiment's table row — on the same terminal.
+  void clear();
 
   std::size_t done() const;
   std::size_t total() const { return total_; }

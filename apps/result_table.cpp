@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "apps/progress.h"
+
 namespace speculum::cli {
 
 std::string json_quote(const std::string& s) {
@@ -57,6 +59,7 @@ ResultTable& ResultTable::cell(const std::string& key, bool value) {
 }
 
 void ResultTable::end_row() {
+  if (progress_) progress_->clear();
   if (json_) {
     std::string line = "{";
     for (std::size_t i = 0; i < row_.size(); ++i)
@@ -81,6 +84,7 @@ void ResultTable::end_row() {
   }
   std::fflush(out_);
   row_.clear();
+  if (progress_) progress_->step();
 }
 
 }  // namespace speculum::cli

@@ -10,6 +10,8 @@
 
 namespace speculum::cli {
 
+class Progress;
+
 class ResultTable {
  public:
   explicit ResultTable(bool json, std::FILE* out = stdout) : json_(json), out_(out) {}
@@ -24,6 +26,8 @@ class ResultTable {
   ResultTable& cell(const std::string& key, bool value);
   // Prints the current row (the header first, before the first row in text mode).
   void end_row();
+  // A progress bar stepped once per row (and cleared while the row prints); may be null.
+  void set_progress(Progress* progress) { progress_ = progress; }
 
  private:
   struct Cell {
@@ -32,6 +36,7 @@ class ResultTable {
   void add(const std::string& key, std::string json, std::string text);
   bool json_;
   std::FILE* out_;
+  Progress* progress_ = nullptr;
   bool header_printed_ = false;
   std::vector<std::size_t> widths_;
   std::vector<Cell> row_;

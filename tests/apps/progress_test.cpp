@@ -40,6 +40,26 @@ TEST(Progress, SilentBeforeTheDelay) {
   EXPECT_TRUE(out.writes.empty());
 }
 
+TEST(Progress, ClearErasesTheDrawnBarAndTheNextStepRedrawsIt) {
+  Captured out;
+  Progress p("rows", 3, out.sink(), 0.0);
+  p.clear();  // nothing drawn yet: nothing to erase
+  EXPECT_TRUE(out.writes.empty());
+  p.step();
+  ASSERT_EQ(out.writes.size(), 1u);
+  p.clear();
+  ASSERT_EQ(out.writes.size(), 2u);
+  EXPECT_EQ(out.writes.back(), "\r\033[K");
+  p.step();  // redraws at once after a clear
+  ASSERT_EQ(out.writes.size(), 3u);
+  EXPECT_EQ(drawn_done(out.writes.back().substr(1)), 2u);
+  p.step();
+  p.finish();
+  EXPECT_EQ(drawn_done(out.writes.back().substr(1)), 3u);
+  p.clear();  // finished: the final line stays
+  EXPECT_EQ(out.writes.back().back(), '\n');
+}
+
 TEST(Progress, ConcurrentStepsAreAllCountedAndDrawnMonotonically) {
   Captured out;
   constexpr int kThreads = 4, kSteps = 2500;
