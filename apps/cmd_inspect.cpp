@@ -9,7 +9,7 @@
 #include <string>
 
 #include "apps/cli.h"
-#include "apps/inspect_frame_options.h"
+#include "apps/pipeline_frame_options.h"
 #include "apps/inspect_images.h"
 #include "apps/inspect_report.h"
 #include "apps/pipeline_frame.h"
@@ -24,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct InspectOptions {
-  inspect::FrameOptions frame;
+  pipeline::FrameOptions frame;
   std::string output = "inspect";
   bool no_svg = false;
 };
@@ -54,7 +54,7 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   if (global.lanes != 0) par::set_default_lanes(global.lanes);
   const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
   const Scene scene = load_scene(o.frame.scene.empty() ? default_scene_name() : o.frame.scene);
-  const pipeline::FrameSettings settings = inspect::make_frame_settings(o.frame, scene);
+  const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
   const fs::path dir = o.output;
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -184,7 +184,7 @@ void add_inspect_command(CLI::App& app, GlobalOptions& global) {
   cmd->footer(
       "Example: speculum inspect sphere-in-room --technique envmap --width 160 --height 120 -o insp\n"
       "         then open insp/index.html in a browser (no server needed)");
-  inspect::add_frame_options(*cmd, opts->frame);
+  pipeline::add_frame_options(*cmd, opts->frame);
   cmd->add_option("-o,--output", opts->output, "Output directory (created; files are overwritten)")
       ->capture_default_str();
   cmd->add_flag("--no-svg", opts->no_svg, "Do not run Graphviz `dot` for graph.svg");

@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.h"
-#include "apps/inspect_frame_options.h"
+#include "apps/pipeline_frame_options.h"
 #include "apps/pipeline_frame.h"
 #include "apps/progress.h"
 #include "apps/result_table.h"
@@ -27,7 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct ProfileOptions {
-  inspect::FrameOptions frame;
+  pipeline::FrameOptions frame;
   int repeat = 5;
   int warmup = 1;
   std::string output;
@@ -57,7 +57,7 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
   if (global.lanes != 0) par::set_default_lanes(global.lanes);
   const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
   const Scene scene = load_scene(o.frame.scene.empty() ? default_scene_name() : o.frame.scene);
-  const pipeline::FrameSettings settings = inspect::make_frame_settings(o.frame, scene);
+  const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
   if (!o.output.empty()) {
     std::error_code ec;
     fs::create_directories(o.output, ec);
@@ -135,7 +135,7 @@ void add_profile_command(CLI::App& app, GlobalOptions& global) {
   cmd->fallthrough();
   cmd->footer("Example: speculum profile sphere-in-room --technique envmap --repeat 10 -o prof\n"
               "         (open prof/trace.json in Perfetto or chrome://tracing)");
-  inspect::add_frame_options(*cmd, opts->frame);
+  pipeline::add_frame_options(*cmd, opts->frame);
   cmd->add_option("--repeat", opts->repeat, "Timed frames; medians are reported")
       ->check(CLI::Range(1, 10000))->capture_default_str();
   cmd->add_option("--warmup", opts->warmup, "Untimed frames before the timed ones")

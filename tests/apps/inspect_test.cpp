@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "apps/inspect_frame_options.h"
+#include "apps/pipeline_frame_options.h"
 #include "apps/pipeline_techniques.h"
 #include "core/image.h"
 #include "core/image_metrics.h"
@@ -29,11 +29,11 @@ nlohmann::json read_json(const fs::path& p) { return nlohmann::json::parse(test:
 
 // The nodes render_frame runs for `technique` with inspect's defaults and kSmall, in order.
 std::vector<std::string> expected_order(const std::string& technique) {
-  inspect::FrameOptions o;
+  pipeline::FrameOptions o;
   o.technique = technique;
   o.width = 40, o.height = 30, o.cube_map_size = 16, o.shadow_map_size = 32;
   const Scene scene = load_scene(kScene);
-  const pipeline::FrameSettings f = inspect::make_frame_settings(o, scene);
+  const pipeline::FrameSettings f = pipeline::make_frame_settings(o, scene);
   par::Graph g;
   pipeline::find_technique(technique).add_passes(g, &scene, f);
   g.request(pipeline::kRadiance);

@@ -1,12 +1,12 @@
-// Frame options of `inspect` and `profile`: see inspect_frame_options.h.
-#include "apps/inspect_frame_options.h"
+// Frame options of `render`, `inspect` and `profile`: see pipeline_frame_options.h.
+#include "apps/pipeline_frame_options.h"
 
 #include <cmath>
 #include <cstdlib>
 
 #include "core/error.h"
 
-namespace speculum::inspect {
+namespace speculum::pipeline {
 
 void add_frame_options(CLI::App& cmd, FrameOptions& o) {
   cmd.add_option("scene", o.scene, "glTF/OBJ/PLY file or built-in scene name (default: the "
@@ -30,17 +30,17 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
       ->check(CLI::Range(1, 4096))->capture_default_str();
   cmd.add_option("--shadow-size", o.shadow_map_size, "Side of the shadow maps")
       ->check(CLI::Range(1, 8192))->capture_default_str();
-  pipeline::add_camera_options(cmd, o.camera);
+  add_camera_options(cmd, o.camera);
 }
 
-pipeline::FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
+FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
   // A square spp is k×k supersampling for feed-forward techniques; any other count only
   // reaches sample-based techniques (reference, yu-lod) through FrameSettings::spp.
   int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
   if (k * k != o.spp) k = 1;
   if (double(o.width) * o.height * o.spp > double(1 << 26))
     throw InputError("--width/--height/--spp", "more than 67M samples");
-  pipeline::FrameSettings f;
+  FrameSettings f;
   f.width = o.width;
   f.height = o.height;
   f.supersample = k;
@@ -60,8 +60,8 @@ pipeline::FrameSettings make_frame_settings(const FrameOptions& o, const Scene& 
       throw InputError("--param", "expected name=number, got '" + item + "'");
     f.params[item.substr(0, eq)] = v;
   }
-  f.camera = pipeline::resolve_camera(scene, o.camera);
+  f.camera = resolve_camera(scene, o.camera);
   return f;
 }
 
-}  // namespace speculum::inspect
+}  // namespace speculum::pipeline

@@ -1,5 +1,5 @@
-// The frame options `inspect` and `profile` share (scene, technique, size, spp, technique
-// parameters, camera) and the FrameSettings they make — the same meaning as `render`'s.
+// The frame options `render`, `inspect` and `profile` share (scene, technique, size, spp,
+// technique parameters, map sizes, camera) and the FrameSettings they make.
 #pragma once
 
 #include <string>
@@ -11,7 +11,7 @@
 #include "apps/pipeline_techniques.h"
 #include "core/scene.h"
 
-namespace speculum::inspect {
+namespace speculum::pipeline {
 
 struct FrameOptions {
   std::string scene;
@@ -26,12 +26,13 @@ struct FrameOptions {
   std::vector<std::string> params;
   int cube_map_size = 256;
   int shadow_map_size = 512;
-  pipeline::CameraOverrides camera;
+  CameraOverrides camera;
 };
 
 void add_frame_options(CLI::App& cmd, FrameOptions& options);
 
-// Validates (InputError on bad values, as `render` does) and resolves the camera.
-pipeline::FrameSettings make_frame_settings(const FrameOptions& options, const Scene& scene);
+// Validates (InputError on bad values) and resolves the camera. A square spp is k×k
+// supersampling; other counts reach only sample-based techniques through FrameSettings::spp.
+FrameSettings make_frame_settings(const FrameOptions& options, const Scene& scene);
 
-}  // namespace speculum::inspect
+}  // namespace speculum::pipeline
