@@ -2,6 +2,8 @@
 // estimate per path sample over the shared shading model of core/shading.h.
 #include "trace/reference_tracer.h"
 
+#include "trace/hit_surface.h"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "core/optics.h"
 #include "core/sampling.h"
 #include "core/shading.h"
+#include "trace/hit_surface.h"
 #include "trace/traversal.h"
 
 namespace speculum::trace {
@@ -54,31 +57,14 @@ struct Tracer {
     const glm::vec3 dir = glm::normalize(ray.direction);
     if (!h.hit()) return environment_radiance(scene.environment, dir);
 
-    const TriangleMesh& m = scene.mesh;
-    const std::uint32_t t = h.triangle;
-    const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
-    const float w0 = 1.0f - h.u - h.v;
-    // The hit point from the barycentrics: its error scales with the triangle's coordinates,
-    // not with the ray's origin (a far camera would otherwise put p on the wrong side).
-    const glm::vec3 p = m.positions[i0] * w0 + m.positions[i1] * h.u + m.positions[i2] * h.v;
-    glm::vec3 ng = glm::cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]);
-    const float ng_len = glm::length(ng);
-    ng = ng_len > 0.0f ? ng / ng_len : -dir;
-    glm::vec3 n = ng;
-    if (m.normals.size() == m.positions.size()) {
-      const glm::vec3 s = m.normals[i0] * w0 + m.normals[i1] * h.u + m.normals[i2] * h.v;
-      if (glm::length(s) > 0.0f) n = glm::normalize(s);
-    }
-    glm::vec2 uv(0.0f), uv1(0.0f);
-    if (m.uvs.size() == m.positions.size()) uv = m.uvs[i0] * w0 + m.uvs[i1] * h.u + m.uvs[i2] * h.v;
-    if (m.uvs1.size() == m.positions.size()) uv1 = m.uvs1[i0] * w0 + m.uvs1[i1] * h.u + m.uvs1[i2] * h.v;
-    const std::uint32_t mat = t < m.triangle_material.size() ? m.triangle_material[t] : 0u;
-    const SurfaceParams s = surface_params(scene, mat, uv, uv1);
-
-    // Face the viewer: both normals on the incident side.
-    const bool entering = glm::dot(ng, dir) < 0.0f;
-    if (!entering) ng = -ng;
-    if (glm::dot(n, ng) < 0.0f) n = -n;
+    // The hit point comes from the barycentrics: its error scales with the triangle's
+    // coordinates, not with the ray's origin (a far camera would otherwise put p on the wrong
+    // side). Both normals face the viewer.
+    const HitSurface hit = hit_surface(scene, h, ray.direction);
+    const glm::vec3 p = hit.p;
+    glm::vec3 ng = hit.ng, n = hit.n;
+    const SurfaceParams& s = hit.s;
+    const bool entering = hit.entering;
     const glm::vec3 v = -dir;
     const float cos_nv = std::max(glm::dot(n, v), 0.0f);
     const glm::vec3 above = offset(p, ng);

@@ -14,6 +14,7 @@
 #include "core/scene.h"
 #include "core/shading.h"
 #include "parallel/executor.h"
+#include "trace/hit_surface.h"
 #include "trace/traversal.h"
 
 namespace speculum::trace {
@@ -47,15 +48,6 @@ glm::vec3 offset_point(const glm::vec3& p, const glm::vec3& n);
 SecondaryRays secondary_rays(par::Executor& executor, const Buffer2D<glm::vec3>& position,
                              const Buffer2D<glm::vec3>& normal, const Buffer2D<SurfaceParams>& surface,
                              const IdBuffer& object, const glm::vec3& eye);
-
-// The surface at a closest hit: position from the barycentrics, geometric and interpolated
-// shading normal (both facing the incident side), material at the hit's uv.
-struct HitSurface {
-  glm::vec3 p{0.0f}, ng{0.0f, 0.0f, 1.0f}, n{0.0f, 0.0f, 1.0f};
-  SurfaceParams s;
-  bool entering = true;  // the ray arrived on the front (geometric-normal) side
-};
-HitSurface hit_surface(const Scene& scene, const Hit& hit, const glm::vec3& ray_direction);
 
 // The next generation: every hit on a specular surface spawns its reflected/refracted ray
 // (the same rules as secondary_rays), weight multiplied. Kernel "bounce_rays".
