@@ -10,47 +10,15 @@
 #include <glm/geometric.hpp>
 
 #include "trace/ray_triangle.h"
+#include "trace/scalar_box_test.h"
 
 namespace speculum::trace {
 
 namespace {
 
-constexpr float kFarWiden = 1.0f + 8.0f * 5.96e-8f;
-constexpr float kNearShrink = 1.0f - 8.0f * 5.96e-8f;
-
-struct RayPrep {
-  glm::vec3 o, d, inv;
-  float tmin, tmax;
-  RayShear shear;
-  explicit RayPrep(const Ray& r)
-      : o(r.origin), d(r.direction), tmin(r.tmin), tmax(r.tmax), shear(r.origin, r.direction) {
-    for (int a = 0; a < 3; ++a) {
-      const float c = std::fabs(d[a]) < 1e-30f ? std::copysign(1e-30f, d[a]) : d[a];
-      inv[a] = 1.0f / c;
-    }
-  }
-};
-
-bool valid_ray(const Ray& r) {
-  const glm::vec3& d = r.direction;
-  return (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f) && std::isfinite(d.x) && std::isfinite(d.y) &&
-         std::isfinite(d.z) && std::isfinite(r.origin.x) && std::isfinite(r.origin.y) &&
-         std::isfinite(r.origin.z) && !(r.tmin > r.tmax);
-}
-
-inline bool box_hit(const RayPrep& r, const Aabb& b, float tmax, float& tnear) {
-  float t0 = r.tmin, t1 = tmax;
-  for (int a = 0; a < 3; ++a) {
-    float lo = (b.lo[a] - r.o[a]) * r.inv[a];
-    float hi = (b.hi[a] - r.o[a]) * r.inv[a];
-    if (lo > hi) std::swap(lo, hi);
-    lo = lo > 0.0f ? lo * kNearShrink : lo * kFarWiden;
-    t0 = lo > t0 ? lo : t0;
-    t1 = hi * kFarWiden < t1 ? hi * kFarWiden : t1;
-  }
-  tnear = t0;
-  return t0 <= t1 && !b.empty();
-}
+using scalar::box_hit;
+using scalar::RayPrep;
+using scalar::valid_ray;
 
 inline bool inside(const Aabb& b, const glm::vec3& p) {
   return p.x >= b.lo.x && p.y >= b.lo.y && p.z >= b.lo.z && p.x <= b.hi.x && p.y <= b.hi.y &&
