@@ -5,7 +5,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "core/optics.h"
+#include "raster/specular_radiance.h"
 
 namespace speculum::raster {
 
@@ -35,25 +35,8 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
         st.bracketed += hit.bracketed;
         return maps.maps[m].radiance(glm::normalize(hit.direction), exponent);
       };
-      const glm::vec3 v = g.view_direction(i), incident = -v;
-      glm::vec3 n = g.normal.pixels[i];
-      glm::vec3 radiance;
-      if (s.is_refractor()) {
-        const bool entering = glm::dot(n, v) >= 0.0f;
-        if (!entering) n = -n;
-        const float nu = entering ? s.ior : 1.0f / s.ior;
-        const glm::vec3 r = reflect(incident, n);
-        glm::vec3 t;
-        if (refract(incident, n, nu, t)) {
-          const float f = fresnel_schlick(glm::dot(n, v), fresnel_f0(nu));
-          radiance = f * lookup(r, 1e6f) + (1.0f - f) * s.base_color * lookup(t, 1e6f);
-        } else {
-          radiance = lookup(r, 1e6f);  // total internal reflection
-        }
-      } else {
-        const glm::vec3 r = reflect(incident, n);
-        radiance = specular_fresnel(s, glm::dot(n, v)) * lookup(r, s.phong_exponent);
-      }
+      const glm::vec3 radiance =
+          specular_radiance(s, g.normal.pixels[i], g.view_direction(i), lookup);
       out.pixels[i] = glm::vec4(radiance, 1.0f);
     }
   });

@@ -3,7 +3,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "core/optics.h"
+#include "raster/specular_radiance.h"
 
 namespace speculum::raster {
 namespace {
@@ -17,31 +17,11 @@ ImageRGBA reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& m
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface.pixels[i];
       if (!is_specular(s)) continue;
-      const glm::vec3 v = g.view_direction(i), incident = -v;
-      glm::vec3 n = g.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return map_of(g.object.pixels[i]).radiance(d, exponent);
       };
-      glm::vec3 radiance;
-      if (s.is_refractor()) {
-        // Entering when the normal faces the viewer; leaving flips n and the index ratio.
-        const bool entering = glm::dot(n, v) >= 0.0f;
-        if (!entering) n = -n;
-        const float nu = entering ? s.ior : 1.0f / s.ior;
-        const glm::vec3 r = reflect(incident, n);
-        glm::vec3 t;
-        const float cos_i = glm::dot(n, v);
-        if (refract(incident, n, nu, t)) {
-          // Schlick with F0 of the interface; past the critical angle F = 1 (TIR).
-          const float f = fresnel_schlick(cos_i, fresnel_f0(nu));
-          radiance = f * lookup(r, 1e6f) + (1.0f - f) * s.base_color * lookup(t, 1e6f);
-        } else {
-          radiance = lookup(r, 1e6f);
-        }
-      } else {
-        const glm::vec3 r = reflect(incident, n);
-        radiance = specular_fresnel(s, glm::dot(n, v)) * lookup(r, s.phong_exponent);
-      }
+      const glm::vec3 radiance =
+          specular_radiance(s, g.normal.pixels[i], g.view_direction(i), lookup);
       out.pixels[i] = glm::vec4(radiance, 1.0f);
     }
   });
