@@ -1,71 +1,114 @@
-// Exclusive and inclusive scan over the Executor: chunk sums, a serial scan of the chunk
-// sums in chunk order, then each chunk scanned from its offset (deterministic for any
-// thread count; for floats the association is fixed by the chunk size). Large inputs run
-// both passes tile by tile so the second read comes from cache.
+// Exclusive and inclusive scan over the Executor in one pass over memory (single-pass
+// chained scan with decoupled look-back, DESIGN.md "Stream constraints"): each fixed chunk
+// is reduced, gets its offset from the prefixes its predecessors publish, and is scanned
+// again from cache; big outputs go out with streaming stores. The association (chunk sums
+// folded in chunk order from init) is fixed, so results are the same for any thread count
+// and timing, floats included.
 #pragma once
 
 #include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
+#include <stdexcept>
+#include <type_traits>
 #include <vector>
 
+#include "parallel/scan_kernels.h"
 #include "parallel/stream.h"
 
 namespace speculum::par {
 
 namespace detail {
 
-// Elements per tile: the two passes run tile by tile so the second pass re-reads its input
-// from the last-level cache instead of memory (4 MiB of input per tile).
+// Outputs at least this large bypass the caches (streaming stores): they cannot stay cached
+// for the next kernel anyway, and a cached store would first read every output line from
+// memory (read-for-ownership), a third memory stream beside the input read and the write.
+inline constexpr std::size_t kScanStreamingBytes = std::size_t(8) << 20;
+
+// What chunk c publishes: first its sum (state kSum), then its inclusive prefix, init ⊕
+// every element up to the chunk's end (state kPrefix). A cache line each, so a thread
+// polling a link reads a line only its owner writes.
 template <class T>
-std::size_t scan_tile(std::size_t chunk) {
-  const std::size_t target = (std::size_t(4) << 20) / sizeof(T);
-  return std::max<std::size_t>(1, target / chunk) * chunk;
+struct alignas(64) ScanLink {
+  static constexpr std::uint32_t kNone = 0, kSum = 1, kPrefix = 2;
+  std::atomic<std::uint32_t> state{kNone};
+  T sum{};
+  T prefix{};
+};
+
+// Polls before a thread gives up waiting for a predecessor's sum and computes it itself
+// (about the time one chunk's reduction takes): a descheduled thread on an oversubscribed
+// machine then costs one extra chunk read, not a time slice.
+inline constexpr unsigned kScanPatience = 1024;
+
+// Offset of chunk c (the inclusive prefix of chunk c-1) by decoupled look-back: walk back
+// over published sums, or sums this thread computes itself, to the nearest published prefix
+// (or init before chunk 0), then fold forward. The fold is the same left fold in chunk order
+// as a serial pass, (((init ⊕ s0) ⊕ s1) ⊕ ...), whichever prefix it starts from, so the
+// offset has the same bits for any timing. `sums` is the caller's scratch.
+template <class T, class Op, class SumOf>
+T look_back(const ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum_of,
+            std::vector<T>& sums) {
+  sums.clear();
+  T base = init;
+  for (std::size_t j = c; j-- > 0;) {
+    std::uint32_t s = links[j].state.load(std::memory_order_acquire);
+    for (unsigned spin = 0; s == ScanLink<T>::kNone && spin < kScanPatience; ++spin) {
+      scan_kernels::cpu_relax();
+      s = links[j].state.load(std::memory_order_acquire);
+    }
+    if (s == ScanLink<T>::kPrefix) {
+      base = links[j].prefix;
+      break;
+    }
+    sums.push_back(s == ScanLink<T>::kSum ? links[j].sum : sum_of(j));
+  }
+  for (std::size_t k = sums.size(); k-- > 0;) base = op(base, sums[k]);
+  return base;
 }
 
 template <bool Inclusive, class T, class Op>
 T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out, T init, Op op,
        std::size_t chunk) {
   const std::size_t n = in.size();
+  if (out.size() < n) throw std::invalid_argument("scan: output shorter than input");
   if (chunk == 0) chunk = 1;
-  const std::size_t tile = scan_tile<T>(chunk);
-  const std::string sums_name = launch_name(name, "chunk_sums");
-  const std::string scan_name = launch_name(name, "chunk_scan");
-  std::vector<T> offset(Executor::chunk_count(std::min(n, tile), chunk));
-  T running = init;
-  // Tiles are whole chunks and run in order, so the association (chunk sums folded in
-  // chunk order from init) is the same as one pass over all chunks.
-  for (std::size_t t0 = 0; t0 < n; t0 += tile) {
-    const std::size_t tn = std::min(tile, n - t0);
-    const T* const tin = in.data() + t0;
-    T* const tout = out.data() + t0;
-    ex.parallel_for(sums_name, tn, chunk, [&](std::size_t b, std::size_t e) {
-      T acc = tin[b];
-      for (std::size_t i = b + 1; i < e; ++i) acc = op(acc, tin[i]);
-      offset[b / chunk] = acc;
-    });
-    const std::size_t chunks = Executor::chunk_count(tn, chunk);
-    for (std::size_t c = 0; c < chunks; ++c) {
-      const T sum = offset[c];
-      offset[c] = running;
-      running = op(running, sum);
+  const std::size_t chunks = Executor::chunk_count(n, chunk);
+  if (chunks == 0) return init;
+  const bool streaming = n * sizeof(T) >= kScanStreamingBytes;
+  const T* const src = in.data();
+  T* const dst = out.data();
+  auto sum_of = [&](std::size_t c) {
+    const std::size_t b = c * chunk;
+    return scan_kernels::chunk_sum(src + b, std::min(n, b + chunk) - b, op);
+  };
+  std::unique_ptr<ScanLink<T>[]> links(new ScanLink<T>[chunks]);
+  // Chunks are handed out in index order, so a chunk's predecessors are usually done or in
+  // flight on another thread, and the look-back stops after one or two links; no thread
+  // ever blocks on another (a missing sum is computed, not awaited).
+  std::atomic<std::size_t> next{0};
+  const std::size_t workers = std::min<std::size_t>(std::size_t(ex.threads()), chunks);
+  ex.parallel_for(launch_name(name, "chained_scan"), workers, 1, [&](std::size_t, std::size_t) {
+    std::vector<T> sums;
+    for (;;) {
+      const std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
+      if (c >= chunks) return;
+      ScanLink<T>& link = links[c];
+      link.sum = sum_of(c);
+      link.state.store(ScanLink<T>::kSum, std::memory_order_release);
+      const T offset = look_back(links.get(), c, init, op, sum_of, sums);
+      link.prefix = op(offset, link.sum);
+      link.state.store(ScanLink<T>::kPrefix, std::memory_order_release);
+      const std::size_t b = c * chunk;
+      scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
+                                          streaming);
     }
-    // In-place safe: each element is read before its slot is written.
-    ex.parallel_for(scan_name, tn, chunk, [&](std::size_t b, std::size_t e) {
-      T acc = offset[b / chunk];
-      for (std::size_t i = b; i < e; ++i) {
-        const T x = tin[i];
-        if constexpr (Inclusive) {
-          acc = op(acc, x);
-          tout[i] = acc;
-        } else {
-          tout[i] = acc;
-          acc = op(acc, x);
-        }
-      }
-    });
-  }
-  return running;
+  });
+  return links[chunks - 1].prefix;
 }
 }  // namespace detail
 

@@ -7,6 +7,7 @@
 
 #include <bit>
 #include <cstring>
+#include <memory>
 #include <numeric>
 
 #include "primitive_test_util.h"
@@ -78,11 +79,11 @@ TEST(Stream, FloatScanAndReduceBitIdenticalAcrossThreads) {
   }
 }
 
-// Several 4 MiB tiles (scan.h runs the two passes tile by tile): float results equal the
-// documented association bit for bit (chunk sums folded in order, each chunk scanned from
-// its offset), for every thread count.
+// 10 MiB of floats (past scan.h's streaming-store threshold, many look-backs): results
+// equal the documented association bit for bit (chunk sums folded in order, each chunk
+// scanned from its offset), for every thread count.
 TEST(Stream, FloatScanAcrossTilesMatchesChunkAssociation) {
-  const std::size_t n = (std::size_t(5) << 19) + 77;  // 2.5 tiles of floats
+  const std::size_t n = (std::size_t(5) << 19) + 77;  // 10 MiB of floats
   std::vector<float> in(n);
   for (std::size_t i = 0; i < n; ++i) in[i] = unit_float(i) * 10.f - 3.f;
   std::vector<float> oracle(n);
@@ -103,17 +104,98 @@ TEST(Stream, FloatScanAcrossTilesMatchesChunkAssociation) {
   }
 }
 
-TEST(Stream, Scan16M) {
+// 16M u32 (the streaming-store path): exclusive and inclusive, 1/2/8 threads, into an
+// output one element off line alignment (unaligned head and tail per chunk) and in place.
+TEST(Stream, Scan16MEverySpanAndThreadCount) {
   const std::size_t n = std::size_t(16) << 20;
-  std::vector<std::uint32_t> in(n), out(n);
-  for (std::size_t i = 0; i < n; ++i) in[i] = i & 3;
-  const auto total = exclusive_scan(executor(2), "scan16M", std::span<const std::uint32_t>(in), std::span(out));
-  std::uint32_t run = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    ASSERT_EQ(out[i], run) << i;
-    run += in[i];
+  std::vector<std::uint32_t> in(n);
+  for (std::size_t i = 0; i < n; ++i) in[i] = hash32(i) & 1023;
+  std::vector<std::uint32_t> ex_ref(n), in_ref(n);
+  std::exclusive_scan(in.begin(), in.end(), ex_ref.begin(), 3u);
+  std::inclusive_scan(in.begin(), in.end(), in_ref.begin(), std::plus<>(), 3u);
+  const std::uint32_t total = in_ref.back();
+  std::vector<std::uint32_t> buf(n + 1);
+  for (int t : kThreadCounts) {
+    const std::span<std::uint32_t> shifted(buf.data() + 1, n);
+    EXPECT_EQ(exclusive_scan(executor(t), "ex16M", std::span<const std::uint32_t>(in), shifted, 3u), total);
+    ASSERT_TRUE(std::equal(shifted.begin(), shifted.end(), ex_ref.begin())) << t;
+    std::vector<std::uint32_t> b(in);
+    EXPECT_EQ(inclusive_scan(executor(t), "in16M", std::span<const std::uint32_t>(b), std::span(b), 3u), total);
+    ASSERT_TRUE(b == in_ref) << t;
   }
-  EXPECT_EQ(total, run);
+}
+
+// Types and operators off the SIMD path, past the streaming threshold: u64 sums (generic
+// streaming stores), signed 32-bit sums (SIMD), and a u32 max (scalar).
+TEST(Stream, ScansOffTheSimdPathEqualSerial) {
+  const std::size_t n = (std::size_t(9) << 20) / 8 + 5;  // > 8 MiB of u64
+  std::vector<std::uint64_t> in64(n);
+  for (std::size_t i = 0; i < n; ++i) in64[i] = std::uint64_t(hash32(i)) << 20 | hash32(i + n);
+  std::vector<std::uint64_t> ref64(n);
+  std::inclusive_scan(in64.begin(), in64.end(), ref64.begin(), std::plus<>(), std::uint64_t(7));
+  const std::size_t m = std::size_t(3) << 20;  // 12 MiB of 32-bit values
+  std::vector<std::int32_t> ins(m);
+  for (std::size_t i = 0; i < m; ++i) ins[i] = std::int32_t(hash32(i) % 2001) - 1000;
+  std::vector<std::int32_t> refs(m);
+  std::exclusive_scan(ins.begin(), ins.end(), refs.begin(), -5);
+  std::vector<std::uint32_t> inu(m), refmax(m);
+  for (std::size_t i = 0; i < m; ++i) inu[i] = hash32(i * 3);
+  auto max_op = [](std::uint32_t x, std::uint32_t y) { return std::max(x, y); };
+  std::inclusive_scan(inu.begin(), inu.end(), refmax.begin(), max_op, 0u);
+  for (int t : kThreadCounts) {
+    std::vector<std::uint64_t> out64(n);
+    EXPECT_EQ(inclusive_scan(executor(t), "u64", std::span<const std::uint64_t>(in64), std::span(out64),
+                             std::uint64_t(7)), ref64.back());
+    ASSERT_TRUE(out64 == ref64) << t;
+    std::vector<std::int32_t> outs(m);
+    exclusive_scan(executor(t), "i32", std::span<const std::int32_t>(ins), std::span(outs), -5);
+    ASSERT_TRUE(outs == refs) << t;
+    std::vector<std::uint32_t> outmax(m);
+    EXPECT_EQ(inclusive_scan(executor(t), "max", std::span<const std::uint32_t>(inu), std::span(outmax), 0u,
+                             max_op), refmax.back());
+    ASSERT_TRUE(outmax == refmax) << t;
+  }
+}
+
+// The look-back gives the serial left fold's bits whatever the predecessors have published:
+// nothing (the sum is computed here), a sum, or a prefix (where the walk stops).
+TEST(Stream, ScanLookBackFoldsInChunkOrder) {
+  using Link = detail::ScanLink<float>;
+  constexpr std::size_t kChunks = 9;
+  float sum[kChunks], prefix[kChunks];
+  float running = 0.25f;
+  for (std::size_t c = 0; c < kChunks; ++c) {
+    sum[c] = unit_float(c) * 1000.f - 400.f;
+    running += sum[c];
+    prefix[c] = running;
+  }
+  std::plus<float> op;
+  std::vector<float> scratch;
+  // state[c] per pattern: 0 none, 1 sum, 2 prefix.
+  const std::uint32_t patterns[][kChunks] = {{0, 0, 0, 0, 0, 0, 0, 0, 0},
+                                              {1, 1, 1, 1, 1, 1, 1, 1, 1},
+                                              {2, 0, 1, 0, 2, 1, 0, 1, 0},
+                                              {2, 2, 2, 2, 2, 2, 2, 2, 2}};
+  for (const auto& pattern : patterns) {
+    std::unique_ptr<Link[]> links(new Link[kChunks]);
+    for (std::size_t c = 0; c < kChunks; ++c) {
+      links[c].sum = sum[c];
+      links[c].prefix = prefix[c];
+      links[c].state.store(pattern[c]);
+    }
+    std::size_t computed = 0;
+    auto sum_of = [&](std::size_t c) {
+      ++computed;
+      return sum[c];
+    };
+    for (std::size_t c = 0; c < kChunks; ++c) {
+      const float offset = detail::look_back(links.get(), c, 0.25f, op, sum_of, scratch);
+      const float expected = c == 0 ? 0.25f : prefix[c - 1];
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(offset), std::bit_cast<std::uint32_t>(expected)) << c;
+    }
+    if (pattern[0] == 0) EXPECT_GT(computed, 0u);  // the missing sums were computed, not awaited
+    if (pattern[0] == 2 && pattern[1] == 2) EXPECT_EQ(computed, 0u);
+  }
 }
 
 template <int W>
