@@ -173,6 +173,9 @@ struct Packed<std::uint32_t> {
 // skewed top digit would otherwise leave one thread sorting most of the array).
 constexpr std::size_t kMaxLocalBucket = std::size_t(1) << 18;
 
+// Sorted outputs at least this large are written with streaming stores (unpack_bucket).
+constexpr std::size_t kStreamingBytes = std::size_t(8) << 20;
+
 // Per-thread buffers of the 32-bit path: one 64-byte line per top-digit bucket for the
 // write-combining scatter, and the ping-pong array and digit counts of a bucket's sort.
 template <class E>
@@ -217,6 +220,66 @@ inline void store_fence() {
 #if defined(__AVX2__)
   _mm_sfence();  // streaming stores are weakly ordered: publish them before the join
 #endif
+}
+
+// Elements before dst + k is 64-byte aligned (at most m).
+inline std::size_t to_line(const std::uint32_t* dst, std::size_t m) {
+  const std::size_t k = ((64 - reinterpret_cast<std::uintptr_t>(dst) % 64) % 64) / 4;
+  return std::min(k, m);
+}
+
+// dst[i] = the high (Key = true) or low 32 bits of src[i], i < m; whole aligned lines of dst
+// go out as streaming stores (the sorted output is too big to stay cached, and a cached
+// store would first read its line from memory), the unaligned head and tail as plain stores.
+template <bool Key>
+void stream_halves(const std::uint64_t* src, std::size_t m, std::uint32_t* dst) {
+  std::size_t i = to_line(dst, m);
+  for (std::size_t j = 0; j < i; ++j) dst[j] = std::uint32_t(Key ? src[j] >> 32 : src[j]);
+#if defined(__AVX2__)
+  constexpr int kPick = Key ? _MM_SHUFFLE(3, 1, 3, 1) : _MM_SHUFFLE(2, 0, 2, 0);
+  // Two 4-word vectors -> 8 halves in order: pick per 128-bit lane, then fix the quadword order.
+  auto halves8 = [](const std::uint64_t* p) {
+    const __m256 a = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
+    const __m256 b = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + 4)));
+    return _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, kPick)),
+                                    _MM_SHUFFLE(3, 1, 2, 0));
+  };
+  for (; i + 16 <= m; i += 16) {
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i), halves8(src + i));
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i + 8), halves8(src + i + 8));
+  }
+#endif
+  for (; i < m; ++i) dst[i] = std::uint32_t(Key ? src[i] >> 32 : src[i]);
+}
+
+inline void stream_copy(const std::uint32_t* src, std::size_t m, std::uint32_t* dst) {
+  std::size_t i = to_line(dst, m);
+  std::copy_n(src, i, dst);
+#if defined(__AVX2__)
+  for (; i + 16 <= m; i += 16) {
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i),
+                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + i)));
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i + 8),
+                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + i + 8)));
+  }
+#endif
+  std::copy(src + i, src + m, dst + i);
+}
+
+// Writes a sorted bucket out unpacked: keys[i] (and payload[i]) from from[i], i < m.
+template <class E>
+void unpack_bucket(const E* from, std::size_t m, std::uint32_t* keys, std::uint32_t* payload,
+                   bool streaming) {
+  if (!streaming) {
+    for (std::size_t i = 0; i < m; ++i) Packed<E>::unpack(from[i], keys, payload, i);
+    return;
+  }
+  if constexpr (sizeof(E) == 8) {
+    stream_halves<true>(from, m, keys);
+    stream_halves<false>(from, m, payload);
+  } else {
+    stream_copy(from, m, keys);
+  }
 }
 
 // Chunk [b, e) of the top-digit scatter into `out` (64-byte aligned). offset[d] = next slot
@@ -264,10 +327,8 @@ void top_scatter_chunk(const std::uint32_t* keys, const std::uint32_t* payload, 
 // other bit is equal within the bucket), written unpacked to keys/payload[0, m).
 template <class E>
 void sort_bucket(E* src, std::size_t m, unsigned lo_bit, unsigned bits, std::uint32_t* keys,
-                 std::uint32_t* payload) {
-  auto unpack_all = [&](const E* from) {
-    for (std::size_t i = 0; i < m; ++i) Packed<E>::unpack(from[i], keys, payload, i);
-  };
+                 std::uint32_t* payload, bool streaming) {
+  auto unpack_all = [&](const E* from) { unpack_bucket(from, m, keys, payload, streaming); };
   if (bits == 0 || m <= 1) return unpack_all(src);
   if (m <= 32) {  // insertion sort: stable (moves only past strictly greater keys)
     for (std::size_t i = 1; i < m; ++i) {
@@ -388,14 +449,16 @@ void msd_sort32(Executor& ex, std::string_view name, std::span<std::uint32_t> ke
   });
   // Fixed groups of buckets per task (uniform keys: ~8 buckets of n / 2048 elements each).
   constexpr std::size_t kBucketsPerTask = 8;
+  const bool streaming = n * sizeof(E) >= kStreamingBytes;
   ex.parallel_for(launch_name(name, "bucket_sort"), buckets, kBucketsPerTask,
                   [&](std::size_t b0, std::size_t b1) {
                     for (std::size_t d = b0; d < b1; ++d) {
                       const std::size_t first = bucket_begin[d];
                       sort_bucket<E>(packed + first, bucket_begin[d + 1] - first, lo_bit, local_bits,
                                      keys.data() + first,
-                                     payload.empty() ? nullptr : payload.data() + first);
+                                     payload.empty() ? nullptr : payload.data() + first, streaming);
                     }
+                    if (streaming) store_fence();
                   });
 }
 

@@ -3,6 +3,8 @@
 // of the same traffic measured in the same process; plus the ROGER ch.4 block-size sweep.
 // Traffic = bytes the primitive must read + write at minimum; memcpy traffic = 2 × copy size.
 // Counters: GBps (primitive), memcpy_GBps (same traffic, same thread count), Mkeys_s.
+// BM_StreamCopy (read once, streaming stores) is the ceiling for the scan: its 2T/1T is the
+// most any bandwidth-bound one-pass kernel can scale on this machine.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -11,7 +13,10 @@
 #include <numeric>
 #include <vector>
 
+#include <immintrin.h>
+
 #include "parallel/compact.h"
+#include "parallel/page_buffer.h"
 #include "parallel/partition.h"
 #include "parallel/scan.h"
 #include "parallel/stream.h"
@@ -73,6 +78,32 @@ void BM_Memcpy(benchmark::State& state) {
   state.counters["GBps"] = benchmark::Counter(double(n) * 8e-9, benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// The bandwidth ceiling of any one-read-one-write kernel: each element read once and written
+// once with streaming (cache-bypassing) stores, as the scan and the radix sort's output do.
+// Same traffic convention as BM_Memcpy (8 bytes per u32); compare its 2T/1T with theirs.
+void BM_StreamCopy(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  PageBuffer src_buf, dst_buf;  // 64-byte aligned (2 MiB)
+  std::uint32_t* const src = src_buf.reserve<std::uint32_t>(n);
+  std::uint32_t* const dst = dst_buf.reserve<std::uint32_t>(n);
+  std::fill_n(src, n, 1u);
+  std::fill_n(dst, n, 0u);
+  for (auto _ : state) {
+    executor(threads).parallel_for("stream_copy", n, kStreamChunk, [&](std::size_t s, std::size_t e) {
+      for (std::size_t i = s; i < e; i += 16) {
+        const __m256i a = _mm256_load_si256(reinterpret_cast<const __m256i*>(src + i));
+        const __m256i b = _mm256_load_si256(reinterpret_cast<const __m256i*>(src + i + 8));
+        _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i), a);
+        _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i + 8), b);
+      }
+      _mm_sfence();
+    });
+    benchmark::DoNotOptimize(dst);
+  }
+  state.counters["GBps"] = benchmark::Counter(double(n) * 8e-9, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 void BM_ExclusiveScan(benchmark::State& state) {
   const std::size_t n = state.range(0);
   const int threads = int(state.range(1));
@@ -80,6 +111,18 @@ void BM_ExclusiveScan(benchmark::State& state) {
   for (std::size_t i = 0; i < n; ++i) in[i] = hash32(i) & 7;
   for (auto _ : state) {
     benchmark::DoNotOptimize(exclusive_scan(executor(threads), "scan", std::span<const std::uint32_t>(in), std::span(out)));
+  }
+  report(state, n * 8, threads);
+}
+
+// In place, as a compaction's offsets or a histogram's bucket starts are scanned.
+void BM_InclusiveScan(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const int threads = int(state.range(1));
+  std::vector<std::uint32_t> data(n);
+  for (std::size_t i = 0; i < n; ++i) data[i] = hash32(i) & 7;
+  for (auto _ : state) {  // rescans its own output (wrapping sums): the same work every time
+    benchmark::DoNotOptimize(inclusive_scan(executor(threads), "scan", std::span<const std::uint32_t>(data), std::span(data)));
   }
   report(state, n * 8, threads);
 }
@@ -180,7 +223,9 @@ void sizes_threads(benchmark::internal::Benchmark* b) {
 }
 
 BENCHMARK(BM_Memcpy)->Apply(sizes_threads);
+BENCHMARK(BM_StreamCopy)->Apply(sizes_threads);
 BENCHMARK(BM_ExclusiveScan)->Apply(sizes_threads);
+BENCHMARK(BM_InclusiveScan)->Apply(sizes_threads);
 BENCHMARK(BM_Reduce)->Apply(sizes_threads);
 BENCHMARK(BM_CompactScatter)->Apply(sizes_threads);
 BENCHMARK(BM_CompactHierarchical)->Apply([](benchmark::internal::Benchmark* b) {
