@@ -308,6 +308,14 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
               static_cast<double>(counters.nodes_visited) / std::max<double>(1.0, rays.size()),
               static_cast<double>(counters.triangle_tests) / std::max<double>(1.0, rays.size()),
               static_cast<unsigned long long>(counters.stack_overflows));
+  // The last build's phases (build_ms covers all of them: refs, binary tree, both layouts).
+  const trace::BvhStats& st = bvh.stats();
+  std::printf(", \"bvh\": {\"hash\": \"%016llx\", \"leaves\": %llu, \"triangle_packs\": %llu, \"wide_nodes\": %llu, \"refs_ms\": %.1f, "
+              "\"top_ms\": %.1f, \"subtrees_ms\": %.1f, \"splice_ms\": %.1f, \"layouts_ms\": %.1f}",
+              static_cast<unsigned long long>(bvh.content_hash()), static_cast<unsigned long long>(st.leaves),
+              static_cast<unsigned long long>(st.triangle_packs),
+              static_cast<unsigned long long>(st.wide_nodes), st.refs_ms, st.top_ms, st.subtrees_ms, st.splice_ms,
+              st.layouts_ms);
 #ifdef SPECULUM_HAVE_EMBREE
   if (!o.no_embree) {
     const EmbreeFigures e = run_embree(scene, rays, repeat, ex);

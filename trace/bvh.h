@@ -92,9 +92,12 @@ struct LeafTriangle {
 };
 
 struct BvhStats {
-  std::uint64_t binary_nodes = 0, leaves = 0, wide_nodes = 0;
+  std::uint64_t binary_nodes = 0, leaves = 0, wide_nodes = 0, triangle_packs = 0;
   std::uint32_t max_depth = 0;
-  double build_ms = 0.0;
+  double build_ms = 0.0;  // everything below: refs, binary tree, both layouts
+  // Phases of build_ms (wall clock): primitive refs, top-level splits, parallel subtrees,
+  // leaf-triangle gather + depth-first splice, traversal layouts (threaded, packs, wide).
+  double refs_ms = 0.0, top_ms = 0.0, subtrees_ms = 0.0, splice_ms = 0.0, layouts_ms = 0.0;
 };
 
 class Bvh {
@@ -131,7 +134,8 @@ class Bvh {
   std::uint64_t content_hash() const;
 
  private:
-  void derive_layouts();
+  void derive_layouts(par::Executor& executor);
+  void derive_wide(const std::vector<std::uint32_t>& leaf_ref);
 
   std::vector<BinaryNode> binary_;
   std::vector<WideNode> wide_;

@@ -216,20 +216,34 @@ bool make_leaf(const Range& r, const Bins& bins, const BvhBuildOptions& opt, Spl
   return false;
 }
 
-// Builds a subtree over one range serially into `nodes` (root at nodes[0]).
-void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt, std::vector<TempNode>& nodes) {
+// A subtree built by one task: nodes in depth-first order with `right` relative to the
+// subtree's root (shifted when spliced), and the counts the stats need.
+struct Subtree {
+  std::vector<BinaryNode> nodes;
+  std::uint32_t max_depth = 0;
+  std::uint64_t leaves = 0;
+};
+
+// Builds a subtree over one range serially, emitting nodes directly in depth-first order
+// (a node's index is taken when it is popped; the left child is popped right after it).
+void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt, Subtree& out) {
   struct Item {
     Range range;
-    std::size_t node;
+    std::uint32_t parent;  // node whose `right` is this item (kEmptyChild: none)
+    std::uint32_t depth;
   };
   std::vector<Item> stack;
-  nodes.push_back({});
-  stack.push_back({root, 0});
+  stack.push_back({root, kEmptyChild, 0});
+  std::vector<BinaryNode>& nodes = out.nodes;
   Bins bins;
   while (!stack.empty()) {
     const Item it = stack.back();
     stack.pop_back();
-    nodes[it.node].box = it.range.box;
+    const auto me = static_cast<std::uint32_t>(nodes.size());
+    if (it.parent != kEmptyChild) nodes[it.parent].right = me;
+    out.max_depth = std::max(out.max_depth, it.depth);
+    BinaryNode node;
+    node.box = it.range.box;
     Split split;
     bool leaf = static_cast<int>(it.range.end - it.range.begin) <= opt.max_leaf_size;
     const Binner binner(it.range.cbox, opt.bins);
@@ -239,18 +253,16 @@ void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt,
       leaf = make_leaf(it.range, bins, opt, split);
     }
     if (leaf) {
-      nodes[it.node].first = it.range.begin;
-      nodes[it.node].count = it.range.end - it.range.begin;
+      node.first = it.range.begin;
+      node.count = it.range.end - it.range.begin;
+      nodes.push_back(node);
+      ++out.leaves;
       continue;
     }
+    nodes.push_back(node);
     const auto [L, R] = partition(refs, it.range, split, binner);
-    const std::size_t l = nodes.size();
-    nodes.push_back({});
-    nodes.push_back({});
-    nodes[it.node].left = static_cast<std::int64_t>(l);
-    nodes[it.node].right = static_cast<std::int64_t>(l + 1);
-    stack.push_back({R, l + 1});
-    stack.push_back({L, l});
+    stack.push_back({R, me, it.depth + 1});
+    stack.push_back({L, kEmptyChild, it.depth + 1});
   }
 }
 
@@ -293,6 +305,13 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
       r.pad = 0;
     }
   });
+  auto lap = [t = t0]() mutable {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+  };
+  bvh.stats_.refs_ms = lap();
   std::uint8_t any_bad = 0;
   for (std::uint8_t b : bad) any_bad |= b;
   if (any_bad & 1) throw InputError(source, "triangle index out of range");
@@ -373,11 +392,13 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
     }
   }
 
+  bvh.stats_.top_ms = lap();
   // Parallel phase: each task builds its subtree alone; chunk = 1 task.
-  std::vector<std::vector<TempNode>> sub(tasks.size());
+  std::vector<Subtree> sub(tasks.size());
   ex.parallel_for("bvh_subtrees", tasks.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t t = b; t < e; ++t) build_subtree(refs.data(), tasks[t], opt, sub[t]);
   });
+  bvh.stats_.subtrees_ms = lap();
 
   // Leaf triangles in ref order.
   bvh.triangles_.resize(tri_count);
@@ -390,52 +411,60 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
     }
   });
 
-  // Splice depth-first into the final binary layout.
+  // Splice depth-first into the final binary layout: a serial walk over the few top nodes
+  // places each subtree at its offset, then the subtrees are copied (shifting `right`) in
+  // parallel, one task per subtree.
   if (tri_count > 0) {
-    struct Ref {
-      const std::vector<TempNode>* list;
-      std::int64_t index;
-      std::uint32_t depth;
-      std::int64_t fix_right_of;  // final node whose `right` must point here (-1: none)
+    struct Placement {
+      std::size_t task;
+      std::uint32_t offset, depth;
     };
-    auto resolve = [&](const std::vector<TempNode>& list, std::int64_t idx, std::int64_t task) -> Ref {
-      if (task >= 0) return {&sub[static_cast<std::size_t>(task)], 0, 0, -1};
-      return {&list, idx, 0, -1};
+    std::vector<Placement> placements;
+    std::vector<std::pair<std::uint32_t, BinaryNode>> top_out;  // (final index, node)
+    std::uint32_t cursor = 0;
+    auto place_task = [&](std::int64_t task, std::uint32_t depth) {
+      const auto t = static_cast<std::size_t>(task);
+      placements.push_back({t, cursor, depth});
+      cursor += static_cast<std::uint32_t>(sub[t].nodes.size());
     };
-    std::size_t total = top.size();
-    for (const auto& v : sub) total += v.size();
-    bvh.binary_.reserve(total);
-    std::vector<Ref> stack{top[0].left_task >= 0 && top[0].left < 0
-                               ? Ref{&sub[static_cast<std::size_t>(top[0].left_task)], 0, 0, -1}
-                               : Ref{&top, 0, 0, -1}};
-    while (!stack.empty()) {
-      const Ref r = stack.back();
-      stack.pop_back();
-      const TempNode& n = (*r.list)[static_cast<std::size_t>(r.index)];
-      const auto me = static_cast<std::uint32_t>(bvh.binary_.size());
-      if (r.fix_right_of >= 0) bvh.binary_[static_cast<std::size_t>(r.fix_right_of)].right = me;
-      bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, r.depth);
-      BinaryNode out;
-      out.box = n.box;
-      if (n.count > 0) {
-        out.first = n.first;
-        out.count = n.count;
-        ++bvh.stats_.leaves;
-        bvh.binary_.push_back(out);
-        continue;
+    auto place_top = [&](auto&& self, std::size_t idx, std::uint32_t depth) -> void {
+      const TempNode& n = top[idx];
+      const std::uint32_t me = cursor++;
+      top_out.push_back({me, BinaryNode{}});
+      const std::size_t slot = top_out.size() - 1;
+      top_out[slot].second.box = n.box;
+      bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, depth);
+      if (n.left_task >= 0) place_task(n.left_task, depth + 1);
+      else self(self, static_cast<std::size_t>(n.left), depth + 1);
+      top_out[slot].second.right = cursor;
+      if (n.right_task >= 0) place_task(n.right_task, depth + 1);
+      else self(self, static_cast<std::size_t>(n.right), depth + 1);
+    };
+    if (top[0].left < 0) place_task(top[0].left_task, 0);  // the whole tree is one task
+    else place_top(place_top, 0, 0);
+    bvh.binary_.resize(cursor);
+    for (const auto& [index, node] : top_out) bvh.binary_[index] = node;
+    ex.parallel_for("bvh_splice", placements.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t p = b; p < e; ++p) {
+        const Placement& pl = placements[p];
+        const std::vector<BinaryNode>& nodes = sub[pl.task].nodes;
+        BinaryNode* out = bvh.binary_.data() + pl.offset;
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+          out[i] = nodes[i];
+          if (!nodes[i].is_leaf()) out[i].right += pl.offset;
+        }
       }
-      bvh.binary_.push_back(out);
-      Ref left = resolve(*r.list, n.left, n.left_task);
-      Ref right = resolve(*r.list, n.right, n.right_task);
-      left.depth = right.depth = r.depth + 1;
-      right.fix_right_of = me;
-      stack.push_back(right);
-      stack.push_back(left);
+    });
+    for (const Placement& pl : placements) {
+      bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, pl.depth + sub[pl.task].max_depth);
+      bvh.stats_.leaves += sub[pl.task].leaves;
     }
   }
   bvh.stats_.binary_nodes = bvh.binary_.size();
-  bvh.derive_layouts();
+  bvh.stats_.splice_ms = lap();
+  bvh.derive_layouts(ex);
   bvh.stats_.wide_nodes = bvh.wide_.size();
+  bvh.stats_.layouts_ms = lap();
   bvh.stats_.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return bvh;
@@ -469,7 +498,7 @@ void Bvh::refit(const std::vector<glm::vec3>& positions, const std::vector<std::
     }
     n.box = box;
   }
-  derive_layouts();
+  derive_layouts(ex);
 }
 
 }  // namespace speculum::trace

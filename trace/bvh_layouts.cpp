@@ -9,13 +9,16 @@
 
 namespace speculum::trace {
 
-void Bvh::derive_layouts() {
-  // Threaded: parents precede children, so a forward pass hands each child its miss link.
-  threaded_.assign(binary_.size(), ThreadedNode{});
-  if (!binary_.empty()) threaded_[0].miss = kThreadEnd;
-  for (std::size_t i = 0; i < binary_.size(); ++i) {
-    const BinaryNode& b = binary_[i];
-    ThreadedNode& t = threaded_[i];
+namespace {
+
+// The threaded layout: parents precede children, so a forward pass hands each child its
+// miss link.
+void derive_threaded(const std::vector<BinaryNode>& binary, std::vector<ThreadedNode>& threaded) {
+  threaded.resize(binary.size());
+  if (!binary.empty()) threaded[0].miss = kThreadEnd;
+  for (std::size_t i = 0; i < binary.size(); ++i) {
+    const BinaryNode& b = binary[i];
+    ThreadedNode& t = threaded[i];
     t.box = b.box;
     t.first = b.first;
     t.count = b.count;
@@ -23,37 +26,67 @@ void Bvh::derive_layouts() {
       t.hit = t.miss;
     } else {
       t.hit = static_cast<std::uint32_t>(i + 1);
-      threaded_[i + 1].miss = b.right;
-      threaded_[b.right].miss = t.miss;
+      threaded[i + 1].miss = b.right;
+      threaded[b.right].miss = t.miss;
     }
   }
+}
 
-  // Triangle packs: each binary leaf's triangles in groups of 4, in depth-first order.
-  packs_.clear();
-  std::vector<std::uint32_t> leaf_ref(binary_.size(), kEmptyChild);
+// One leaf's triangles as packs of 4 (unused lanes: NaN vertices, id kEmptyChild).
+void fill_packs(const std::vector<LeafTriangle>& tris, const std::vector<std::uint32_t>& ids, const BinaryNode& leaf,
+                TrianglePack* out) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::uint32_t npacks = (leaf.count + 3) / 4;
+  for (std::uint32_t p = 0; p < npacks; ++p) {
+    TrianglePack& pack = out[p];
+    for (int l = 0; l < 4; ++l) {
+      const std::uint32_t k = p * 4 + static_cast<std::uint32_t>(l);
+      const bool used = k < leaf.count;
+      const LeafTriangle t = used ? tris[leaf.first + k] : LeafTriangle{glm::vec3(nan), glm::vec3(nan), glm::vec3(nan)};
+      pack.ax[l] = t.a.x; pack.ay[l] = t.a.y; pack.az[l] = t.a.z;
+      pack.bx[l] = t.b.x; pack.by[l] = t.b.y; pack.bz[l] = t.b.z;
+      pack.cx[l] = t.c.x; pack.cy[l] = t.c.y; pack.cz[l] = t.c.z;
+      pack.id[l] = used ? ids[leaf.first + k] : kEmptyChild;
+    }
+  }
+}
+
+}  // namespace
+
+void Bvh::derive_layouts(par::Executor& ex) {
+  // Triangle packs: each binary leaf's triangles in groups of 4, in depth-first order. The
+  // pack offsets come from one serial pass; the packs (the bulk of the bytes) are written
+  // in parallel over fixed chunks of leaves.
+  std::vector<std::uint32_t> leaf_ref(binary_.size(), kEmptyChild);
+  std::vector<std::uint32_t> leaves;
+  leaves.reserve(stats_.leaves);
+  std::uint32_t pack_count = 0;
   for (std::size_t i = 0; i < binary_.size(); ++i) {
     const BinaryNode& b = binary_[i];
     if (!b.is_leaf()) continue;
-    const auto first_pack = static_cast<std::uint32_t>(packs_.size());
     const std::uint32_t npacks = (b.count + 3) / 4;
-    leaf_ref[i] = kLeafBit | (first_pack << 2) | (npacks - 1);
-    for (std::uint32_t p = 0; p < npacks; ++p) {
-      TrianglePack pack;
-      for (int l = 0; l < 4; ++l) {
-        const std::uint32_t k = p * 4 + static_cast<std::uint32_t>(l);
-        const bool used = k < b.count;
-        const LeafTriangle t = used ? triangles_[b.first + k] : LeafTriangle{glm::vec3(nan), glm::vec3(nan), glm::vec3(nan)};
-        pack.ax[l] = t.a.x; pack.ay[l] = t.a.y; pack.az[l] = t.a.z;
-        pack.bx[l] = t.b.x; pack.by[l] = t.b.y; pack.bz[l] = t.b.z;
-        pack.cx[l] = t.c.x; pack.cy[l] = t.c.y; pack.cz[l] = t.c.z;
-        pack.id[l] = used ? triangle_id_[b.first + k] : kEmptyChild;
-      }
-      packs_.push_back(pack);
-    }
+    leaf_ref[i] = kLeafBit | (pack_count << 2) | (npacks - 1);
+    leaves.push_back(static_cast<std::uint32_t>(i));
+    pack_count += npacks;
   }
+  packs_.resize(pack_count);
+  ex.parallel_for("bvh_triangle_packs", leaves.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const std::uint32_t ref = leaf_ref[leaves[k]];
+      fill_packs(triangles_, triangle_id_, binary_[leaves[k]], &packs_[(ref & ~kLeafBit) >> 2]);
+    }
+  });
+  stats_.triangle_packs = packs_.size();
 
-  // Wide: depth-first allocation, so a child's index is always larger than its parent's.
+  // The threaded layout and the wide collapse are independent: one task each.
+  ex.parallel_for("bvh_layouts", 2, 1, [&](std::size_t task, std::size_t) {
+    if (task == 0) derive_threaded(binary_, threaded_);
+    else derive_wide(leaf_ref);
+  });
+}
+
+// Wide: depth-first allocation, so a child's index is always larger than its parent's.
+void Bvh::derive_wide(const std::vector<std::uint32_t>& leaf_ref) {
   wide_.clear();
   wide_root_ = kEmptyChild;
   if (binary_.empty()) return;
@@ -61,6 +94,7 @@ void Bvh::derive_layouts() {
     wide_root_ = leaf_ref[0];
     return;
   }
+  wide_.reserve(binary_.size() / 2);
   struct Item {
     std::uint32_t binary;
     std::uint32_t parent;  // wide node to patch (kEmptyChild: root)

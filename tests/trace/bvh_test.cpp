@@ -109,6 +109,54 @@ TEST(Bvh, DegenerateSoupMatchesOracle) {
   EXPECT_GT(expect_matches_oracle(s, bvh, rays), 300);
 }
 
+// Axis-aligned rays whose origin lies exactly on box faces (a zero direction component
+// and an origin on the slab plane): a grid of unit floor tiles (z = 0) and a tiled wall
+// (x = 5), probed along the tile seams, with tmin > 0 as secondary rays have. Such rays
+// used to miss the boxes they graze (the slab ended at t = 0) in the threaded layout.
+TEST(Bvh, AxisAlignedRaysOnBoxFacesMatchOracle) {
+  Soup s;
+  for (int x = 0; x < 4; ++x)
+    for (int y = 0; y < 4; ++y) {
+      const glm::vec3 a(x, y, 0), b(x + 1, y, 0), c(x + 1, y + 1, 0), d(x, y + 1, 0);
+      s.add(a, b, c);
+      s.add(a, c, d);
+    }
+  for (int y = 0; y < 4; ++y)
+    for (int z = 0; z < 2; ++z) {
+      const glm::vec3 a(5, y, z), b(5, y + 1, z), c(5, y + 1, z + 1), d(5, y, z + 1);
+      s.add(a, b, c);
+      s.add(a, c, d);
+    }
+  par::Executor ex(1);
+  BvhBuildOptions one_per_leaf;
+  one_per_leaf.max_leaf_size = 1;  // a box per triangle: every seam is a box face
+  std::vector<Ray> rays;
+  for (int i = 0; i <= 8; ++i)
+    for (int j = 0; j <= 8; ++j) {
+      const float u = 0.5f * static_cast<float>(i), v = 0.5f * static_cast<float>(j);
+      for (float zero : {0.0f, -0.0f}) {
+        Ray down;  // straight down onto the floor: x and y on tile faces when integer
+        down.origin = glm::vec3(u, v, 2.0f);
+        down.direction = glm::vec3(zero, zero, -1.0f);
+        down.tmin = 1e-3f;
+        rays.push_back(down);
+        Ray up = down;  // from below the floor, upwards
+        up.origin.z = -1.0f;
+        up.direction.z = 1.0f;
+        rays.push_back(up);
+        Ray side;  // along +x onto the wall: y and z on tile faces when integer
+        side.origin = glm::vec3(4.5f, u * 0.5f, v * 0.25f);
+        side.direction = glm::vec3(1.0f, zero, zero);
+        side.tmin = 1e-3f;
+        rays.push_back(side);
+      }
+    }
+  for (const BvhBuildOptions& opt : {BvhBuildOptions{}, one_per_leaf}) {
+    const Bvh bvh = Bvh::build(s.positions, s.indices, ex, opt);
+    EXPECT_GT(expect_matches_oracle(s, bvh, rays), 300);
+  }
+}
+
 TEST(Bvh, RealMeshMatchesOracle) {
   const Soup s = testing::read_off("/usr/share/assimp/models/OFF/Wuson.off");
   if (s.indices.empty()) GTEST_SKIP() << "assimp-testmodels not installed";
