@@ -20,6 +20,7 @@ constexpr int kTilePixels = kTileSize * kTileSize;
 constexpr int kPad = 16;  // lanes may read/write past a row's end (never past the arrays)
 constexpr std::uint32_t kNoRef = 0xffffffffu;
 constexpr int kBlocksPerSide = kTileSize / kBlock;
+constexpr std::uint32_t kRefSwapped = 1u, kRefClipped = 2u;
 constexpr int kBlocksPerTile = kBlocksPerSide * kBlocksPerSide;
 // Interpolated 1/w = Σ λ_i/w_i may exceed the largest vertex 1/w by rounding (a few ulps of
 // three products and two sums); the rejection test widens the vertex maximum by far more.
@@ -43,6 +44,7 @@ struct TileScratch {
   bool hiz;
   std::vector<const SetupTriangle*> setup;  // per ref
   std::vector<const ClipMap*> clip_map;     // per ref
+  std::vector<std::uint32_t> flags;         // per ref: kRefSwapped | kRefClipped
 };
 
 // E_i(p) = A_i p.x + B_i p.y + C_i for the edge opposite vertex i, positive inside;
@@ -373,6 +375,88 @@ void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0
   }
 }
 
+// Writes sample `idx` of the tile (frame sample `o`): the winner's ids, depth and
+// barycentrics in the original triangle, or the empty-sample values.
+inline void resolve_sample(const TileScratch& s, int idx, std::size_t o,
+                           const std::vector<std::uint32_t>& triangle_object,
+                           VisibilityBuffer& out) {
+  const std::uint32_t ref = s.ref[idx];
+  if (ref == kNoRef) {
+    out.triangle.pixels[o] = kNoId;
+    out.object.pixels[o] = kNoId;
+    out.depth.pixels[o] = std::numeric_limits<float>::infinity();
+    out.bary.pixels[o] = glm::vec2(0.0f);
+    return;
+  }
+  const SetupTriangle* t = s.setup[ref];
+  const float inv_w = s.inv_w[idx];
+  float b1 = s.p1[idx] / inv_w, b2 = s.p2[idx] / inv_w;
+  if (t->swapped) std::swap(b1, b2);
+  if (const ClipMap* m = s.clip_map[ref]) {
+    const float b0 = 1.0f - b1 - b2;
+    const glm::vec3 b = b0 * m->bary[0] + b1 * m->bary[1] + b2 * m->bary[2];
+    b1 = b.y, b2 = b.z;
+  }
+  out.triangle.pixels[o] = t->triangle;
+  out.object.pixels[o] = triangle_object[t->triangle];
+  out.depth.pixels[o] = 1.0f / inv_w;
+  out.bary.pixels[o] = glm::vec2(b1, b2);
+}
+
+// The resolve 8 samples at a time: the same IEEE divisions as resolve_sample (so the same
+// bits), the winners' object ids gathered, clipped winners and the row tail left to
+// resolve_sample.
+void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
+                       const Viewport& vp, const std::vector<std::uint32_t>& triangle_object,
+                       VisibilityBuffer& out) {
+  const __m256i no_ref = _mm256_set1_epi32(-1);
+  const __m256 one = _mm256_set1_ps(1.0f);
+  const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+  const int* flags = reinterpret_cast<const int*>(s.flags.data());
+  const int* objects = reinterpret_cast<const int*>(triangle_object.data());
+  const int full = (tx1 - tx0 + 1) / 8 * 8;
+  for (int y = ty0; y <= ty1; ++y) {
+    const int row = (y - ty0) * kTileSize;
+    const std::size_t orow = static_cast<std::size_t>(y) * vp.width + tx0;
+    for (int x = 0; x < full; x += 8) {
+      const int idx = row + x;
+      const std::size_t o = orow + x;
+      const __m256i ref = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.ref[idx]));
+      const __m256i valid = _mm256_xor_si256(_mm256_cmpeq_epi32(ref, no_ref), no_ref);
+      const __m256i flag =
+          _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), flags, ref, valid, 4);
+      const __m256i clipped =
+          _mm256_cmpeq_epi32(_mm256_and_si256(flag, _mm256_set1_epi32(int(kRefClipped))),
+                             _mm256_set1_epi32(int(kRefClipped)));
+      const __m256 swapped = _mm256_castsi256_ps(
+          _mm256_cmpeq_epi32(_mm256_and_si256(flag, _mm256_set1_epi32(int(kRefSwapped))),
+                             _mm256_set1_epi32(int(kRefSwapped))));
+      const __m256i tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.triangle[idx]));
+      const __m256i object = _mm256_mask_i32gather_epi32(no_ref, objects, tri, valid, 4);
+      const __m256 inv_w = _mm256_loadu_ps(&s.inv_w[idx]);
+      const __m256 q1 = _mm256_div_ps(_mm256_loadu_ps(&s.p1[idx]), inv_w);
+      const __m256 q2 = _mm256_div_ps(_mm256_loadu_ps(&s.p2[idx]), inv_w);
+      const __m256 validf = _mm256_castsi256_ps(valid);
+      const __m256 b1 = _mm256_and_ps(validf, _mm256_blendv_ps(q1, q2, swapped));
+      const __m256 b2 = _mm256_and_ps(validf, _mm256_blendv_ps(q2, q1, swapped));
+      const __m256 depth = _mm256_blendv_ps(inf, _mm256_div_ps(one, inv_w), validf);
+      // Empty samples keep kNoId in s.triangle (never won).
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&out.triangle.pixels[o]), tri);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&out.object.pixels[o]), object);
+      _mm256_storeu_ps(&out.depth.pixels[o], depth);
+      const __m256 lo = _mm256_unpacklo_ps(b1, b2), hi = _mm256_unpackhi_ps(b1, b2);
+      float* bary = &out.bary.pixels[o].x;
+      _mm256_storeu_ps(bary, _mm256_permute2f128_ps(lo, hi, 0x20));
+      _mm256_storeu_ps(bary + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
+      if (const int c = _mm256_movemask_ps(_mm256_castsi256_ps(clipped)); c != 0)
+        for (int l = 0; l < 8; ++l)
+          if (c & (1 << l)) resolve_sample(s, idx + l, o + l, triangle_object, out);
+    }
+    for (int x = full; x <= tx1 - tx0; ++x)
+      resolve_sample(s, row + x, orow + x, triangle_object, out);
+  }
+}
+
 template <int W>
 void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
                       const std::vector<BinnedChunk>& chunks,
@@ -387,6 +471,7 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
   std::fill(std::begin(s.ref), std::end(s.ref), kNoRef);
   s.setup.clear();
   s.clip_map.clear();
+  s.flags.clear();
   s.count_coverage = !out.coverage.empty();
   s.hiz = !s.count_coverage;
   std::fill(std::begin(s.block_min), std::end(s.block_min), 0.0f);
@@ -399,11 +484,16 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
       const auto ref = static_cast<std::uint32_t>(s.setup.size());
       s.setup.push_back(&t);
       s.clip_map.push_back(t.clip_map >= 0 ? &chunk.clip_maps[t.clip_map] : nullptr);
+      s.flags.push_back((t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u));
       raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);
     }
   }
 
   // Resolve: barycentrics only for the winners (deferred, like a visibility buffer).
+  if (W == 8 && !s.count_coverage) {
+    resolve_tile_avx2(s, tx0, ty0, tx1, ty1, vp, triangle_object, out);
+    return;
+  }
   for (int y = ty0; y <= ty1; ++y) {
     for (int x = tx0; x <= tx1; ++x) {
       const int idx = (y - ty0) * kTileSize + (x - tx0);
@@ -412,29 +502,9 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
       constexpr int kPrefetchAhead = 8;
       if (const std::uint32_t ahead = s.ref[idx + kPrefetchAhead]; ahead != kNoRef)
         __builtin_prefetch(&triangle_object[s.setup[ahead]->triangle]);
-      const std::uint32_t ref = s.ref[idx];
-      const SetupTriangle* t = ref == kNoRef ? nullptr : s.setup[ref];
       const std::size_t o = static_cast<std::size_t>(y) * vp.width + x;
       if (s.count_coverage) out.coverage.pixels[o] = s.coverage[idx];
-      if (!t) {
-        out.triangle.pixels[o] = kNoId;
-        out.object.pixels[o] = kNoId;
-        out.depth.pixels[o] = std::numeric_limits<float>::infinity();
-        out.bary.pixels[o] = glm::vec2(0.0f);
-        continue;
-      }
-      const float inv_w = s.inv_w[idx];
-      float b1 = s.p1[idx] / inv_w, b2 = s.p2[idx] / inv_w;
-      if (t->swapped) std::swap(b1, b2);
-      if (const ClipMap* m = s.clip_map[ref]) {
-        const float b0 = 1.0f - b1 - b2;
-        const glm::vec3 b = b0 * m->bary[0] + b1 * m->bary[1] + b2 * m->bary[2];
-        b1 = b.y, b2 = b.z;
-      }
-      out.triangle.pixels[o] = t->triangle;
-      out.object.pixels[o] = triangle_object[t->triangle];
-      out.depth.pixels[o] = 1.0f / inv_w;
-      out.bary.pixels[o] = glm::vec2(b1, b2);
+      resolve_sample(s, idx, o, triangle_object, out);
     }
   }
 }
