@@ -8,8 +8,13 @@
 #include <cstdint>
 #include <vector>
 
+#include <immintrin.h>
+
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
+
+#include "core/error.h"
+#include "raster/gbuffer_stream.h"
 
 namespace speculum::raster {
 namespace {
@@ -42,70 +47,161 @@ void ensure_size(Buffer2D<T>& b, int width, int height) {
   if (b.width != width || b.height != height) b = Buffer2D<T>(width, height);
 }
 
+// Samples resolved per staging block: 64 makes every plane's share of a block a whole
+// number of cache lines (4, 8, 12 and 44 bytes per sample).
+constexpr std::size_t kBlock = 64;
+// Frames at least this large (≈ 22 MB of G-buffer) are written with streaming stores: they
+// cannot stay cached until a consumer reads them anyway. Smaller ones (cube-map faces) stay
+// in cache for the next node.
+constexpr std::size_t kStreamingMinSamples = std::size_t(1) << 18;
+// How many samples ahead the triangle data of a sample is prefetched: enough to cover a
+// DRAM miss at a few ns per sample.
+constexpr std::size_t kPrefetchAhead = 24;
+
+// What a sample needs of its material, looked up once per frame.
+struct MaterialInfo {
+  SurfaceParams constant;      // the parameters of untextured materials
+  bool textured = false;       // parameters vary with uv: evaluate per sample
+  bool normal_mapped = false;
+};
+
 struct SampleContext {
   const Scene& scene;
   const TriangleMesh& m;
   const VisibilityBuffer& vis;
   const glm::vec3& eye;
-  const std::vector<SurfaceParams>& constant_params;
-  const std::vector<std::uint8_t>& textured;
-  const std::vector<std::uint8_t>& normal_mapped;
+  const std::vector<MaterialInfo>& materials;
 };
 
-// Resolves visibility sample i into g (only the ids on background).
-inline void resolve_sample(const SampleContext& c, std::size_t i, GBuffer& g) {
-  const std::uint32_t t = c.vis.triangle.pixels[i];
-  const std::uint32_t object = c.vis.object.pixels[i];
-  g.object.pixels[i] = object;
-  if (t == kNoId) {
-    g.reflector.pixels[i] = kNoId;
-    return;
+struct alignas(64) StagingBlock {
+  std::uint32_t object[kBlock];
+  glm::vec3 position[kBlock];
+  glm::vec3 normal[kBlock];
+  glm::vec2 uv[kBlock];
+  SurfaceParams surface[kBlock];
+  std::uint32_t reflector[kBlock];
+};
+
+// Triangle data straight from the mesh arrays (no prepared records).
+struct MeshCorners {
+  const TriangleMesh& m;
+  TriangleRecord operator()(std::uint32_t t) const {
+    TriangleRecord r;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = m.indices[3 * t + k];
+      r.position[k] = m.positions[v];
+      r.normal[k] = m.normals[v];
+      r.uv[k] = m.uvs[v];
+    }
+    r.material = m.triangle_material[t];
+    return r;
   }
-  const TriangleMesh& m = c.m;
-  const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+  void prefetch(std::uint32_t t) const {
+    _mm_prefetch(reinterpret_cast<const char*>(m.indices.data() + 3 * std::size_t(t)), _MM_HINT_T0);
+  }
+};
+
+// Triangle data from the scene-static records (gbuffer_triangles.h).
+struct RecordCorners {
+  const TriangleRecord* records;
+  const TriangleRecord& operator()(std::uint32_t t) const { return records[t]; }
+  void prefetch(std::uint32_t t) const {
+    const char* p = reinterpret_cast<const char*>(records + t);
+    _mm_prefetch(p, _MM_HINT_T0);
+    _mm_prefetch(p + 64, _MM_HINT_T0);
+  }
+};
+
+// Resolves covered visibility sample i of triangle t (corners r) into slot j of the block.
+inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t t,
+                           const TriangleRecord& r, StagingBlock& out, std::size_t j) {
+  const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
   const float b0 = 1.0f - b.x - b.y;
-  auto lerp3 = [&](const auto& a) { return b0 * a[i0] + b.x * a[i1] + b.y * a[i2]; };
-  const glm::vec3 p = lerp3(m.positions);
-  glm::vec3 n = lerp3(m.normals);
+  auto lerp3 = [&](const auto& a) { return b0 * a[0] + b.x * a[1] + b.y * a[2]; };
+  const glm::vec3 p = lerp3(r.position);
+  glm::vec3 n = lerp3(r.normal);
   const float nl = glm::length(n);
   if (nl > 1e-12f) {
     n = n / nl;
   } else {  // degenerate interpolated normal: fall back to the face normal
-    n = glm::normalize(
-        glm::cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]));
+    n = glm::normalize(glm::cross(r.position[1] - r.position[0], r.position[2] - r.position[0]));
   }
-  const glm::vec2 uv = lerp3(m.uvs);
-  const std::uint32_t mat = m.triangle_material[t];
-  const bool textured = c.textured[mat] != 0, normal_mapped = c.normal_mapped[mat] != 0;
-  const glm::vec2 uv1 =
-      (textured || normal_mapped) && !m.uvs1.empty() ? lerp3(m.uvs1) : glm::vec2(0.0f);
-  if (normal_mapped)
-    n = apply_normal_map(c.scene, c.scene.materials[mat], n, lerp3(m.tangents), uv, uv1);
-  SurfaceParams& sp = g.surface.pixels[i];
-  sp = textured ? surface_params(c.scene, mat, uv, uv1) : c.constant_params[mat];
+  const glm::vec2 uv = lerp3(r.uv);
+  const std::uint32_t mat = r.material;
+  const MaterialInfo& info = c.materials[mat];
+  SurfaceParams& sp = out.surface[j];
+  if (info.textured || info.normal_mapped) {  // rare: the extra vertex streams come from the mesh
+    const TriangleMesh& m = c.m;
+    const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+    auto lerp_mesh = [&](const auto& a) { return b0 * a[i0] + b.x * a[i1] + b.y * a[i2]; };
+    const glm::vec2 uv1 = !m.uvs1.empty() ? lerp_mesh(m.uvs1) : glm::vec2(0.0f);
+    if (info.normal_mapped)
+      n = apply_normal_map(c.scene, c.scene.materials[mat], n, lerp_mesh(m.tangents), uv, uv1);
+    sp = info.textured ? surface_params(c.scene, mat, uv, uv1) : info.constant;
+  } else {
+    sp = info.constant;
+  }
   // Opaque surfaces are shaded on the side the camera sees (double-sided or not, a visible
   // back face would otherwise shade black); refractors keep their orientation so the
   // reflection node knows whether the ray enters or leaves. Only the sign of N·V matters,
   // so V is not normalized.
   if (!sp.is_refractor() && glm::dot(n, c.eye - p) < 0.0f) n = -n;
-  g.position.pixels[i] = p;
-  g.normal.pixels[i] = n;
-  g.uv.pixels[i] = uv;
-  g.reflector.pixels[i] = is_specular(sp) ? object : kNoId;
+  out.object[j] = object;
+  out.position[j] = p;
+  out.normal[j] = n;
+  out.uv[j] = uv;
+  out.reflector[j] = is_specular(sp) ? object : kNoId;
 }
 
-}  // namespace
-
-GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
-                        const glm::vec3& eye) {
-  GBuffer g;
-  resolve_gbuffer(executor, scene, vis, eye, g);
-  return g;
+// Background samples get the ids and the planes' default values, so every byte of the
+// G-buffer is defined (and the same for any thread count) whatever the buffer held before.
+inline void resolve_background(const SampleContext& c, std::size_t i, StagingBlock& out,
+                               std::size_t j) {
+  out.object[j] = c.vis.object.pixels[i];
+  out.position[j] = glm::vec3(0.0f);
+  out.normal[j] = glm::vec3(0.0f);
+  out.uv[j] = glm::vec2(0.0f);
+  out.surface[j] = SurfaceParams{};
+  out.reflector[j] = kNoId;
 }
 
-void resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
-                     const glm::vec3& eye, GBuffer& g) {
+template <class T>
+void store_plane(Buffer2D<T>& plane, std::size_t begin, const T* src, std::size_t n, bool stream) {
+  detail::store_block(plane.pixels.data() + begin, src, n * sizeof(T), stream);
+}
+
+// Resolves samples [begin, end) block by block; `corners` fetches and prefetches triangles.
+template <class Corners>
+void resolve_range(const SampleContext& c, const Corners& corners, std::size_t begin,
+                   std::size_t end, bool stream, GBuffer& g) {
+  StagingBlock blk;
+  const std::uint32_t* tri = c.vis.triangle.pixels.data();
+  const std::size_t total = c.vis.triangle.size();
+  for (std::size_t t = begin; t < std::min(begin + kPrefetchAhead, total); ++t)
+    if (tri[t] != kNoId) corners.prefetch(tri[t]);
+  for (std::size_t b = begin; b < end; b += kBlock) {
+    const std::size_t n = std::min(kBlock, end - b);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::size_t i = b + j;
+      if (i + kPrefetchAhead < total && tri[i + kPrefetchAhead] != kNoId)
+        corners.prefetch(tri[i + kPrefetchAhead]);
+      const std::uint32_t t = tri[i];
+      if (t == kNoId) resolve_background(c, i, blk, j);
+      else resolve_sample(c, i, t, corners(t), blk, j);
+    }
+    store_plane(g.object, b, blk.object, n, stream);
+    store_plane(g.position, b, blk.position, n, stream);
+    store_plane(g.normal, b, blk.normal, n, stream);
+    store_plane(g.uv, b, blk.uv, n, stream);
+    store_plane(g.surface, b, blk.surface, n, stream);
+    store_plane(g.reflector, b, blk.reflector, n, stream);
+  }
+  detail::end_stores(stream);
+}
+
+void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles* records,
+             const VisibilityBuffer& vis, const glm::vec3& eye, GBuffer& g) {
   const int w = vis.width, h = vis.height;
   g.width = w;
   g.height = h;
@@ -118,19 +214,51 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visibili
   ensure_size(g.reflector, w, h);
   const TriangleMesh& m = scene.mesh;
   // Untextured materials have the same parameters everywhere: evaluate them once.
-  std::vector<SurfaceParams> constant_params;
-  std::vector<std::uint8_t> textured, normal_mapped;
+  std::vector<MaterialInfo> materials;
   for (const Material& mat : scene.materials) {
-    constant_params.push_back(surface_params(mat));
-    textured.push_back(mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
-                       mat.emissive_texture.valid() || mat.transmission_texture.valid());
-    normal_mapped.push_back(!m.tangents.empty() && mat.normal_texture.valid());
+    MaterialInfo info;
+    info.constant = surface_params(mat);
+    info.textured = mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
+                    mat.emissive_texture.valid() || mat.transmission_texture.valid();
+    info.normal_mapped = !m.tangents.empty() && mat.normal_texture.valid();
+    materials.push_back(info);
   }
-  const SampleContext ctx{scene, m, vis, eye, constant_params, textured, normal_mapped};
-  executor.parallel_for("gbuffer.resolve", vis.triangle.size(), kPixelChunk,
-                        [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) resolve_sample(ctx, i, g);
-  });
+  const SampleContext ctx{scene, m, vis, eye, materials};
+  const bool stream = vis.triangle.size() >= kStreamingMinSamples;
+  if (records) {
+    const RecordCorners corners{records->data()};
+    executor.parallel_for("gbuffer.resolve", vis.triangle.size(), kPixelChunk,
+                          [&](std::size_t begin, std::size_t end) {
+      resolve_range(ctx, corners, begin, end, stream, g);
+    });
+  } else {
+    const MeshCorners corners{m};
+    executor.parallel_for("gbuffer.resolve", vis.triangle.size(), kPixelChunk,
+                          [&](std::size_t begin, std::size_t end) {
+      resolve_range(ctx, corners, begin, end, stream, g);
+    });
+  }
+}
+
+}  // namespace
+
+GBuffer resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
+                        const glm::vec3& eye) {
+  GBuffer g;
+  resolve(executor, scene, nullptr, vis, eye, g);
+  return g;
+}
+
+void resolve_gbuffer(par::Executor& executor, const Scene& scene, const VisibilityBuffer& vis,
+                     const glm::vec3& eye, GBuffer& g) {
+  resolve(executor, scene, nullptr, vis, eye, g);
+}
+
+void resolve_gbuffer(par::Executor& executor, const Scene& scene, const GBufferTriangles& triangles,
+                     const VisibilityBuffer& vis, const glm::vec3& eye, GBuffer& g) {
+  if (!triangles.matches(scene.mesh))
+    throw InputError(scene.name, "G-buffer triangle records were built from another mesh");
+  resolve(executor, scene, &triangles, vis, eye, g);
 }
 
 ImageF specular_level_image(const GBuffer& g) {

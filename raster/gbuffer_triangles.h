@@ -1,0 +1,55 @@
+// The scene-static input of the `gbuffer` node: one interleaved 128-byte record per triangle
+// (corner positions, normals, uvs and the material) built once per static scene, like a
+// GPU's vertex-buffer upload (issue 4 "Nodes", gbuffer; DESIGN.md "Stream constraints").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/scene.h"
+#include "parallel/executor.h"
+#include "parallel/page_buffer.h"
+
+namespace speculum::raster {
+
+// The three corners of one triangle, copied bit for bit from the mesh arrays, so the resolve
+// reads two adjacent cache lines (one prefetchable unit) instead of chasing indices → vertex
+// arrays through five separate allocations.
+struct alignas(64) TriangleRecord {
+  glm::vec3 position[3];
+  glm::vec3 normal[3];
+  glm::vec2 uv[3];
+  std::uint32_t material = 0;
+  std::uint32_t unused[7] = {};
+};
+static_assert(sizeof(TriangleRecord) == 128);
+
+// The records of one mesh in huge-page-backed memory (random gathers over 100+ MB would
+// otherwise miss the TLB on nearly every sample). Valid only while the mesh is unchanged:
+// rebuild it after editing the scene.
+class GBufferTriangles {
+ public:
+  GBufferTriangles() = default;
+  // Builds the records of scene.mesh (named launch "gbuffer.prepare").
+  GBufferTriangles(par::Executor& executor, const Scene& scene);
+
+  std::size_t size() const { return count_; }
+  const TriangleRecord* data() const { return records_; }
+  const TriangleRecord& operator[](std::size_t t) const { return records_[t]; }
+  // True if built from a mesh with this many triangles and vertices (a cheap guard against
+  // passing the records of another scene).
+  bool matches(const TriangleMesh& mesh) const {
+    return count_ == mesh.triangle_count() && vertices_ == mesh.vertex_count();
+  }
+
+ private:
+  par::PageBuffer memory_;
+  const TriangleRecord* records_ = nullptr;
+  std::size_t count_ = 0;
+  std::size_t vertices_ = 0;
+};
+
+}  // namespace speculum::raster
