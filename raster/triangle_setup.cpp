@@ -6,7 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
+
+#include <immintrin.h>
 
 namespace speculum::raster {
 namespace {
@@ -160,6 +163,99 @@ inline ScreenVertex screen_vertex(const glm::vec4& clip, const Viewport& vp, con
   return v;
 }
 
+// 8 vertices of the vertex stage at a time: the same IEEE operations as
+// `view_projection * vec4(p, 1)` (glm sums (m0·x + m1·y) + (m2·z + m3·1)), screen_vertex and
+// project_and_snap, in the same order, so every field has the same bits.
+inline void screen_vertices_avx2(const glm::mat4& m, const glm::vec3* p, const Viewport& vp,
+                                 const GuardBand& g, ScreenVertex* out) {
+  static_assert(sizeof(ScreenVertex) == 32, "8 fields of 4 bytes, transposed below");
+  const float* base = &p[0].x;
+  const __m256i stride = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
+  const __m256 px = _mm256_i32gather_ps(base, stride, 4);
+  const __m256 py = _mm256_i32gather_ps(base + 1, stride, 4);
+  const __m256 pz = _mm256_i32gather_ps(base + 2, stride, 4);
+  __m256 c[4];
+  for (int r = 0; r < 4; ++r) {
+    const __m256 xy = _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(m[0][r]), px),
+                                    _mm256_mul_ps(_mm256_set1_ps(m[1][r]), py));
+    const __m256 zw = _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(m[2][r]), pz),
+                                    _mm256_mul_ps(_mm256_set1_ps(m[3][r]), _mm256_set1_ps(1.0f)));
+    c[r] = _mm256_add_ps(xy, zw);
+  }
+  const __m256 x = c[0], y = c[1], z = c[2], w = c[3];
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 neg_w = _mm256_sub_ps(zero, w);
+  auto bit = [](__m256 m, int b) {
+    return _mm256_and_si256(_mm256_castps_si256(m), _mm256_set1_epi32(b));
+  };
+  __m256i outcode = _mm256_or_si256(
+      _mm256_or_si256(bit(_mm256_cmp_ps(x, neg_w, _CMP_LT_OQ), 1), bit(_mm256_cmp_ps(x, w, _CMP_GT_OQ), 2)),
+      _mm256_or_si256(bit(_mm256_cmp_ps(y, neg_w, _CMP_LT_OQ), 4), bit(_mm256_cmp_ps(y, w, _CMP_GT_OQ), 8)));
+  outcode = _mm256_or_si256(
+      outcode, _mm256_or_si256(bit(_mm256_cmp_ps(z, neg_w, _CMP_LT_OQ), 16),
+                               bit(_mm256_cmp_ps(z, w, _CMP_GT_OQ), 32)));
+  // Inside: w > 0 and every plane distance of plane_distance() >= 0 (false on NaN).
+  const __m256 gx = _mm256_set1_ps(g.gx), gy = _mm256_set1_ps(g.gy);
+  auto ge0 = [&](__m256 d) { return _mm256_cmp_ps(d, zero, _CMP_GE_OQ); };
+  __m256 inside = _mm256_and_ps(_mm256_cmp_ps(w, zero, _CMP_GT_OQ),
+                                _mm256_and_ps(ge0(_mm256_add_ps(z, w)), ge0(_mm256_sub_ps(w, z))));
+  inside = _mm256_and_ps(inside, _mm256_and_ps(ge0(_mm256_add_ps(x, _mm256_mul_ps(gx, w))),
+                                               ge0(_mm256_sub_ps(_mm256_mul_ps(gx, w), x))));
+  inside = _mm256_and_ps(inside, _mm256_and_ps(ge0(_mm256_add_ps(y, _mm256_mul_ps(gy, w))),
+                                               ge0(_mm256_sub_ps(_mm256_mul_ps(gy, w), y))));
+  // project_and_snap.
+  const __m256 half = _mm256_set1_ps(0.5f);
+  const __m256 inv_w = _mm256_div_ps(_mm256_set1_ps(1.0f), w);
+  const __m256 sx = _mm256_mul_ps(
+      _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(x, inv_w), half), half),
+      _mm256_set1_ps(static_cast<float>(vp.width)));
+  const __m256 sy = _mm256_mul_ps(
+      _mm256_sub_ps(half, _mm256_mul_ps(_mm256_mul_ps(y, inv_w), half)),
+      _mm256_set1_ps(static_cast<float>(vp.height)));
+  constexpr float kLimit = 4.0f * kGuardBandPixels + 65536.0f;
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 limit = _mm256_set1_ps(kLimit);
+  const __m256 finite_inv_w = _mm256_cmp_ps(_mm256_and_ps(inv_w, abs_mask),
+                                            _mm256_set1_ps(std::numeric_limits<float>::infinity()),
+                                            _CMP_LT_OQ);
+  const __m256 snappable = _mm256_and_ps(
+      _mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(sx, abs_mask), limit, _CMP_LT_OQ),
+                    _mm256_cmp_ps(_mm256_and_ps(sy, abs_mask), limit, _CMP_LT_OQ)),
+      _mm256_and_ps(_mm256_cmp_ps(inv_w, zero, _CMP_GT_OQ), finite_inv_w));
+  const __m256 one_sub = _mm256_set1_ps(static_cast<float>(kSubpixelOne));
+  constexpr int kNearest = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
+  const __m256i fx = _mm256_cvttps_epi32(_mm256_round_ps(_mm256_mul_ps(sx, one_sub), kNearest));
+  const __m256i fy = _mm256_cvttps_epi32(_mm256_round_ps(_mm256_mul_ps(sy, one_sub), kNearest));
+  const __m256 snapped = _mm256_and_ps(inside, snappable);
+  const __m256i snapped_i = _mm256_castps_si256(snapped);
+  // Not inside: x, y, inv_w stay 0; inside but not snappable: inv_w was already written.
+  const __m256 out_x = _mm256_and_ps(_mm256_castsi256_ps(fx), snapped);
+  const __m256 out_y = _mm256_and_ps(_mm256_castsi256_ps(fy), snapped);
+  const __m256 out_w = _mm256_and_ps(inv_w, inside);
+  outcode = _mm256_or_si256(outcode,
+                            _mm256_andnot_si256(snapped_i, _mm256_set1_epi32(int(kNeedsClip))));
+  // 8×8 transpose: row k = the 8 fields of vertex k.
+  __m256 r0 = x, r1 = y, r2 = z, r3 = w, r4 = out_x, r5 = out_y, r6 = out_w,
+         r7 = _mm256_castsi256_ps(outcode);
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+  const __m256 t4 = _mm256_unpacklo_ps(r4, r5), t5 = _mm256_unpackhi_ps(r4, r5);
+  const __m256 t6 = _mm256_unpacklo_ps(r6, r7), t7 = _mm256_unpackhi_ps(r6, r7);
+  const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xee);
+  const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xee);
+  const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xee);
+  const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xee);
+  float* o = reinterpret_cast<float*>(out);
+  _mm256_storeu_ps(o + 0, _mm256_permute2f128_ps(u0, u4, 0x20));
+  _mm256_storeu_ps(o + 8, _mm256_permute2f128_ps(u1, u5, 0x20));
+  _mm256_storeu_ps(o + 16, _mm256_permute2f128_ps(u2, u6, 0x20));
+  _mm256_storeu_ps(o + 24, _mm256_permute2f128_ps(u3, u7, 0x20));
+  _mm256_storeu_ps(o + 32, _mm256_permute2f128_ps(u0, u4, 0x31));
+  _mm256_storeu_ps(o + 40, _mm256_permute2f128_ps(u1, u5, 0x31));
+  _mm256_storeu_ps(o + 48, _mm256_permute2f128_ps(u2, u6, 0x31));
+  _mm256_storeu_ps(o + 56, _mm256_permute2f128_ps(u3, u7, 0x31));
+}
+
 }  // namespace
 
 ScreenVertex make_screen_vertex(const glm::vec4& clip, const Viewport& vp) {
@@ -169,7 +265,10 @@ ScreenVertex make_screen_vertex(const glm::vec4& clip, const Viewport& vp) {
 void make_screen_vertices(const glm::mat4& view_projection, const glm::vec3* positions,
                           std::size_t count, const Viewport& vp, ScreenVertex* out) {
   const GuardBand g = guard_band(vp);
-  for (std::size_t i = 0; i < count; ++i)
+  const std::size_t wide = count / 8 * 8;
+  for (std::size_t i = 0; i < wide; i += 8)
+    screen_vertices_avx2(view_projection, positions + i, vp, g, out + i);
+  for (std::size_t i = wide; i < count; ++i)
     out[i] = screen_vertex(view_projection * glm::vec4(positions[i], 1.0f), vp, g);
 }
 

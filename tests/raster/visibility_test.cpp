@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "core/camera_rays.h"
 #include "core/error.h"
 #include "raster_test_scenes.h"
 
@@ -315,6 +316,46 @@ TEST(RasterInput, OverflowingCoordinatesAreDroppedNotUndefined) {
   const auto b = render_visibility(ex, with_huge, cam, 64, 64);
   for (std::size_t i = 0; i < a.triangle.size(); ++i)
     if (b.triangle.pixels[i] != 1u) EXPECT_EQ(a.triangle.pixels[i], b.triangle.pixels[i]);
+}
+
+}  // namespace
+}  // namespace speculum::raster
+
+namespace speculum::raster {
+namespace {
+
+// The batched vertex stage (8 vertices per AVX2 step plus a scalar tail) must give every
+// vertex the bytes of the one-vertex function, including vertices behind the eye, outside
+// the guard band, exactly on clip planes and overflowing to inf/NaN.
+TEST(RasterVertexStage, BatchedEqualsOneVertexFunctionBitForBit) {
+  Camera cam;
+  cam.eye = {0.3f, 0.2f, 3.0f};
+  cam.znear = 0.1f;
+  cam.zfar = 50.0f;
+  const int width = 333, height = 250;
+  const glm::mat4 vp = projection_matrix(cam, width, height) * view_matrix(cam);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> near_box(-4.0f, 4.0f), far_box(-3000.0f, 3000.0f);
+  std::vector<glm::vec3> positions;
+  for (int i = 0; i < 997; ++i)  // not a multiple of 8: exercises the tail
+    positions.push_back(i % 3 ? glm::vec3(near_box(rng), near_box(rng), near_box(rng))
+                              : glm::vec3(far_box(rng), far_box(rng), far_box(rng)));
+  positions.push_back(cam.eye);                        // w = 0
+  positions.push_back({0.3f, 0.2f, 3.0f - cam.znear}); // on the near plane
+  positions.push_back({3e38f, 0.0f, 0.0f});            // overflows to inf
+  positions.push_back({-3e38f, 3e38f, -3e38f});
+  positions.push_back({std::nanf(""), 0.0f, 0.0f});
+  const Viewport viewport{width, height};
+  std::vector<ScreenVertex> batched(positions.size());
+  make_screen_vertices(vp, positions.data(), positions.size(), viewport, batched.data());
+  std::size_t needs_clip = 0, snapped = 0;
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const ScreenVertex one = make_screen_vertex(vp * glm::vec4(positions[i], 1.0f), viewport);
+    EXPECT_EQ(0, std::memcmp(&one, &batched[i], sizeof(ScreenVertex))) << i;
+    (one.outcode & kNeedsClip ? needs_clip : snapped) += 1;
+  }
+  EXPECT_GT(needs_clip, 50u);  // both outcomes are exercised
+  EXPECT_GT(snapped, 300u);
 }
 
 }  // namespace
