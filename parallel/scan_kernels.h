@@ -111,12 +111,12 @@ std::uint32_t scan_sum32(const std::uint32_t* in, std::uint32_t* out, std::size_
     const __m256i x0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i));
     const __m256i x1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i + 8));
     const __m256i p0 = prefix8(x0);
-    // Both halves' prefixes are independent of carry: the loop-carried chain is one add
-    // and one lane broadcast per 16 elements.
+    // Everything but the carry update is independent of the carry, so the loop-carried
+    // chain is one add per 16 elements (a cross-lane broadcast in it would cost its latency).
     const __m256i p1 = _mm256_add_epi32(prefix8(x1), _mm256_permutevar8x32_epi32(p0, last));
     __m256i s0 = _mm256_add_epi32(p0, carry);
     __m256i s1 = _mm256_add_epi32(p1, carry);
-    carry = _mm256_permutevar8x32_epi32(s1, last);
+    carry = _mm256_add_epi32(carry, _mm256_permutevar8x32_epi32(p1, last));
     if constexpr (!Inclusive) {
       s0 = _mm256_sub_epi32(s0, x0);
       s1 = _mm256_sub_epi32(s1, x1);
