@@ -285,4 +285,59 @@ void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const Screen
        cull_sign, nullptr, out, clip_maps);
 }
 
+void setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
+                     std::size_t begin, std::size_t end, const std::uint32_t* triangle_object,
+                     const std::vector<std::uint8_t>& excluded, const Viewport& vp,
+                     int cull_sign, std::vector<SetupTriangle>& out,
+                     std::vector<ClipMap>& clip_maps) {
+  // Room for one triangle per remaining input; only clipping can emit more (then the
+  // vector is resized around the clipped triangle's appends).
+  std::size_t n = out.size();
+  out.resize(n + (end - begin));
+  SetupTriangle* dst = out.data();
+  const int half = kSubpixelOne / 2;
+  for (std::size_t t = begin; t < end; ++t) {
+    if (!excluded.empty()) {
+      const std::uint32_t object = triangle_object[t];
+      if (object < excluded.size() && excluded[object]) continue;
+    }
+    const std::uint32_t* idx = &indices[3 * t];
+    const ScreenVertex& v0 = vertices[idx[0]];
+    const ScreenVertex& v1 = vertices[idx[1]];
+    const ScreenVertex& v2 = vertices[idx[2]];
+    if ((v0.outcode & v1.outcode & v2.outcode) & 0x3fu) continue;
+    if ((v0.outcode | v1.outcode | v2.outcode) & kNeedsClip) {
+      out.resize(n);
+      clip_and_emit(v0, v1, v2, static_cast<std::uint32_t>(t), vp, cull_sign, out, clip_maps);
+      n = out.size();
+      out.resize(n + (end - t - 1));
+      dst = out.data();
+      continue;
+    }
+    // emit() without branches on the outcome: the record is always written at dst[n] and
+    // kept by advancing n (random small triangles made those branches unpredictable).
+    const std::int32_t x0 = v0.x, y0 = v0.y, x1 = v1.x, y1 = v1.y, x2 = v2.x, y2 = v2.y;
+    const std::int64_t area = (std::int64_t(y0) - y1) * x2 + (std::int64_t(x1) - x0) * y2 +
+                              (std::int64_t(x0) * y1 - std::int64_t(y0) * x1);
+    const std::int32_t minx = std::min({x0, x1, x2}), maxx = std::max({x0, x1, x2});
+    const std::int32_t miny = std::min({y0, y1, y2}), maxy = std::max({y0, y1, y2});
+    SetupTriangle& r = dst[n];
+    r.px0 = std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits);
+    r.py0 = std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits);
+    r.px1 = std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits);
+    r.py1 = std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits);
+    const bool swap = area < 0;
+    r.x[0] = x0, r.y[0] = y0, r.inv_w[0] = v0.inv_w;
+    r.x[1] = swap ? x2 : x1, r.y[1] = swap ? y2 : y1, r.inv_w[1] = swap ? v2.inv_w : v1.inv_w;
+    r.x[2] = swap ? x1 : x2, r.y[2] = swap ? y1 : y2, r.inv_w[2] = swap ? v1.inv_w : v2.inv_w;
+    r.triangle = static_cast<std::uint32_t>(t);
+    r.clip_map = -1;
+    r.swapped = swap ? 1u : 0u;
+    const bool culled = (cull_sign > 0 && area > 0) || (cull_sign < 0 && area < 0);
+    const bool keep = (area != 0) & !culled & (r.px0 <= r.px1) & (r.py0 <= r.py1);
+    n += keep ? 1 : 0;
+  }
+  out.resize(n);
+}
+
 }  // namespace speculum::raster

@@ -14,7 +14,7 @@
 namespace speculum::raster {
 namespace {
 constexpr std::size_t kVertexChunk = 16384;
-constexpr std::size_t kTriangleChunk = 16384;
+constexpr std::size_t kTriangleChunk = 4096;
 }  // namespace
 
 namespace {
@@ -55,17 +55,8 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
         BinnedChunk& chunk = chunks[begin / kTriangleChunk];
         chunk.triangles.clear();
         chunk.clip_maps.clear();
-        chunk.triangles.reserve(end - begin);
-        for (std::size_t t = begin; t < end; ++t) {
-          if (!excluded.empty()) {
-            const std::uint32_t object = triangle_object[t];
-            if (object < excluded.size() && excluded[object]) continue;
-          }
-          const std::uint32_t* idx = &indices[3 * t];
-          setup_triangle(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]],
-                         static_cast<std::uint32_t>(t), vp, cull, chunk.triangles,
-                         chunk.clip_maps);
-        }
+        setup_triangles(vertices.data(), indices.data(), begin, end, triangle_object.data(),
+                        excluded, vp, cull, chunk.triangles, chunk.clip_maps);
         bin_chunk(chunk, grid);
       });
 
