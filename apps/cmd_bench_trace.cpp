@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <fstream>
 #include <limits>
@@ -50,6 +51,14 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Process CPU time (all threads), ms: on a shared, loaded machine the ratio of CPU times
+// is a steadier A/B figure than wall clock (which includes waiting for a core).
+double cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -141,6 +150,7 @@ Checksum checksum(const trace::HitStream& h) {
 #ifdef SPECULUM_HAVE_EMBREE
 struct EmbreeFigures {
   double build_ms = 0, mrays1 = 0, mrays16 = 0;
+  double build_cpu_ms = 0, trace1_cpu_ms = 0;  // medians of process CPU time
   Checksum sum;
 };
 
@@ -152,7 +162,7 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
   // Embree reads vertices as 16-byte loads: one float of padding after the last vertex.
   std::vector<float> verts(scene.mesh.positions.size() * 3 + 4, 0.0f);
   std::memcpy(verts.data(), scene.mesh.positions.data(), scene.mesh.positions.size() * sizeof(glm::vec3));
-  std::vector<double> build;
+  std::vector<double> build, build_cpu;
   RTCScene rs = nullptr;
   for (int k = 0; k < repeat; ++k) {
     if (rs) rtcReleaseScene(rs);
@@ -166,10 +176,13 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
     rtcAttachGeometry(rs, g);
     rtcReleaseGeometry(g);
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_ms();
     ex.run([&] { rtcCommitScene(rs); });
     build.push_back(ms_since(t0));
+    build_cpu.push_back(cpu_ms() - c0);
   }
   fig.build_ms = median(build);
+  fig.build_cpu_ms = median(build_cpu);
   const std::size_t n = rays.size();
   trace::HitStream hits;
   hits.resize(n);
@@ -190,9 +203,10 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
   };
-  std::vector<double> t1, t16;
+  std::vector<double> t1, t16, t1_cpu;
   for (int k = 0; k < repeat; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_ms();
     ex.parallel_for("embree_intersect1", n, trace::kRayChunk, [&](std::size_t b, std::size_t e) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
@@ -206,6 +220,7 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
       }
     });
     t1.push_back(ms_since(t0));
+    t1_cpu.push_back(cpu_ms() - c0);
   }
   fig.sum = checksum(hits);
   for (int k = 0; k < repeat; ++k) {
@@ -236,6 +251,7 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
     t16.push_back(ms_since(t0));
   }
   fig.mrays1 = static_cast<double>(n) / (std::max(median(t1), 1e-6) * 1e3);
+  fig.trace1_cpu_ms = median(t1_cpu);
   fig.mrays16 = static_cast<double>(n) / (std::max(median(t16), 1e-6) * 1e3);
   rtcReleaseScene(rs);
   rtcReleaseDevice(device);
@@ -281,20 +297,24 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
   const trace::RayStream rays = trace::read_ray_file(o.rays);
   const int repeat = std::max(1, o.repeat);
 
-  std::vector<double> build_ms, trace_ms;
+  std::vector<double> build_ms, trace_ms, build_cpu, trace_cpu;
   trace::Bvh bvh;
   for (int k = 0; k < repeat; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_ms();
     bvh = trace::Bvh::build(scene.mesh, ex);
     build_ms.push_back(ms_since(t0));
+    build_cpu.push_back(cpu_ms() - c0);
   }
   trace::HitStream hits;
   trace::TraversalCounters counters;
   for (int k = 0; k < repeat; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_ms();
     if (o.kernel == "packet") trace::closest_hit_stream_packets(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
     else trace::closest_hit_stream(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
     trace_ms.push_back(ms_since(t0));
+    trace_cpu.push_back(cpu_ms() - c0);
   }
   const Checksum sum = checksum(hits);
   // Guarded so an empty ray file prints 0, never inf (which is not JSON).
@@ -308,6 +328,7 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
               static_cast<double>(counters.nodes_visited) / std::max<double>(1.0, rays.size()),
               static_cast<double>(counters.triangle_tests) / std::max<double>(1.0, rays.size()),
               static_cast<unsigned long long>(counters.stack_overflows));
+  std::printf(", \"build_cpu_ms\": %.3f, \"trace_cpu_ms\": %.3f", median(build_cpu), median(trace_cpu));
   // The last build's phases (build_ms covers all of them: refs, binary tree, both layouts).
   const trace::BvhStats& st = bvh.stats();
   std::printf(", \"bvh\": {\"hash\": \"%016llx\", \"leaves\": %llu, \"triangle_packs\": %llu, \"wide_nodes\": %llu, \"refs_ms\": %.1f, "
@@ -326,6 +347,9 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
                 static_cast<unsigned long long>(e.sum.hits), static_cast<unsigned long long>(e.sum.prim_sum),
                 e.sum.t_sum, mrays / std::max(e.mrays1, 1e-9), mrays / std::max(e.mrays16, 1e-9),
                 median(build_ms) / std::max(e.build_ms, 1e-9));
+    // CPU-time ratios (see cpu_ms): throughput ours / rtcIntersect1, build ours / Embree.
+    std::printf(", \"cpu_ratio_vs_intersect1\": %.3f, \"build_cpu_ratio\": %.3f",
+                e.trace1_cpu_ms / std::max(median(trace_cpu), 1e-9), median(build_cpu) / std::max(e.build_cpu_ms, 1e-9));
   }
 #endif
   std::printf("}\n");

@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "core/error.h"
 #include "trace/bvh.h"
@@ -351,44 +352,65 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
     std::vector<Item> fifo;
     top.push_back({});
     fifo.push_back({bounds_of(0, static_cast<std::uint32_t>(tri_count)), 0, false, 0});
-    for (std::size_t head = 0; head < fifo.size(); ++head) {
-      const Item it = fifo[head];
-      const std::size_t n = it.range.end - it.range.begin;
-      if (n <= kParallelRange) {
-        const auto task = static_cast<std::int64_t>(tasks.size());
-        tasks.push_back(it.range);
-        if (it.node == 0) top[0].left_task = task;  // the whole tree is one task
-        else if (it.is_left) top[it.parent].left_task = task;
-        else top[it.parent].right_task = task;
-        continue;
+    // One tree level at a time (the FIFO is breadth-first): each range is binned in parallel
+    // over chunks, then the level's partitions run in parallel, one range per chunk. Nodes
+    // and tasks are numbered in FIFO order, as a one-at-a-time loop would number them.
+    struct Pending {
+      Item item;
+      Binner binner;
+      Split split;
+      Range left, right;
+    };
+    std::size_t head = 0;
+    while (head < fifo.size()) {
+      const std::size_t level_end = fifo.size();
+      std::vector<Pending> splits;
+      for (; head < level_end; ++head) {
+        const Item it = fifo[head];
+        const std::size_t n = it.range.end - it.range.begin;
+        if (n <= kParallelRange) {
+          const auto task = static_cast<std::int64_t>(tasks.size());
+          tasks.push_back(it.range);
+          if (it.node == 0) top[0].left_task = task;  // the whole tree is one task
+          else if (it.is_left) top[it.parent].left_task = task;
+          else top[it.parent].right_task = task;
+          continue;
+        }
+        const Binner binner(it.range.cbox, opt.bins);
+        const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
+        std::vector<Bins> part(chunks);
+        ex.parallel_for("bvh_bin", n, kBinChunk, [&](std::size_t b, std::size_t e) {
+          Bins& local = part[b / kBinChunk];
+          for (auto& axis : local) axis.fill(Bin{});
+          bin_refs(refs.data() + it.range.begin + b, e - b, binner, local);
+        });
+        Bins bins;
+        for (auto& axis : bins) axis.fill(Bin{});
+        for (std::size_t c = 0; c < chunks; ++c)
+          for (int a = 0; a < 3; ++a)
+            for (int i = 0; i < opt.bins; ++i) {
+              bins[a][i].lo = _mm_min_ps(part[c][a][i].lo, bins[a][i].lo);
+              bins[a][i].hi = _mm_max_ps(part[c][a][i].hi, bins[a][i].hi);
+              bins[a][i].count += part[c][a][i].count;
+            }
+        top[it.node].box = it.range.box;
+        splits.push_back({it, binner, best_split(bins, it.range.cbox, n, opt), {}, {}});
       }
-      const Binner binner(it.range.cbox, opt.bins);
-      const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
-      std::vector<Bins> part(chunks);
-      ex.parallel_for("bvh_bin", n, kBinChunk, [&](std::size_t b, std::size_t e) {
-        Bins& local = part[b / kBinChunk];
-        for (auto& axis : local) axis.fill(Bin{});
-        bin_refs(refs.data() + it.range.begin + b, e - b, binner, local);
+      ex.parallel_for("bvh_top_partition", splits.size(), 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          Pending& p = splits[k];
+          std::tie(p.left, p.right) = partition(refs.data(), p.item.range, p.split, p.binner);
+        }
       });
-      Bins bins;
-      for (auto& axis : bins) axis.fill(Bin{});
-      for (std::size_t c = 0; c < chunks; ++c)
-        for (int a = 0; a < 3; ++a)
-          for (int i = 0; i < opt.bins; ++i) {
-            bins[a][i].lo = _mm_min_ps(part[c][a][i].lo, bins[a][i].lo);
-            bins[a][i].hi = _mm_max_ps(part[c][a][i].hi, bins[a][i].hi);
-            bins[a][i].count += part[c][a][i].count;
-          }
-      top[it.node].box = it.range.box;
-      const Split split = best_split(bins, it.range.cbox, n, opt);
-      auto [L, R] = partition(refs.data(), it.range, split, binner);
-      const std::size_t l = top.size();
-      top.push_back({});
-      top.push_back({});
-      top[it.node].left = static_cast<std::int64_t>(l);
-      top[it.node].right = static_cast<std::int64_t>(l + 1);
-      fifo.push_back({L, l, true, it.node});
-      fifo.push_back({R, l + 1, false, it.node});
+      for (const Pending& p : splits) {
+        const std::size_t l = top.size();
+        top.push_back({});
+        top.push_back({});
+        top[p.item.node].left = static_cast<std::int64_t>(l);
+        top[p.item.node].right = static_cast<std::int64_t>(l + 1);
+        fifo.push_back({p.left, l, true, p.item.node});
+        fifo.push_back({p.right, l + 1, false, p.item.node});
+      }
     }
   }
 

@@ -1,5 +1,5 @@
-// Derives the traversal layouts from the binary BVH (bvh.h): the 8-wide collapse (each wide
-// node opens its largest-area inner children until it holds 8) with triangle packs and the threaded layout of
+// Derives the traversal layouts from the binary BVH (bvh.h): the 8-wide collapse (SAH-optimal
+// choice of each wide node's up to 8 slots, Ylitie et al. 2017 §3.1) with triangle packs and the threaded layout of
 // YU §3 / [CHCH06] (depth-first order, hit link = left child, miss link = next subtree).
 #include <cmath>
 #include <cstring>
@@ -51,6 +51,58 @@ void fill_packs(const std::vector<LeafTriangle>& tris, const std::vector<std::ui
   }
 }
 
+// The SAH-optimal collapse of the binary tree into 8-wide nodes (Ylitie et al. 2017,
+// "Efficient incoherent ray traversal on GPUs through compressed wide BVHs" §3.1), with
+// the binary leaves kept as the leaves: each leaf lands in exactly one slot, so its cost is
+// the same for every collapse and only the wide nodes' areas are minimised. cost(n, j) is
+// the cheapest way to represent subtree n in at most j slots: n itself as one slot (a wide
+// node over its children, area(n) + the children in 8 slots), or n dissolved with its
+// children sharing the j slots. Greedy opening by area left many bottom nodes 2-4 full.
+struct CollapsePlan {
+  std::vector<std::uint8_t> choice;      // [n * 8 + j - 1]: 0 = n is one slot, else slots of the left child
+  std::vector<std::uint8_t> node_split;  // n as a wide node: slots of its left child (of 8)
+};
+
+CollapsePlan plan_collapse(const std::vector<BinaryNode>& binary) {
+  const std::size_t n = binary.size();
+  CollapsePlan plan;
+  plan.choice.assign(n * kWideArity, 0);
+  plan.node_split.assign(n, 0);
+  std::vector<float> cost(n * kWideArity, 0.0f);  // leaves cost 0 (the same in every collapse)
+  for (std::size_t i = n; i-- > 0;) {  // children follow their parent in depth-first order
+    const BinaryNode& b = binary[i];
+    if (b.is_leaf()) continue;
+    const float* l = &cost[(i + 1) * kWideArity];
+    const float* r = &cost[static_cast<std::size_t>(b.right) * kWideArity];
+    float split_cost[kWideArity + 1];
+    std::uint8_t split_left[kWideArity + 1];
+    for (int j = 2; j <= kWideArity; ++j) {
+      float best = l[0] + r[j - 2];
+      int best_k = 1;
+      for (int k = 2; k < j; ++k) {
+        const float c = l[k - 1] + r[j - k - 1];
+        if (c < best) {
+          best = c;
+          best_k = k;
+        }
+      }
+      split_cost[j] = best;
+      split_left[j] = static_cast<std::uint8_t>(best_k);
+    }
+    const float as_node = b.box.half_area() + split_cost[kWideArity];
+    plan.node_split[i] = split_left[kWideArity];
+    float* out = &cost[i * kWideArity];
+    std::uint8_t* choice = &plan.choice[i * kWideArity];
+    out[0] = as_node;
+    for (int j = 2; j <= kWideArity; ++j) {
+      const bool dissolve = split_cost[j] < as_node;
+      out[j - 1] = dissolve ? split_cost[j] : as_node;
+      choice[j - 1] = dissolve ? split_left[j] : 0;
+    }
+  }
+  return plan;
+}
+
 }  // namespace
 
 void Bvh::derive_layouts(par::Executor& ex) {
@@ -95,6 +147,7 @@ void Bvh::derive_wide(const std::vector<std::uint32_t>& leaf_ref) {
     return;
   }
   wide_.reserve(binary_.size() / 2);
+  const CollapsePlan plan = plan_collapse(binary_);
   struct Item {
     std::uint32_t binary;
     std::uint32_t parent;  // wide node to patch (kEmptyChild: root)
@@ -107,23 +160,20 @@ void Bvh::derive_wide(const std::vector<std::uint32_t>& leaf_ref) {
     const auto me = static_cast<std::uint32_t>(wide_.size());
     if (it.parent == kEmptyChild) wide_root_ = me;
     else wide_[it.parent].child[it.slot] = me;
-    std::uint32_t kids[kWideArity] = {it.binary + 1, binary_[it.binary].right};
-    int count = 2;
-    while (count < kWideArity) {
-      int best = -1;
-      float best_area = -1.0f;
-      for (int k = 0; k < count; ++k) {
-        const BinaryNode& c = binary_[kids[k]];
-        if (!c.is_leaf() && c.box.half_area() > best_area) {
-          best_area = c.box.half_area();
-          best = k;
-        }
+    std::uint32_t kids[kWideArity];
+    int count = 0;
+    auto emit = [&](auto&& self, std::uint32_t c, int slots) -> void {
+      const int k = binary_[c].is_leaf() ? 0 : plan.choice[c * kWideArity + slots - 1];
+      if (k == 0) {
+        kids[count++] = c;
+        return;
       }
-      if (best < 0) break;
-      const std::uint32_t opened = kids[best];
-      kids[best] = opened + 1;
-      kids[count++] = binary_[opened].right;
-    }
+      self(self, c + 1, k);
+      self(self, binary_[c].right, slots - k);
+    };
+    const int k = plan.node_split[it.binary];
+    emit(emit, it.binary + 1, k);
+    emit(emit, binary_[it.binary].right, kWideArity - k);
     WideNode node;
     std::memset(&node, 0, sizeof(node));
     for (int k = 0; k < kWideArity; ++k) {
