@@ -10,7 +10,20 @@
 #include "core/optics.h"
 #include "core/sampling.h"
 
+#include <sys/mman.h>
+
 namespace speculum::trace {
+
+namespace {
+const Ray kUnbounded;  // a reflected ray's default t range
+}  // namespace
+
+void advise_huge_pages(const void* data, std::size_t bytes) {
+  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+  const auto begin = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t first = (begin + kHuge - 1) / kHuge * kHuge, last = (begin + bytes) / kHuge * kHuge;
+  if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+}
 
 float sample_solid_angle(float cos_theta, float exponent, int n) {
   const float p = phong_lobe_pdf(cos_theta, exponent);
@@ -37,8 +50,13 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
   const std::size_t N = static_cast<std::size_t>(opt.rays_per_pixel);
   const std::size_t P = out.pixel.size();
   out.fresnel.resize(P);
-  out.rays.resize(P * N);
-  out.solid_angle.assign(P * N, 0.0f);
+  RayStream& rs = out.rays;
+  for (auto* v : {&rs.ox, &rs.oy, &rs.oz, &rs.dx, &rs.dy, &rs.dz, &rs.tmin, &rs.tmax, &out.solid_angle})
+    resize_on_huge_pages(*v, P * N);
+  // The N Hamersley points are the same for every pixel (only the rotation differs).
+  std::vector<glm::vec2> points(N);
+  for (std::size_t j = 0; j < N; ++j)
+    points[j] = hamersley(static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(N));
   constexpr std::size_t kChunk = 64;  // pixels per chunk
   std::vector<std::uint64_t> rejected((P + kChunk - 1) / kChunk, 0);
   ex.parallel_for("glossy_rays", P, kChunk, [&](std::size_t b, std::size_t e) {
@@ -58,27 +76,33 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
       // Offset along the normal scaled with the point's magnitude (as the reference tracer).
       const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
       const glm::vec3 origin = p + n * (1e-4f * m);
+      const float exponent = s.phong_exponent;
+      const std::size_t first = k * N;
+      // Origin and t range are per pixel: written as one run, then the per-ray directions.
+      std::fill_n(rs.ox.begin() + first, N, origin.x);
+      std::fill_n(rs.oy.begin() + first, N, origin.y);
+      std::fill_n(rs.oz.begin() + first, N, origin.z);
       for (std::size_t j = 0; j < N; ++j) {
-        const glm::vec2 u = rotate_unit_square(hamersley(static_cast<std::uint32_t>(j),
-                                                         static_cast<std::uint32_t>(N)), shift);
-        const glm::vec3 local = sample_phong_lobe(u, s.phong_exponent);
+        const glm::vec2 u = rotate_unit_square(points[j], shift);
+        const glm::vec3 local = sample_phong_lobe(u, exponent);
         const glm::vec3 d = lobe.to_world(local);
-        const std::size_t slot = k * N + j;
-        Ray ray;
+        const std::size_t slot = first + j;
         if (glm::dot(d, n) <= 0.0f) {
           // Rejected, not reflected: the shading model gives such directions zero weight,
           // and the estimator still divides by N (as the reference tracer does).
           ++below;
-          ray.origin = origin;
-          ray.direction = glm::vec3(0.0f);
-          ray.tmin = 1.0f;
-          ray.tmax = 0.0f;
+          rs.dx[slot] = rs.dy[slot] = rs.dz[slot] = 0.0f;
+          rs.tmin[slot] = 1.0f;
+          rs.tmax[slot] = 0.0f;
+          out.solid_angle[slot] = 0.0f;
         } else {
-          ray.origin = origin;
-          ray.direction = d;
-          out.solid_angle[slot] = sample_solid_angle(local.z, s.phong_exponent, static_cast<int>(N));
+          rs.dx[slot] = d.x;
+          rs.dy[slot] = d.y;
+          rs.dz[slot] = d.z;
+          rs.tmin[slot] = kUnbounded.tmin;
+          rs.tmax[slot] = kUnbounded.tmax;
+          out.solid_angle[slot] = sample_solid_angle(local.z, exponent, static_cast<int>(N));
         }
-        out.rays.set(slot, ray);
       }
     }
     rejected[b / kChunk] = below;

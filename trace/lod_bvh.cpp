@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
 
@@ -118,6 +119,9 @@ LodBvh build_lod_bvh(const Bvh& bvh, const std::vector<glm::vec3>& triangle_radi
       }
     }
   }
+  lod.stop_k.resize(lod.nodes.size());
+  for (std::size_t k = 0; k < lod.nodes.size(); ++k)
+    lod.stop_k[k] = lod.nodes[k].quad ? lod.nodes[k].box_solid_angle_k : std::numeric_limits<float>::quiet_NaN();
   return lod;
 }
 

@@ -37,6 +37,10 @@ struct LodBvh {
   std::vector<LodNode> nodes;
   std::vector<std::uint32_t> triangle_leaf;  // original triangle index → its leaf node
   std::vector<float> triangle_area;          // original triangle index → area
+  // The eq.7 operand the traversal reads per inner node, packed apart from the proxies (4
+  // bytes per node instead of a LodNode cache line): the node's box_solid_angle_k when it has
+  // a quad proxy, NaN otherwise (every comparison with NaN is false: the node never stops).
+  std::vector<float> stop_k;
 };
 
 // `triangle_radiance` is indexed by original triangle (size bvh.triangle_count()); throws

@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "trace/glossy_rays.h"
 #include "trace/ray_triangle.h"
 #include "trace/scalar_box_test.h"
 
@@ -43,39 +44,37 @@ inline bool intersect_proxy(const RayPrep& r, const LodNode& n, float tmax, floa
   return true;
 }
 
-}  // namespace
 
-LodHit closest_hit_lod(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float solid_angle,
-                       const LodOptions& opt, LodCounters* counters) {
-  LodCounters c;
-  c.traversal.rays = 1;
+// The traversal, compiled once with the eq.7 test and once without it (LOD off: exactly the
+// threaded traversal's loop, with no per-node LOD branch).
+template <bool kLod>
+LodHit traverse(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float budget, LodCounters& c) {
   LodHit best;
   best.t = ray.tmax;
-  const auto& nodes = bvh.threaded_nodes();
-  const auto& tris = bvh.leaf_triangles();
-  const auto& ids = bvh.triangle_ids();
-  // eq.7 as Ω_box ≤ α² Ω_s, with eq.6's division moved to the right-hand side.
-  const float budget = opt.alpha * opt.alpha * solid_angle;
-  const bool lod_on = opt.enabled && budget > 0.0f && lod.nodes.size() == nodes.size();
-  if (valid_ray(ray) && !nodes.empty()) {
-    const RayPrep r(ray);
-    std::uint32_t i = 0;
-    while (i != kThreadEnd) {
-      const ThreadedNode& n = nodes[i];
-      ++c.traversal.nodes_visited;
-      float tnear;
-      if (!box_hit(r, n.box, best.t, tnear)) {
-        i = n.miss;
-        continue;
-      }
-      if (lod_on && n.count == 0) {
-        const LodNode& ln = lod.nodes[i];
+  const ThreadedNode* nodes = bvh.threaded_nodes().data();
+  const LeafTriangle* tris = bvh.leaf_triangles().data();
+  const std::uint32_t* ids = bvh.triangle_ids().data();
+  const float* stop_k = lod.stop_k.data();
+  if (!valid_ray(ray) || bvh.threaded_nodes().empty()) return best;
+  const RayPrep r(ray);
+  std::uint64_t visited = 0, tested = 0;
+  std::uint32_t i = 0;
+  while (i != kThreadEnd) {
+    const ThreadedNode& n = nodes[i];
+    ++visited;
+    float tnear;
+    if (!box_hit(r, n.box, best.t, tnear)) {
+      i = n.miss;
+      continue;
+    }
+    if constexpr (kLod) {
+      if (n.count == 0) {
+        // eq.7 as Ω_box ≤ α² Ω_s, with eq.6's division moved to the right-hand side.
         const glm::vec3 to_center = n.box.center() - r.o;
-        if (ln.quad && ln.box_solid_angle_k <= budget * glm::dot(to_center, to_center) &&
-            !inside(n.box, r.o)) {
+        if (stop_k[i] <= budget * glm::dot(to_center, to_center) && !inside(n.box, r.o)) {
           ++c.lod_stops;
           float t, s, w;
-          if (intersect_proxy(r, ln, best.t, t, s, w)) {
+          if (intersect_proxy(r, lod.nodes[i], best.t, t, s, w)) {
             best.t = t;
             best.u = s;
             best.v = w;
@@ -86,25 +85,47 @@ LodHit closest_hit_lod(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float 
           continue;
         }
       }
-      for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
-        ++c.traversal.triangle_tests;
-        TriangleHit h;
-        if (!intersect_triangle_watertight(r.shear, tris[k].a, tris[k].b, tris[k].c, r.tmin, best.t, h))
-          continue;
-        const std::uint32_t id = ids[k];
-        if (h.t < best.t || id < best.triangle) {
-          best.t = h.t;
-          best.u = h.u;
-          best.v = h.v;
-          best.triangle = id;
-          best.proxy = kNoHit;
-        }
-      }
-      i = n.hit;
     }
+    for (std::uint32_t k = n.first; k < n.first + n.count; ++k) {
+      ++tested;
+      TriangleHit h;
+      if (!intersect_triangle_watertight(r.shear, tris[k].a, tris[k].b, tris[k].c, r.tmin, best.t, h))
+        continue;
+      const std::uint32_t id = ids[k];
+      if (h.t < best.t || id < best.triangle) {
+        best.t = h.t;
+        best.u = h.u;
+        best.v = h.v;
+        best.triangle = id;
+        best.proxy = kNoHit;
+      }
+    }
+    i = n.hit;
   }
+  c.traversal.nodes_visited += visited;
+  c.traversal.triangle_tests += tested;
+  return best;
+}
+
+// Accumulates into `c` (one ray).
+LodHit closest_hit_lod_into(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float solid_angle,
+                            const LodOptions& opt, LodCounters& c) {
+  ++c.traversal.rays;
+  const float budget = opt.alpha * opt.alpha * solid_angle;
+  const bool lod_on = opt.enabled && budget > 0.0f && lod.nodes.size() == bvh.threaded_nodes().size() &&
+                      lod.stop_k.size() == lod.nodes.size();
+  LodHit best = lod_on ? traverse<true>(bvh, lod, ray, budget, c) : traverse<false>(bvh, lod, ray, budget, c);
   if (!best.hit()) best = LodHit{};
   if (best.proxy != kNoHit) ++c.proxy_hits;
+  return best;
+}
+
+}  // namespace
+
+LodHit closest_hit_lod(const Bvh& bvh, const LodBvh& lod, const Ray& ray, float solid_angle,
+                       const LodOptions& opt, LodCounters* counters) {
+  LodCounters c;
+  const LodHit best = closest_hit_lod_into(bvh, lod, ray, solid_angle, opt, c);
   if (counters) counters->add(c);
   return best;
 }
@@ -113,14 +134,19 @@ void closest_hit_lod_stream(const Bvh& bvh, const LodBvh& lod, const RayStream& 
                             const std::vector<float>& solid_angle, const LodOptions& opt,
                             std::vector<LodHit>& hits, par::Executor& ex, LodCounters* counters) {
   const std::size_t n = rays.size();
-  hits.resize(n);
+  resize_on_huge_pages(hits, n);
   const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
   std::vector<LodCounters> per_chunk(chunks);
   ex.parallel_for("lod_trace", n, kRayChunk, [&](std::size_t b, std::size_t e) {
     LodCounters c;
     for (std::size_t i = b; i < e; ++i) {
       const float omega = i < solid_angle.size() ? solid_angle[i] : 0.0f;
-      hits[i] = closest_hit_lod(bvh, lod, rays.get(i), omega, opt, &c);
+      Ray ray;
+      ray.origin = {rays.ox[i], rays.oy[i], rays.oz[i]};
+      ray.direction = {rays.dx[i], rays.dy[i], rays.dz[i]};
+      ray.tmin = rays.tmin[i];
+      ray.tmax = rays.tmax[i];
+      hits[i] = closest_hit_lod_into(bvh, lod, ray, omega, opt, c);
     }
     per_chunk[b / kRayChunk] = c;
   });
