@@ -14,6 +14,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "core/error.h"
+#include "raster/gbuffer_normals.h"
 #include "raster/gbuffer_stream.h"
 
 namespace speculum::raster {
@@ -63,6 +64,9 @@ struct MaterialInfo {
   SurfaceParams constant;      // the parameters of untextured materials
   bool textured = false;       // parameters vary with uv: evaluate per sample
   bool normal_mapped = false;
+  bool simple = false;         // neither: constant parameters, normals take the 8-wide path
+  std::uint32_t keep_side = 0; // all ones for refractors (see resolve_sample)
+  bool specular = false;       // is_specular(constant)
 };
 
 struct SampleContext {
@@ -96,8 +100,18 @@ struct MeshCorners {
     r.material = m.triangle_material[t];
     return r;
   }
-  void prefetch(std::uint32_t t) const {
+  // Two stages: the indices first, the corners once the indices have arrived.
+  void prefetch_indices(std::uint32_t t) const {
     _mm_prefetch(reinterpret_cast<const char*>(m.indices.data() + 3 * std::size_t(t)), _MM_HINT_T0);
+  }
+  void prefetch(std::uint32_t t) const {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = m.indices[3 * std::size_t(t) + k];
+      _mm_prefetch(reinterpret_cast<const char*>(m.positions.data() + v), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(m.normals.data() + v), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(m.uvs.data() + v), _MM_HINT_T0);
+    }
+    _mm_prefetch(reinterpret_cast<const char*>(m.triangle_material.data() + t), _MM_HINT_T0);
   }
 };
 
@@ -105,6 +119,7 @@ struct MeshCorners {
 struct RecordCorners {
   const TriangleRecord* records;
   const TriangleRecord& operator()(std::uint32_t t) const { return records[t]; }
+  void prefetch_indices(std::uint32_t) const {}  // a record needs no indices
   void prefetch(std::uint32_t t) const {
     const char* p = reinterpret_cast<const char*>(records + t);
     _mm_prefetch(p, _MM_HINT_T0);
@@ -154,6 +169,27 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
   out.reflector[j] = is_specular(sp) ? object : kNoId;
 }
 
+// The interpolation half of resolve_sample for a simple material (constant parameters, no
+// normal map): the normal step runs later over the block's lanes.
+inline void interpolate_sample(const SampleContext& c, std::size_t i, const TriangleRecord& r,
+                               const MaterialInfo& info, StagingBlock& out,
+                               detail::NormalLanes<kBlock>& lanes, std::size_t j) {
+  const std::uint32_t object = c.vis.object.pixels[i];
+  const glm::vec2 b = c.vis.bary.pixels[i];
+  const float b0 = 1.0f - b.x - b.y;
+  auto lerp3 = [&](const auto& a) { return b0 * a[0] + b.x * a[1] + b.y * a[2]; };
+  const glm::vec3 p = lerp3(r.position);
+  const glm::vec3 n = lerp3(r.normal);
+  lanes.nx[j] = n.x, lanes.ny[j] = n.y, lanes.nz[j] = n.z;
+  lanes.px[j] = p.x, lanes.py[j] = p.y, lanes.pz[j] = p.z;
+  lanes.keep_side[j] = info.keep_side;
+  out.object[j] = object;
+  out.position[j] = p;
+  out.uv[j] = lerp3(r.uv);
+  out.surface[j] = info.constant;
+  out.reflector[j] = info.specular ? object : kNoId;
+}
+
 // Background samples get the ids and the planes' default values, so every byte of the
 // G-buffer is defined (and the same for any thread count) whatever the buffer held before.
 inline void resolve_background(const SampleContext& c, std::size_t i, StagingBlock& out,
@@ -176,19 +212,60 @@ template <class Corners>
 void resolve_range(const SampleContext& c, const Corners& corners, std::size_t begin,
                    std::size_t end, bool stream, GBuffer& g) {
   StagingBlock blk;
+  detail::NormalLanes<kBlock> lanes;
+  bool simple[kBlock];
   const std::uint32_t* tri = c.vis.triangle.pixels.data();
   const std::size_t total = c.vis.triangle.size();
-  for (std::size_t t = begin; t < std::min(begin + kPrefetchAhead, total); ++t)
-    if (tri[t] != kNoId) corners.prefetch(tri[t]);
+  // Prefetch each run of samples on one triangle once: `near` samples ahead for the corner
+  // data, twice as far for the indices the corner prefetch reads.
+  auto prefetch_at = [&](std::size_t k) {
+    if (k < total && tri[k] != kNoId && (k == begin || tri[k] != tri[k - 1])) corners.prefetch(tri[k]);
+  };
+  auto prefetch_indices_at = [&](std::size_t k) {
+    if (k < total && tri[k] != kNoId && (k == begin || tri[k] != tri[k - 1]))
+      corners.prefetch_indices(tri[k]);
+  };
+  for (std::size_t k = begin; k < begin + 2 * kPrefetchAhead; ++k) prefetch_indices_at(k);
+  for (std::size_t k = begin; k < begin + kPrefetchAhead; ++k) prefetch_at(k);
   for (std::size_t b = begin; b < end; b += kBlock) {
     const std::size_t n = std::min(kBlock, end - b);
     for (std::size_t j = 0; j < n; ++j) {
       const std::size_t i = b + j;
-      if (i + kPrefetchAhead < total && tri[i + kPrefetchAhead] != kNoId)
-        corners.prefetch(tri[i + kPrefetchAhead]);
+      prefetch_indices_at(i + 2 * kPrefetchAhead);
+      prefetch_at(i + kPrefetchAhead);
       const std::uint32_t t = tri[i];
-      if (t == kNoId) resolve_background(c, i, blk, j);
-      else resolve_sample(c, i, t, corners(t), blk, j);
+      simple[j] = false;
+      lanes.nx[j] = lanes.ny[j] = lanes.nz[j] = lanes.px[j] = lanes.py[j] = lanes.pz[j] = 0.0f;
+      lanes.keep_side[j] = 0;
+      if (t == kNoId) {
+        resolve_background(c, i, blk, j);
+        continue;
+      }
+      decltype(auto) r = corners(t);
+      const MaterialInfo& info = c.materials[r.material];
+      if (info.simple) {
+        interpolate_sample(c, i, r, info, blk, lanes, j);
+        simple[j] = true;
+      } else {
+        resolve_sample(c, i, t, r, blk, j);
+      }
+    }
+    for (std::size_t j = n; j < (n + 7) / 8 * 8; ++j) {  // tail lanes of a partial block
+      lanes.nx[j] = lanes.ny[j] = lanes.nz[j] = lanes.px[j] = lanes.py[j] = lanes.pz[j] = 0.0f;
+      lanes.keep_side[j] = 0;
+    }
+    detail::normalize_and_face_eye(lanes, n, c.eye);
+    for (std::size_t j = 0; j < n; ++j) {
+      if (!simple[j]) continue;
+      if (lanes.valid[j]) {
+        blk.normal[j] = glm::vec3(lanes.nx[j], lanes.ny[j], lanes.nz[j]);
+      } else {  // degenerate interpolated normal: the face normal, turned as in resolve_sample
+        const TriangleRecord& r = corners(tri[b + j]);
+        glm::vec3 fn = glm::normalize(
+            glm::cross(r.position[1] - r.position[0], r.position[2] - r.position[0]));
+        if (!lanes.keep_side[j] && glm::dot(fn, c.eye - blk.position[j]) < 0.0f) fn = -fn;
+        blk.normal[j] = fn;
+      }
     }
     store_plane(g.object, b, blk.object, n, stream);
     store_plane(g.position, b, blk.position, n, stream);
@@ -221,6 +298,9 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
     info.textured = mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
                     mat.emissive_texture.valid() || mat.transmission_texture.valid();
     info.normal_mapped = !m.tangents.empty() && mat.normal_texture.valid();
+    info.simple = !info.textured && !info.normal_mapped;
+    info.keep_side = info.constant.is_refractor() ? ~0u : 0u;
+    info.specular = is_specular(info.constant);
     materials.push_back(info);
   }
   const SampleContext ctx{scene, m, vis, eye, materials};

@@ -58,7 +58,8 @@ TEST(GBuffer, PositionUvAndNormalMapOnAQuad) {
 }
 
 // A scene with every material path of the resolve: normal-mapped, textured, mirror,
-// refractor, a triangle whose vertex normals are all zero (face-normal fallback), a closed
+// refractor, triangles whose vertex normals are all zero (face-normal fallback, on a
+// textured and on a constant material, facing away from and towards the eye), a closed
 // torus (back faces visible through nothing, front faces flipped towards the eye) and
 // background around it.
 Scene mixed_material_scene() {
@@ -100,6 +101,8 @@ Scene mixed_material_scene() {
   const std::size_t flat_vertex = scene.mesh.positions.size();
   testing::add_triangles(scene, {{1.0f, -0.9f, 0.3f}, {1.8f, -0.8f, 0.3f}, {1.4f, -0.3f, 0.35f}},
                          {0, 1, 2}, {}, 1);
+  testing::add_triangles(scene, {{-1.9f, 0.3f, 0.3f}, {-1.5f, 0.9f, 0.35f}, {-1.1f, 0.3f, 0.3f}},
+                         {0, 1, 2}, {}, 2);
   for (std::size_t v = flat_vertex; v < scene.mesh.positions.size(); ++v)
     scene.mesh.normals[v] = glm::vec3(0.0f);
   scene.mesh.tangents.assign(scene.mesh.positions.size(), glm::vec4(1, 0, 0, -1));
@@ -201,6 +204,11 @@ TEST(GBuffer, EveryByteMatchesAPerSampleOracle) {
       else ++materials_seen[scene.mesh.triangle_material[t]];
     }
     for (std::size_t k = 0; k < 4; ++k) EXPECT_GT(materials_seen[k], 10u) << "material " << k;
+    std::size_t flat = 0;  // samples on the two zero-normal triangles (the last two)
+    for (std::size_t i = 0; i < vis.triangle.size(); ++i)
+      flat += vis.triangle.pixels[i] + 2 >= scene.mesh.triangle_count() &&
+              vis.triangle.pixels[i] != kNoId;
+    EXPECT_GT(flat, 10u);
     EXPECT_GT(background, 10u);
     const GBuffer fresh = resolve_gbuffer(ex2, scene, vis, cam.eye);
     EXPECT_EQ(mismatches(scene, vis, cam.eye, fresh), 0u) << w << "x" << h << " mesh, fresh";
