@@ -360,3 +360,60 @@ TEST(RasterVertexStage, BatchedEqualsOneVertexFunctionBitForBit) {
 
 }  // namespace
 }  // namespace speculum::raster
+
+namespace speculum::raster {
+namespace {
+
+// The chunked, branch-free setup equals setup_triangle called per triangle: same records
+// (bytes), same clip maps, for every cull mode and with excluded objects; the vertices
+// include ones needing clipping, tiny triangles covering no sample and degenerate ones.
+TEST(RasterSetup, ChunkedSetupEqualsPerTriangleSetup) {
+  Camera cam;
+  cam.eye = {0.0f, 0.0f, 2.0f};
+  cam.znear = 0.5f;
+  const int width = 200, height = 150;
+  const glm::mat4 vp = projection_matrix(cam, width, height) * view_matrix(cam);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> box(-2.5f, 2.5f), small(-0.01f, 0.01f);
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> indices, objects;
+  for (std::uint32_t t = 0; t < 3000; ++t) {
+    const glm::vec3 c(box(rng), box(rng), box(rng));
+    const float s = t % 4 == 0 ? 150.0f : 1.0f;  // some large triangles cross the near plane
+    for (int k = 0; k < 3; ++k) {
+      indices.push_back(static_cast<std::uint32_t>(positions.size()));
+      positions.push_back(t % 7 == 0 && k == 2 ? positions[positions.size() - 1]  // degenerate
+                                               : c + s * glm::vec3(small(rng), small(rng), small(rng)));
+    }
+    objects.push_back(t % 5);
+  }
+  const Viewport viewport{width, height};
+  std::vector<ScreenVertex> vertices(positions.size());
+  make_screen_vertices(vp, positions.data(), positions.size(), viewport, vertices.data());
+  const std::vector<std::uint8_t> excluded{0, 0, 1};  // object 2 left out; 3, 4 beyond the flags
+  for (int cull : {-1, 0, 1}) {
+    for (const auto& skip : {std::vector<std::uint8_t>{}, excluded}) {
+      std::vector<SetupTriangle> one, chunked(5);  // chunked appends after existing records
+      std::vector<ClipMap> one_maps, chunked_maps;
+      for (std::size_t t = 0; t < objects.size(); ++t) {
+        if (!skip.empty() && objects[t] < skip.size() && skip[objects[t]]) continue;
+        const std::uint32_t* idx = &indices[3 * t];
+        setup_triangle(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]],
+                       static_cast<std::uint32_t>(t), viewport, cull, one, one_maps);
+      }
+      setup_triangles(vertices.data(), indices.data(), 0, objects.size(), objects.data(), skip,
+                      viewport, cull, chunked, chunked_maps);
+      ASSERT_EQ(one.size() + 5, chunked.size()) << cull;
+      ASSERT_EQ(one_maps.size(), chunked_maps.size()) << cull;
+      EXPECT_GE(one_maps.size(), 5u);  // clipping is exercised
+      EXPECT_EQ(0, std::memcmp(one.data(), chunked.data() + 5, one.size() * sizeof(SetupTriangle)))
+          << cull;
+      EXPECT_EQ(0, std::memcmp(one_maps.data(), chunked_maps.data(),
+                               one_maps.size() * sizeof(ClipMap)))
+          << cull;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace speculum::raster
