@@ -139,7 +139,9 @@ TEST(RadixSort, SixteenMillion32BitKeys) {
       seen[payload[i]] = true;
       if (i) {
         ASSERT_LE(keys[i - 1], keys[i]);
-        if (keys[i - 1] == keys[i]) ASSERT_LT(payload[i - 1], payload[i]);
+        if (keys[i - 1] == keys[i]) {
+          ASSERT_LT(payload[i - 1], payload[i]);
+        }
       }
     }
     auto bare = original;  // keys only: the same keys in the same order

@@ -193,8 +193,12 @@ TEST(Stream, ScanLookBackFoldsInChunkOrder) {
       const float expected = c == 0 ? 0.25f : prefix[c - 1];
       EXPECT_EQ(std::bit_cast<std::uint32_t>(offset), std::bit_cast<std::uint32_t>(expected)) << c;
     }
-    if (pattern[0] == 0) EXPECT_GT(computed, 0u);  // the missing sums were computed, not awaited
-    if (pattern[0] == 2 && pattern[1] == 2) EXPECT_EQ(computed, 0u);
+    if (pattern[0] == 0) {
+      EXPECT_GT(computed, 0u);  // the missing sums were computed, not awaited
+    }
+    if (pattern[0] == 2 && pattern[1] == 2) {
+      EXPECT_EQ(computed, 0u);
+    }
   }
 }
 
