@@ -15,9 +15,6 @@
 #include <utility>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
 #include "parallel/fork_join.h"
@@ -84,17 +81,11 @@ class Executor {
     if (synchronous() || chunks <= 1) {
       for (std::size_t c = 0; c < chunks; ++c) run_chunk(c);
     } else {
+      // A task_group fork/join, not tbb::parallel_for: see fork_join.h for why.
       ForkJoinSync sync;  // per launch
-      auto run_range = [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c) run_chunk(c);
-      };
       sync.fork();  // after everything the tasks read is written
       ForkJoinSync::JoinOnExit join{sync};
-      arena_->execute([&] {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
-                          ForkJoinTask<decltype(run_range)>(sync, run_range),
-                          tbb::simple_partitioner());
-      });
+      arena_->execute([&] { fork_join_chunks(sync, chunks, run_chunk); });
     }
     record(name, n, chunks, t0, now_ns() - t0);
   }

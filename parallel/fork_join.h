@@ -1,11 +1,12 @@
-// Fork/join happens-before edges for ThreadSanitizer around TBB launches (executor.h,
+// Fork/join on oneTBB with the happens-before edges ThreadSanitizer cannot see (executor.h,
 // graph.cpp). The annotations compile to nothing unless built with -fsanitize=thread;
-// ForkJoinTask is then a two-pointer forwarder. tests/tsan.supp names this file.
+// ForkJoinTask is then a plain forwarder. tests/tsan.supp names this file.
 #pragma once
 
 #include <cstddef>
 #include <type_traits>
-#include <utility>
+
+#include <tbb/task_group.h>
 
 #if defined(__SANITIZE_THREAD__)
 // ThreadSanitizer's annotation entry points (libtsan). Debian's libtbb.so is not
@@ -22,6 +23,14 @@ namespace speculum::par {
 // leave(): a task's writes are published to the join; join(): the launcher, after TBB's
 // wait returns, sees every task's writes. Two separate sync addresses, so tasks of one
 // launch get no edge between each other (a race between two chunks is still reported).
+//
+// What leave()/join() cannot cover: after a task's body returns, TBB's task epilogue (header
+// code, instrumented) still decrements the join counter, which lives in the launcher's
+// frame. tbb::task_group reads that counter with an acquire load in its destructor (header
+// code too), which gives TSan the real edge, so the launcher may reuse its stack afterwards.
+// tbb::parallel_for keeps its counter in a stack node that only libtbb reads: a launcher
+// reusing that stack was reported as racing with the last worker's decrement. So every
+// launch here is a tbb::task_group (fork_join_chunks), never tbb::parallel_for.
 class ForkJoinSync {
  public:
   // Scope guards: leave()/join() also on the exceptional path.
@@ -50,39 +59,70 @@ class ForkJoinSync {
 #endif
 };
 
-// The callable handed to TBB for one launch: pointers to the launch's sync and to the real
-// body (which stays on the launcher's stack), and an index passed to bodies that take one
-// first (the graph's node number). TBB copies it on one thread and runs the copy
-// on another, an edge TSan cannot see; so the pointers are copied and read with relaxed
-// atomics (plain moves in machine code), the only accesses before enter() makes the
-// launcher's writes visible.
+// The callable handed to TBB for one task: pointers to the launch's sync and to the real
+// body (which stays on the launcher's stack), and a range [begin, end) passed to bodies
+// that take two indices (chunk ranges) or its begin to bodies that take one (the graph's
+// node number). TBB copies it on one thread and runs the copy on another, an edge TSan
+// cannot see; so the fields are copied and read with relaxed atomics (plain moves in
+// machine code), the only accesses before enter() makes the launcher's writes visible.
 template <class F>
 class ForkJoinTask {
  public:
-  ForkJoinTask(ForkJoinSync& sync, F& f, std::size_t index = 0)
-      : sync_(&sync), f_(&f), index_(index) {}
+  ForkJoinTask(ForkJoinSync& sync, F& f, std::size_t begin = 0, std::size_t end = 0)
+      : sync_(&sync), f_(&f), begin_(begin), end_(end) {}
   ForkJoinTask(const ForkJoinTask& other) {
     __atomic_store_n(&sync_, __atomic_load_n(&other.sync_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
     __atomic_store_n(&f_, __atomic_load_n(&other.f_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
-    __atomic_store_n(&index_, __atomic_load_n(&other.index_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
+    __atomic_store_n(&begin_, __atomic_load_n(&other.begin_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
+    __atomic_store_n(&end_, __atomic_load_n(&other.end_, __ATOMIC_RELAXED), __ATOMIC_RELAXED);
   }
   ForkJoinTask& operator=(const ForkJoinTask&) = delete;
-  template <class... Args>
-  void operator()(Args&&... args) const {
+  void operator()() const {
     ForkJoinSync* sync = __atomic_load_n(&sync_, __ATOMIC_RELAXED);
     sync->enter();
     ForkJoinSync::LeaveOnExit leave{*sync};
     F& f = *__atomic_load_n(&f_, __ATOMIC_RELAXED);
-    if constexpr (std::is_invocable_v<F&, std::size_t, Args...>)
-      f(__atomic_load_n(&index_, __ATOMIC_RELAXED), std::forward<Args>(args)...);
+    const std::size_t begin = __atomic_load_n(&begin_, __ATOMIC_RELAXED);
+    if constexpr (std::is_invocable_v<F&, std::size_t, std::size_t>)
+      f(begin, __atomic_load_n(&end_, __ATOMIC_RELAXED));
     else
-      f(std::forward<Args>(args)...);
+      f(begin);
   }
 
  private:
   ForkJoinSync* sync_;
   F* f_;
-  std::size_t index_;
+  std::size_t begin_;
+  std::size_t end_;
 };
+
+// Runs chunk_body(c) for every c in [0, chunks) on the current task arena and returns when
+// all have finished. The caller fork()s `sync` before and join()s it after, on its own
+// thread (the arena's execute may hand this call to a worker). The range is halved
+// recursively and the upper halves are spawned, like tbb::simple_partitioner with grain 1,
+// so idle threads steal large pieces first. Spawning tasks do not fork(): a worker
+// publishing its own writes to later tasks would hide races between chunks. Which thread
+// runs which chunk never matters to the results (chunk boundaries are fixed by the caller).
+template <class ChunkBody>
+void fork_join_chunks(ForkJoinSync& sync, std::size_t chunks, ChunkBody& chunk_body) {
+  if (chunks == 0) return;
+  tbb::task_group group;
+  struct Splitter {
+    tbb::task_group& group;
+    ForkJoinSync& sync;
+    ChunkBody& chunk_body;
+    void operator()(std::size_t begin, std::size_t end) {
+      while (end - begin > 1) {
+        const std::size_t mid = begin + (end - begin) / 2;
+        group.run(ForkJoinTask<Splitter>(sync, *this, mid, end));
+        end = mid;
+      }
+      chunk_body(begin);
+    }
+  } split{group, sync, chunk_body};
+  // The root runs on this thread (run_and_wait does not copy or spawn it); rethrows the
+  // first exception of any chunk once all spawned tasks have finished.
+  group.run_and_wait(ForkJoinTask<Splitter>(sync, split, 0, chunks));
+}  // ~task_group acquires TBB's join counter: the edge leave()/join() cannot state (above)
 
 }  // namespace speculum::par
