@@ -25,11 +25,16 @@ constexpr FaceBasis kFaces[kCubeFaces] = {
 struct FaceFrame {
   glm::vec3 forward, right, up;
 };
-FaceFrame frame(int face) {
+FaceFrame make_frame(int face) {
   const glm::vec3 f = kFaces[face].forward;
   const glm::vec3 r = glm::normalize(glm::cross(f, kFaces[face].up));
   return {f, r, glm::cross(r, f)};
 }
+// Computed once: cube_coord runs per map lookup (dozens per prefiltered texel). The axes
+// are exact (cross products of unit axes), so the table equals per-call computation.
+const std::array<FaceFrame, kCubeFaces> kFrames = {make_frame(0), make_frame(1), make_frame(2),
+                                                   make_frame(3), make_frame(4), make_frame(5)};
+const FaceFrame& frame(int face) { return kFrames[face]; }
 
 }  // namespace
 
@@ -51,7 +56,7 @@ CubeCoord cube_coord(const glm::vec3& d, int size) {
   if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
   else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
   else face = d.z >= 0.0f ? 4 : 5;
-  const FaceFrame f = frame(face);
+  const FaceFrame& f = frame(face);
   const float depth = glm::dot(d, f.forward);
   const float ndc_x = glm::dot(d, f.right) / depth;
   const float ndc_y = glm::dot(d, f.up) / depth;
@@ -61,7 +66,7 @@ CubeCoord cube_coord(const glm::vec3& d, int size) {
 }
 
 glm::vec3 cube_direction(int face, glm::vec2 pixel, int size) {
-  const FaceFrame f = frame(face);
+  const FaceFrame& f = frame(face);
   const float s = static_cast<float>(size);
   const float ndc_x = 2.0f * pixel.x / s - 1.0f, ndc_y = 1.0f - 2.0f * pixel.y / s;
   return glm::normalize(f.forward + f.right * ndc_x + f.up * ndc_y);

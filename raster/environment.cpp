@@ -76,11 +76,13 @@ EnvironmentMap build_environment(par::Executor& executor, const Environment& env
 }
 
 EnvironmentMap environment_from_faces(par::Executor& executor,
-                                      std::array<ImageRGBA, kCubeFaces> faces, bool with_sh) {
+                                      std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
+                                      int level_count) {
   EnvironmentMap map;
   const int size = faces[0].width;
   map.size = size;
-  const int levels = static_cast<int>(std::log2(static_cast<float>(size))) + 1;
+  const int all = static_cast<int>(std::log2(static_cast<float>(size))) + 1;
+  const int levels = level_count > 0 ? std::min(level_count, all) : all;
   map.levels.resize(levels);
   map.levels[0] = std::move(faces);
   // Coarser levels: glossy prefiltering of the previous level.
@@ -88,6 +90,10 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
     const int s = std::max(1, size >> l);
     const float target = texel_angle(s), previous = l == 1 ? 0.0f : texel_angle(size >> (l - 1));
     const float step_exponent = lobe_exponent(std::sqrt(target * target - previous * previous));
+    // The lobe's sample directions in the lobe's own frame are the same for every texel.
+    std::array<glm::vec3, kPrefilterSamples> local;
+    for (int k = 0; k < kPrefilterSamples; ++k)
+      local[k] = sample_phong_lobe(hamersley(std::uint32_t(k), kPrefilterSamples), step_exponent);
     for (int face = 0; face < kCubeFaces; ++face) {
       ImageRGBA& img = map.levels[l][face];
       img = ImageRGBA(s, s);
@@ -97,11 +103,8 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
           const glm::vec3 axis = cube_direction(face, {i % s + 0.5f, i / s + 0.5f}, s);
           const Onb onb(axis);
           glm::vec3 sum(0.0f);
-          for (int k = 0; k < kPrefilterSamples; ++k) {
-            const glm::vec3 local =
-                sample_phong_lobe(hamersley(std::uint32_t(k), kPrefilterSamples), step_exponent);
-            sum += lookup_level(map.levels[l - 1], onb.to_world(local));
-          }
+          for (int k = 0; k < kPrefilterSamples; ++k)
+            sum += lookup_level(map.levels[l - 1], onb.to_world(local[k]));
           img.pixels[i] = glm::vec4(sum / float(kPrefilterSamples), 1.0f);
         }
       });
@@ -125,12 +128,32 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
   return map;
 }
 
+namespace {
+
+// The fractional mip level radiance() reads for a lobe of exponent n (before clamping to
+// the levels a map has).
+float lobe_level(int size, float phong_exponent) {
+  if (phong_exponent >= 1e6f) return 0.0f;
+  return std::max(std::log2(lobe_angle(phong_exponent) / texel_angle(size)), 0.0f);
+}
+
+}  // namespace
+
+int levels_for_lobes(int size, float min_phong_exponent) {
+  const int all = static_cast<int>(std::log2(static_cast<float>(size))) + 1;
+  if (!(min_phong_exponent > 0.0f)) return all;
+  // radiance() reads level floor(l), and floor(l) + 1 when l has a fraction, for the widest
+  // lobe's level l; the log2 is monotone in the exponent, so narrower lobes read no coarser
+  // level.
+  const float level = lobe_level(size, min_phong_exponent);
+  if (!(level < float(all))) return all;
+  const int whole = static_cast<int>(level);
+  return std::min(all, whole + (level > float(whole) ? 2 : 1));
+}
+
 glm::vec3 EnvironmentMap::radiance(const glm::vec3& d, float phong_exponent) const {
   const int last = static_cast<int>(levels.size()) - 1;
-  float level = 0.0f;
-  if (phong_exponent < 1e6f)
-    level = std::clamp(std::log2(lobe_angle(phong_exponent) / texel_angle(size)), 0.0f,
-                       float(last));
+  const float level = std::min(lobe_level(size, phong_exponent), float(last));
   const int l0 = static_cast<int>(level), l1 = std::min(l0 + 1, last);
   const float t = level - l0;
   const glm::vec3 a = lookup_level(levels[l0], d);

@@ -30,9 +30,17 @@ struct EnvironmentMap {
 };
 
 // Mip levels and glossy prefiltering of given level-0 faces (e.g. a rendered cube map's
-// colour, for the dynamic environment maps of SURVEY §3.1); SH only when asked.
+// colour, for the dynamic environment maps of SURVEY §3.1); SH only when asked. level_count
+// > 0 keeps only the finest level_count levels (see levels_for_lobes); 0 builds all.
 EnvironmentMap environment_from_faces(par::Executor& executor,
-                                      std::array<ImageRGBA, kCubeFaces> faces, bool with_sh);
+                                      std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
+                                      int level_count = 0);
+
+// How many levels (finest first) EnvironmentMap::radiance can read on a map of side `size`
+// for lobes of exponent ≥ min_phong_exponent (≥ 1e6: mirror, level 0 only; ≤ 0: all of
+// them). Prefiltering only those gives the same radiance for those lobes: a reflector whose
+// materials are all mirrors needs no prefiltering at all.
+int levels_for_lobes(int size, float min_phong_exponent);
 
 // size 0: picks from the image (a quarter of the equirect width, 16..512; 8 for constants).
 EnvironmentMap build_environment(par::Executor& executor, const Environment& env, int size = 0);

@@ -35,8 +35,10 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
         }));
   }
   // map_of_object numbers maps in object order, as render_reflector_maps does.
-  for (const CubeMap& cube : next.cubes)
-    next.maps.push_back(environment_from_faces(executor, cube.colour, false));
+  // Each map keeps the levels its reflector's materials read (render_reflector_maps).
+  for (std::size_t k = 0; k < next.cubes.size(); ++k)
+    next.maps.push_back(environment_from_faces(
+        executor, next.cubes[k].colour, false, static_cast<int>(current.maps[k].levels.size())));
   return next;
 }
 

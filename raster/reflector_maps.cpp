@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include "raster/direct_light.h"
+#include "raster/specular_radiance.h"
 
 namespace speculum::raster {
 
@@ -29,6 +30,15 @@ bool visible_centroid(const GBuffer& g, std::uint32_t object, glm::vec3& centre,
   return true;
 }
 
+// The smallest Phong exponent a reflection node reads an object's map with for this
+// material: refractors read sharply (specular_radiance.h); a roughness texture can only
+// scale roughness down (glTF), but be safe and keep every level then (exponent 0).
+float map_lookup_exponent(const Material& material, const SurfaceParams& s) {
+  if (s.is_refractor()) return kSharpLookupExponent;
+  if (material.metallic_roughness_texture.valid()) return 0.0f;
+  return s.phong_exponent;
+}
+
 }  // namespace
 
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
@@ -43,10 +53,16 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
     bool specular = false;
+    float widest_lobe = 1e6f;  // smallest Phong exponent the map is read with
     Bounds b;
     for (std::uint32_t t = object.first_triangle; t < object.first_triangle + object.triangle_count;
          ++t) {
-      specular |= is_specular(surface_params(scene.materials[m.triangle_material[t]]));
+      const Material& material = scene.materials[m.triangle_material[t]];
+      const SurfaceParams s = surface_params(material);
+      if (is_specular(s)) {
+        specular = true;
+        widest_lobe = std::min(widest_lobe, map_lookup_exponent(material, s));
+      }
       for (int k = 0; k < 3; ++k) b.grow(m.positions[m.indices[3 * t + k]]);
     }
     if (!specular || !b.valid()) continue;
@@ -68,7 +84,8 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
           return direct_light(executor, scene, g, cam, shadows, env);
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
-    out.maps.push_back(environment_from_faces(executor, cube.colour, false));
+    out.maps.push_back(environment_from_faces(executor, cube.colour, false,
+                                              levels_for_lobes(size, widest_lobe)));
     out.cubes.push_back(std::move(cube));
     out.centres.push_back(centre);
   }
