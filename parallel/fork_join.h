@@ -97,7 +97,7 @@ class ForkJoinTask {
 };
 
 // Runs chunk_body(c) for every c in [0, chunks) on the current task arena and returns when
-// all have finished. The caller fork()s `sync` before and join()s it after, on its own
+// all have finished. The caller also fork()s `sync` before and join()s it after, on its own
 // thread (the arena's execute may hand this call to a worker). The range is halved
 // recursively and the upper halves are spawned, like tbb::simple_partitioner with grain 1,
 // so idle threads steal large pieces first. Spawning tasks do not fork(): a worker
@@ -120,6 +120,9 @@ void fork_join_chunks(ForkJoinSync& sync, std::size_t chunks, ChunkBody& chunk_b
       chunk_body(begin);
     }
   } split{group, sync, chunk_body};
+  // Publishes the group's construction (its wait counter, which every task's epilogue
+  // decrements) and anything else this thread wrote; fork() may be called more than once.
+  sync.fork();
   // The root runs on this thread (run_and_wait does not copy or spawn it); rethrows the
   // first exception of any chunk once all spawned tasks have finished.
   group.run_and_wait(ForkJoinTask<Splitter>(sync, split, 0, chunks));
