@@ -7,7 +7,8 @@ void bin_chunk(BinnedChunk& chunk, const TileGrid& grid) {
   const std::size_t tiles = static_cast<std::size_t>(grid.count());
   chunk.tile_offsets.assign(tiles + 1, 0);
   // Pass 1: count per tile (offset by one so the prefix sum lands in place).
-  for (const SetupTriangle& t : chunk.triangles) {
+  for (std::size_t i = 0; i < chunk.count; ++i) {
+    const SetupTriangle& t = chunk.triangles[i];
     const int tx0 = t.px0 >> kTileShift, tx1 = t.px1 >> kTileShift;
     const int ty0 = t.py0 >> kTileShift, ty1 = t.py1 >> kTileShift;
     for (int ty = ty0; ty <= ty1; ++ty)
@@ -18,7 +19,8 @@ void bin_chunk(BinnedChunk& chunk, const TileGrid& grid) {
   chunk.binned.resize(chunk.tile_offsets[tiles]);
   // Pass 2: fill in triangle order, using a cursor per tile.
   std::vector<std::uint32_t> cursor(chunk.tile_offsets.begin(), chunk.tile_offsets.end() - 1);
-  for (const SetupTriangle& t : chunk.triangles) {
+  for (std::size_t i = 0; i < chunk.count; ++i) {
+    const SetupTriangle& t = chunk.triangles[i];
     const int tx0 = t.px0 >> kTileShift, tx1 = t.px1 >> kTileShift;
     const int ty0 = t.py0 >> kTileShift, ty1 = t.py1 >> kTileShift;
     for (int ty = ty0; ty <= ty1; ++ty)

@@ -28,13 +28,14 @@ inline TileGrid make_tile_grid(int width, int height) {
 // The set-up triangles of one chunk of input triangles and their per-tile bins:
 // tile t's triangles are binned[tile_offsets[t] .. tile_offsets[t+1]), in chunk order.
 struct BinnedChunk {
-  std::vector<SetupTriangle> triangles;
+  std::vector<SetupTriangle> triangles;  // the first `count` are this frame's (see setup_triangles)
+  std::size_t count = 0;
   std::vector<ClipMap> clip_maps;
   std::vector<std::uint32_t> tile_offsets;  // grid.count() + 1
   std::vector<SetupTriangle> binned;        // one copy per overlapped tile
 };
 
-// Fills chunk.tile_offsets / binned from chunk.triangles (which keep their order).
+// Fills chunk.tile_offsets / binned from chunk.triangles[0, count) (which keep their order).
 void bin_chunk(BinnedChunk& chunk, const TileGrid& grid);
 
 }  // namespace speculum::raster

@@ -285,15 +285,15 @@ void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const Screen
        cull_sign, nullptr, out, clip_maps);
 }
 
-void setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
-                     std::size_t begin, std::size_t end, const std::uint32_t* triangle_object,
-                     const std::vector<std::uint8_t>& excluded, const Viewport& vp,
-                     int cull_sign, std::vector<SetupTriangle>& out,
-                     std::vector<ClipMap>& clip_maps) {
-  // Room for one triangle per remaining input; only clipping can emit more (then the
-  // vector is resized around the clipped triangle's appends).
-  std::size_t n = out.size();
-  out.resize(n + (end - begin));
+std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
+                            std::size_t begin, std::size_t end,
+                            const std::uint32_t* triangle_object,
+                            const std::vector<std::uint8_t>& excluded, const Viewport& vp,
+                            int cull_sign, std::size_t first, std::vector<SetupTriangle>& out,
+                            std::vector<ClipMap>& clip_maps) {
+  // Room for one triangle per remaining input; only clipping can emit more.
+  std::size_t n = first;
+  if (out.size() < n + (end - begin)) out.resize(n + (end - begin));
   SetupTriangle* dst = out.data();
   const int half = kSubpixelOne / 2;
   for (std::size_t t = begin; t < end; ++t) {
@@ -307,11 +307,18 @@ void setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
     const ScreenVertex& v2 = vertices[idx[2]];
     if ((v0.outcode & v1.outcode & v2.outcode) & 0x3fu) continue;
     if ((v0.outcode | v1.outcode | v2.outcode) & kNeedsClip) {
-      out.resize(n);
-      clip_and_emit(v0, v1, v2, static_cast<std::uint32_t>(t), vp, cull_sign, out, clip_maps);
-      n = out.size();
-      out.resize(n + (end - t - 1));
-      dst = out.data();
+      // Clipped pieces go through a small side buffer, so `out` only grows (never shrinks
+      // and re-initializes its tail) and only when a triangle yields more than one piece.
+      thread_local std::vector<SetupTriangle> pieces;
+      pieces.clear();
+      clip_and_emit(v0, v1, v2, static_cast<std::uint32_t>(t), vp, cull_sign, pieces, clip_maps);
+      const std::size_t need = n + pieces.size() + (end - t - 1);
+      if (need > out.size()) {
+        out.resize(need);
+        dst = out.data();
+      }
+      std::copy(pieces.begin(), pieces.end(), dst + n);
+      n += pieces.size();
       continue;
     }
     // emit() without branches on the outcome: the record is always written at dst[n] and
@@ -337,7 +344,7 @@ void setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
     const bool keep = (area != 0) & !culled & (r.px0 <= r.px1) & (r.py0 <= r.py1);
     n += keep ? 1 : 0;
   }
-  out.resize(n);
+  return n;
 }
 
 }  // namespace speculum::raster

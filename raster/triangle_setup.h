@@ -65,14 +65,17 @@ void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const Screen
                     std::uint32_t triangle, const Viewport& viewport, int cull_sign,
                     std::vector<SetupTriangle>& out, std::vector<ClipMap>& clip_maps);
 
-// setup_triangle over triangles [begin, end) of an indexed list (indices[3t..3t+2]),
-// appending to `out` in triangle order with the same results, skipping triangles whose
-// object is flagged in `excluded` (indexed by object id; empty: none). The common case (no
+// setup_triangle over triangles [begin, end) of an indexed list (indices[3t..3t+2]) with
+// the same results, skipping triangles whose object is flagged in `excluded` (indexed by
+// object id; empty: none). Writes the records to out[first ..) in triangle order and
+// returns the end index; `out` grows as needed but never shrinks (entries past the end are
+// stale), so a buffer reused across frames is not re-initialized. The common case (no
 // clipping) appends without a branch on the triangle's outcome.
-void setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
-                     std::size_t begin, std::size_t end, const std::uint32_t* triangle_object,
-                     const std::vector<std::uint8_t>& excluded, const Viewport& viewport,
-                     int cull_sign, std::vector<SetupTriangle>& out,
-                     std::vector<ClipMap>& clip_maps);
+std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
+                            std::size_t begin, std::size_t end,
+                            const std::uint32_t* triangle_object,
+                            const std::vector<std::uint8_t>& excluded, const Viewport& viewport,
+                            int cull_sign, std::size_t first, std::vector<SetupTriangle>& out,
+                            std::vector<ClipMap>& clip_maps);
 
 }  // namespace speculum::raster

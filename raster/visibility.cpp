@@ -53,10 +53,10 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
   executor.parallel_for(
       "raster.setup_bin", triangles, kTriangleChunk, [&](std::size_t begin, std::size_t end) {
         BinnedChunk& chunk = chunks[begin / kTriangleChunk];
-        chunk.triangles.clear();
         chunk.clip_maps.clear();
-        setup_triangles(vertices.data(), indices.data(), begin, end, triangle_object.data(),
-                        excluded, vp, cull, chunk.triangles, chunk.clip_maps);
+        chunk.count = setup_triangles(vertices.data(), indices.data(), begin, end,
+                                      triangle_object.data(), excluded, vp, cull, 0,
+                                      chunk.triangles, chunk.clip_maps);
         bin_chunk(chunk, grid);
       });
 

@@ -393,7 +393,7 @@ TEST(RasterSetup, ChunkedSetupEqualsPerTriangleSetup) {
   const std::vector<std::uint8_t> excluded{0, 0, 1};  // object 2 left out; 3, 4 beyond the flags
   for (int cull : {-1, 0, 1}) {
     for (const auto& skip : {std::vector<std::uint8_t>{}, excluded}) {
-      std::vector<SetupTriangle> one, chunked(5);  // chunked appends after existing records
+      std::vector<SetupTriangle> one, chunked(5);  // chunked writes after 5 existing records
       std::vector<ClipMap> one_maps, chunked_maps;
       for (std::size_t t = 0; t < objects.size(); ++t) {
         if (!skip.empty() && objects[t] < skip.size() && skip[objects[t]]) continue;
@@ -401,9 +401,11 @@ TEST(RasterSetup, ChunkedSetupEqualsPerTriangleSetup) {
         setup_triangle(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]],
                        static_cast<std::uint32_t>(t), viewport, cull, one, one_maps);
       }
-      setup_triangles(vertices.data(), indices.data(), 0, objects.size(), objects.data(), skip,
-                      viewport, cull, chunked, chunked_maps);
-      ASSERT_EQ(one.size() + 5, chunked.size()) << cull;
+      const std::size_t end = setup_triangles(vertices.data(), indices.data(), 0,
+                                              objects.size(), objects.data(), skip, viewport,
+                                              cull, 5, chunked, chunked_maps);
+      ASSERT_EQ(one.size() + 5, end) << cull;
+      ASSERT_GE(chunked.size(), end);
       ASSERT_EQ(one_maps.size(), chunked_maps.size()) << cull;
       EXPECT_GE(one_maps.size(), 5u);  // clipping is exercised
       EXPECT_EQ(0, std::memcmp(one.data(), chunked.data() + 5, one.size() * sizeof(SetupTriangle)))
