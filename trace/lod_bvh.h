@@ -20,7 +20,7 @@
 
 namespace speculum::trace {
 
-constexpr float kPlanarity = 0.7f;  // |Σ A n| / Σ A at or above: the quad proxy
+constexpr float kPlanarity = 0.8f;  // |Σ A n| / Σ A at or above: the quad proxy
 
 struct LodNode {
   glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};  // quad: origin + s edge_u + t edge_v
