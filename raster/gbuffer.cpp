@@ -89,17 +89,7 @@ struct alignas(64) StagingBlock {
 // Triangle data straight from the mesh arrays (no prepared records).
 struct MeshCorners {
   const TriangleMesh& m;
-  TriangleRecord operator()(std::uint32_t t) const {
-    TriangleRecord r;
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = m.indices[3 * t + k];
-      r.position[k] = m.positions[v];
-      r.normal[k] = m.normals[v];
-      r.uv[k] = m.uvs[v];
-    }
-    r.material = m.triangle_material[t];
-    return r;
-  }
+  TriangleRecord operator()(std::uint32_t t) const { return triangle_record(m, t); }
   // Two stages: the indices first, the corners once the indices have arrived.
   void prefetch_indices(std::uint32_t t) const {
     _mm_prefetch(reinterpret_cast<const char*>(m.indices.data() + 3 * std::size_t(t)), _MM_HINT_T0);

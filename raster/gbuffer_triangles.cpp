@@ -16,17 +16,7 @@ GBufferTriangles::GBufferTriangles(par::Executor& executor, const Scene& scene) 
     throw InputError(scene.name, "mesh attribute arrays do not match its vertex/triangle counts");
   TriangleRecord* out = memory_.reserve<TriangleRecord>(n > 0 ? n : 1);
   executor.parallel_for("gbuffer.prepare", n, kTriangleChunk, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t t = begin; t < end; ++t) {
-      TriangleRecord r;
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t v = m.indices[3 * t + k];
-        r.position[k] = m.positions[v];
-        r.normal[k] = m.normals[v];
-        r.uv[k] = m.uvs[v];
-      }
-      r.material = m.triangle_material[t];
-      out[t] = r;
-    }
+    for (std::size_t t = begin; t < end; ++t) out[t] = triangle_record(m, std::uint32_t(t));
   });
   records_ = out;
   count_ = n;

@@ -27,6 +27,19 @@ struct alignas(64) TriangleRecord {
 };
 static_assert(sizeof(TriangleRecord) == 128);
 
+// Triangle t's record, read from the mesh arrays (indices → corners).
+inline TriangleRecord triangle_record(const TriangleMesh& m, std::uint32_t t) {
+  TriangleRecord r;
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t v = m.indices[3 * std::size_t(t) + k];
+    r.position[k] = m.positions[v];
+    r.normal[k] = m.normals[v];
+    r.uv[k] = m.uvs[v];
+  }
+  r.material = m.triangle_material[t];
+  return r;
+}
+
 // The records of one mesh in huge-page-backed memory (random gathers over 100+ MB would
 // otherwise miss the TLB on nearly every sample). Valid only while the mesh is unchanged:
 // rebuild it after editing the scene.
