@@ -9,21 +9,13 @@
 #include "core/error.h"
 #include "core/optics.h"
 #include "core/sampling.h"
-
-#include <sys/mman.h>
+#include "parallel/page_buffer.h"
 
 namespace speculum::trace {
 
 namespace {
 const Ray kUnbounded;  // a reflected ray's default t range
 }  // namespace
-
-void advise_huge_pages(const void* data, std::size_t bytes) {
-  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-  const auto begin = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t first = (begin + kHuge - 1) / kHuge * kHuge, last = (begin + bytes) / kHuge * kHuge;
-  if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-}
 
 float sample_solid_angle(float cos_theta, float exponent, int n) {
   const float p = phong_lobe_pdf(cos_theta, exponent);
@@ -52,7 +44,7 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
   out.fresnel.resize(P);
   RayStream& rs = out.rays;
   for (auto* v : {&rs.ox, &rs.oy, &rs.oz, &rs.dx, &rs.dy, &rs.dz, &rs.tmin, &rs.tmax, &out.solid_angle})
-    resize_on_huge_pages(*v, P * N);
+    par::resize_on_huge_pages(*v, P * N);
   // The N Hamersley points are the same for every pixel (only the rotation differs).
   std::vector<glm::vec2> points(N);
   for (std::size_t j = 0; j < N; ++j)

@@ -32,18 +32,6 @@ struct GlossyRays {
   std::size_t ray_count() const { return rays.size(); }
 };
 
-// Sizes a per-frame stream to n value-initialized elements, asking the kernel for 2 MiB pages
-// first (advice only): the yu-lod streams are ~100-200 MB per frame and on 4 KiB pages their
-// first-touch page faults cost as much as filling them.
-void advise_huge_pages(const void* data, std::size_t bytes);
-template <class T>
-void resize_on_huge_pages(std::vector<T>& v, std::size_t n) {
-  v.clear();
-  v.reserve(n);
-  advise_huge_pages(v.data(), n * sizeof(T));
-  v.resize(n);
-}
-
 // The surfaces this node traces: opaque samples with a mirror or glossy Phong lobe.
 inline bool traces_glossy(const SurfaceParams& s) {
   return !s.is_refractor() && (s.is_mirror_lobe() || s.is_glossy_lobe());

@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "parallel/page_buffer.h"
 #include "trace/glossy_rays.h"
 #include "trace/ray_triangle.h"
 #include "trace/scalar_box_test.h"
@@ -134,7 +135,7 @@ void closest_hit_lod_stream(const Bvh& bvh, const LodBvh& lod, const RayStream& 
                             const std::vector<float>& solid_angle, const LodOptions& opt,
                             std::vector<LodHit>& hits, par::Executor& ex, LodCounters* counters) {
   const std::size_t n = rays.size();
-  resize_on_huge_pages(hits, n);
+  par::resize_on_huge_pages(hits, n);
   const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
   std::vector<LodCounters> per_chunk(chunks);
   ex.parallel_for("lod_trace", n, kRayChunk, [&](std::size_t b, std::size_t e) {
