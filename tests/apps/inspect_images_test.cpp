@@ -6,22 +6,12 @@
 #include <gtest/gtest.h>
 
 #include "apps/inspect_images.h"
+#include "captured_output.h"
 #include "apps/pipeline_envmap.h"
 #include "raster/gbuffer.h"
 
 namespace speculum::inspect {
 namespace {
-
-template <class T>
-par::CapturedOutput capture(const T& value, std::string resource = "r") {
-  par::CapturedOutput o;
-  o.node = "n";
-  o.port = o.resource = std::move(resource);
-  o.type = typeid(T);
-  o.type_name = "T";
-  o.value = &value;
-  return o;
-}
 
 TEST(InspectImages, IdColoursAreStableDistinctAndNeverBlack) {
   EXPECT_EQ(id_colour(kNoId), glm::vec3(0.0f));

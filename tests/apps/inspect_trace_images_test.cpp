@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "apps/inspect_trace_images.h"
+#include "captured_output.h"
 #include "core/shading.h"
 #include "trace/glossy_rays.h"
 #include "trace/lod_trace.h"
@@ -13,17 +14,6 @@
 
 namespace speculum::inspect {
 namespace {
-
-template <class T>
-par::CapturedOutput capture(const T& value, std::string resource = "r") {
-  par::CapturedOutput o;
-  o.node = "n";
-  o.port = o.resource = std::move(resource);
-  o.type = typeid(T);
-  o.type_name = "T";
-  o.value = &value;
-  return o;
-}
 
 std::map<std::string, View> by_label(const Drawing& d) {
   std::map<std::string, View> m;
