@@ -77,13 +77,60 @@ struct SampleContext {
   const std::vector<MaterialInfo>& materials;
 };
 
-struct alignas(64) StagingBlock {
-  std::uint32_t object[kBlock];
-  glm::vec3 position[kBlock];
-  glm::vec3 normal[kBlock];
-  glm::vec2 uv[kBlock];
-  SurfaceParams surface[kBlock];
-  std::uint32_t reflector[kBlock];
+// One block's slots in the planes' staging buffers (see PlaneWriters).
+struct StagingBlock {
+  std::uint32_t* object;
+  glm::vec3* position;
+  glm::vec3* normal;
+  glm::vec2* uv;
+  SurfaceParams* surface;
+  std::uint32_t* reflector;
+};
+
+// Samples are written through a writer per plane that streams whole cache lines.
+template <class T>
+using PlaneWriter = detail::LineWriter<kBlock * sizeof(T)>;
+
+template <class T>
+T* slots(PlaneWriter<T>& w) {
+  static_assert(alignof(T) <= 4);  // the staging phase is a multiple of 4 bytes
+  return reinterpret_cast<T*>(w.next());
+}
+
+struct PlaneWriters {
+  PlaneWriter<std::uint32_t> object, reflector;
+  PlaneWriter<glm::vec3> position, normal;
+  PlaneWriter<glm::vec2> uv;
+  PlaneWriter<SurfaceParams> surface;
+
+  PlaneWriters(GBuffer& g, std::size_t begin, bool stream)
+      : object(g.object.pixels.data() + begin, stream),
+        reflector(g.reflector.pixels.data() + begin, stream),
+        position(g.position.pixels.data() + begin, stream),
+        normal(g.normal.pixels.data() + begin, stream),
+        uv(g.uv.pixels.data() + begin, stream),
+        surface(g.surface.pixels.data() + begin, stream) {}
+
+  StagingBlock block() {
+    return {slots<std::uint32_t>(object), slots<glm::vec3>(position), slots<glm::vec3>(normal),
+            slots<glm::vec2>(uv),         slots<SurfaceParams>(surface), slots<std::uint32_t>(reflector)};
+  }
+  void commit(std::size_t n) {
+    object.commit(n * sizeof(std::uint32_t));
+    position.commit(n * sizeof(glm::vec3));
+    normal.commit(n * sizeof(glm::vec3));
+    uv.commit(n * sizeof(glm::vec2));
+    surface.commit(n * sizeof(SurfaceParams));
+    reflector.commit(n * sizeof(std::uint32_t));
+  }
+  void finish() {
+    object.finish();
+    position.finish();
+    normal.finish();
+    uv.finish();
+    surface.finish();
+    reflector.finish();
+  }
 };
 
 // Triangle data straight from the mesh arrays (no prepared records).
@@ -119,7 +166,7 @@ struct RecordCorners {
 
 // Resolves covered visibility sample i of triangle t (corners r) into slot j of the block.
 inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t t,
-                           const TriangleRecord& r, StagingBlock& out, std::size_t j) {
+                           const TriangleRecord& r, const StagingBlock& out, std::size_t j) {
   const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
   const float b0 = 1.0f - b.x - b.y;
@@ -162,7 +209,7 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
 // The interpolation half of resolve_sample for a simple material (constant parameters, no
 // normal map): the normal step runs later over the block's lanes.
 inline void interpolate_sample(const SampleContext& c, std::size_t i, const TriangleRecord& r,
-                               const MaterialInfo& info, StagingBlock& out,
+                               const MaterialInfo& info, const StagingBlock& out,
                                detail::NormalLanes<kBlock>& lanes, std::size_t j) {
   const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
@@ -182,7 +229,7 @@ inline void interpolate_sample(const SampleContext& c, std::size_t i, const Tria
 
 // Background samples get the ids and the planes' default values, so every byte of the
 // G-buffer is defined (and the same for any thread count) whatever the buffer held before.
-inline void resolve_background(const SampleContext& c, std::size_t i, StagingBlock& out,
+inline void resolve_background(const SampleContext& c, std::size_t i, const StagingBlock& out,
                                std::size_t j) {
   out.object[j] = c.vis.object.pixels[i];
   out.position[j] = glm::vec3(0.0f);
@@ -192,16 +239,11 @@ inline void resolve_background(const SampleContext& c, std::size_t i, StagingBlo
   out.reflector[j] = kNoId;
 }
 
-template <class T>
-void store_plane(Buffer2D<T>& plane, std::size_t begin, const T* src, std::size_t n, bool stream) {
-  detail::store_block(plane.pixels.data() + begin, src, n * sizeof(T), stream);
-}
-
 // Resolves samples [begin, end) block by block; `corners` fetches and prefetches triangles.
 template <class Corners>
 void resolve_range(const SampleContext& c, const Corners& corners, std::size_t begin,
                    std::size_t end, bool stream, GBuffer& g) {
-  StagingBlock blk;
+  PlaneWriters writers(g, begin, stream);
   detail::NormalLanes<kBlock> lanes;
   bool simple[kBlock];
   const std::uint32_t* tri = c.vis.triangle.pixels.data();
@@ -219,6 +261,7 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
   for (std::size_t k = begin; k < begin + kPrefetchAhead; ++k) prefetch_at(k);
   for (std::size_t b = begin; b < end; b += kBlock) {
     const std::size_t n = std::min(kBlock, end - b);
+    const StagingBlock blk = writers.block();
     for (std::size_t j = 0; j < n; ++j) {
       const std::size_t i = b + j;
       prefetch_indices_at(i + 2 * kPrefetchAhead);
@@ -257,13 +300,9 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
         blk.normal[j] = fn;
       }
     }
-    store_plane(g.object, b, blk.object, n, stream);
-    store_plane(g.position, b, blk.position, n, stream);
-    store_plane(g.normal, b, blk.normal, n, stream);
-    store_plane(g.uv, b, blk.uv, n, stream);
-    store_plane(g.surface, b, blk.surface, n, stream);
-    store_plane(g.reflector, b, blk.reflector, n, stream);
+    writers.commit(n);
   }
+  writers.finish();
   detail::end_stores(stream);
 }
 

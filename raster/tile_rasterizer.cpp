@@ -45,6 +45,7 @@ struct TileScratch {
   std::vector<const SetupTriangle*> setup;  // per ref
   std::vector<const ClipMap*> clip_map;     // per ref
   std::vector<std::uint32_t> flags;         // per ref: kRefSwapped | kRefClipped
+  std::vector<std::uint32_t> object;        // per ref: the triangle's object id
 };
 
 // E_i(p) = A_i p.x + B_i p.y + C_i for the edge opposite vertex i, positive inside;
@@ -330,8 +331,8 @@ inline void update_block_mins(TileScratch& s, int x0, int y0, int x1, int y1) {
 template <int W>
 void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0, int tx1,
                      int ty1, TileScratch& s) {
-  const int x0 = std::max(t.px0, tx0), x1 = std::min(t.px1, tx1);
-  const int y0 = std::max(t.py0, ty0), y1 = std::min(t.py1, ty1);
+  const int x0 = std::max<int>(t.px0, tx0), x1 = std::min<int>(t.px1, tx1);
+  const int y0 = std::max<int>(t.py0, ty0), y1 = std::min<int>(t.py1, ty1);
   if (x0 > x1 || y0 > y1) return;
   // Block range of the clipped bounding box, tile-relative.
   const int bx0 = (x0 - tx0) / kBlock, bx1 = (x1 - tx0) / kBlock;
@@ -377,9 +378,7 @@ void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0
 
 // Writes sample `idx` of the tile (frame sample `o`): the winner's ids, depth and
 // barycentrics in the original triangle, or the empty-sample values.
-inline void resolve_sample(const TileScratch& s, int idx, std::size_t o,
-                           const std::vector<std::uint32_t>& triangle_object,
-                           VisibilityBuffer& out) {
+inline void resolve_sample(const TileScratch& s, int idx, std::size_t o, VisibilityBuffer& out) {
   const std::uint32_t ref = s.ref[idx];
   if (ref == kNoRef) {
     out.triangle.pixels[o] = kNoId;
@@ -398,22 +397,21 @@ inline void resolve_sample(const TileScratch& s, int idx, std::size_t o,
     b1 = b.y, b2 = b.z;
   }
   out.triangle.pixels[o] = t->triangle;
-  out.object.pixels[o] = triangle_object[t->triangle];
+  out.object.pixels[o] = t->object;
   out.depth.pixels[o] = 1.0f / inv_w;
   out.bary.pixels[o] = glm::vec2(b1, b2);
 }
 
 // The resolve 8 samples at a time: the same IEEE divisions as resolve_sample (so the same
-// bits), the winners' object ids gathered, clipped winners and the row tail left to
-// resolve_sample.
+// bits), the winners' object ids gathered from the tile's refs, clipped winners and the row
+// tail left to resolve_sample.
 void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
-                       const Viewport& vp, const std::vector<std::uint32_t>& triangle_object,
-                       VisibilityBuffer& out) {
+                       const Viewport& vp, VisibilityBuffer& out) {
   const __m256i no_ref = _mm256_set1_epi32(-1);
   const __m256 one = _mm256_set1_ps(1.0f);
   const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   const int* flags = reinterpret_cast<const int*>(s.flags.data());
-  const int* objects = reinterpret_cast<const int*>(triangle_object.data());
+  const int* objects = reinterpret_cast<const int*>(s.object.data());
   const int full = (tx1 - tx0 + 1) / 8 * 8;
   for (int y = ty0; y <= ty1; ++y) {
     const int row = (y - ty0) * kTileSize;
@@ -432,7 +430,7 @@ void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
           _mm256_cmpeq_epi32(_mm256_and_si256(flag, _mm256_set1_epi32(int(kRefSwapped))),
                              _mm256_set1_epi32(int(kRefSwapped))));
       const __m256i tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.triangle[idx]));
-      const __m256i object = _mm256_mask_i32gather_epi32(no_ref, objects, tri, valid, 4);
+      const __m256i object = _mm256_mask_i32gather_epi32(no_ref, objects, ref, valid, 4);
       const __m256 inv_w = _mm256_loadu_ps(&s.inv_w[idx]);
       const __m256 q1 = _mm256_div_ps(_mm256_loadu_ps(&s.p1[idx]), inv_w);
       const __m256 q2 = _mm256_div_ps(_mm256_loadu_ps(&s.p2[idx]), inv_w);
@@ -450,17 +448,15 @@ void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
       _mm256_storeu_ps(bary + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
       if (const int c = _mm256_movemask_ps(_mm256_castsi256_ps(clipped)); c != 0)
         for (int l = 0; l < 8; ++l)
-          if (c & (1 << l)) resolve_sample(s, idx + l, o + l, triangle_object, out);
+          if (c & (1 << l)) resolve_sample(s, idx + l, o + l, out);
     }
-    for (int x = full; x <= tx1 - tx0; ++x)
-      resolve_sample(s, row + x, orow + x, triangle_object, out);
+    for (int x = full; x <= tx1 - tx0; ++x) resolve_sample(s, row + x, orow + x, out);
   }
 }
 
 template <int W>
-void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
-                      const std::vector<BinnedChunk>& chunks,
-                      const std::vector<std::uint32_t>& triangle_object, VisibilityBuffer& out) {
+void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const TileBins& bins,
+                      VisibilityBuffer& out) {
   thread_local TileScratch scratch;  // fully re-initialized below: no state crosses tiles
   TileScratch& s = scratch;
   const int tx0 = (tile % grid.tiles_x) * kTileSize, ty0 = (tile / grid.tiles_x) * kTileSize;
@@ -472,39 +468,34 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
   s.setup.clear();
   s.clip_map.clear();
   s.flags.clear();
+  s.object.clear();
   s.count_coverage = !out.coverage.empty();
   s.hiz = !s.count_coverage;
   std::fill(std::begin(s.block_min), std::end(s.block_min), 0.0f);
   if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
 
-  for (const BinnedChunk& chunk : chunks) {
-    const std::uint32_t begin = chunk.tile_offsets[tile], end = chunk.tile_offsets[tile + 1];
-    for (std::uint32_t k = begin; k < end; ++k) {
-      const SetupTriangle& t = chunk.binned[k];
-      const auto ref = static_cast<std::uint32_t>(s.setup.size());
-      s.setup.push_back(&t);
-      s.clip_map.push_back(t.clip_map >= 0 ? &chunk.clip_maps[t.clip_map] : nullptr);
-      s.flags.push_back((t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u));
-      raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);
-    }
+  const std::uint32_t begin = bins.tile_offsets[tile], end = bins.tile_offsets[tile + 1];
+  for (std::uint32_t k = begin; k < end; ++k) {
+    const SetupTriangle& t = bins.binned[k];
+    const auto ref = static_cast<std::uint32_t>(s.setup.size());
+    s.setup.push_back(&t);
+    s.clip_map.push_back(t.clip_map >= 0 ? &bins.clip_maps[t.clip_map] : nullptr);
+    s.flags.push_back((t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u));
+    s.object.push_back(t.object);
+    raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);
   }
 
   // Resolve: barycentrics only for the winners (deferred, like a visibility buffer).
   if (W == 8 && !s.count_coverage) {
-    resolve_tile_avx2(s, tx0, ty0, tx1, ty1, vp, triangle_object, out);
+    resolve_tile_avx2(s, tx0, ty0, tx1, ty1, vp, out);
     return;
   }
   for (int y = ty0; y <= ty1; ++y) {
     for (int x = tx0; x <= tx1; ++x) {
       const int idx = (y - ty0) * kTileSize + (x - tx0);
-      // The winners' object ids are scattered through the mesh: fetch a few samples ahead
-      // (idx + kPrefetchAhead stays inside the padded arrays; any valid ref is harmless).
-      constexpr int kPrefetchAhead = 8;
-      if (const std::uint32_t ahead = s.ref[idx + kPrefetchAhead]; ahead != kNoRef)
-        __builtin_prefetch(&triangle_object[s.setup[ahead]->triangle]);
       const std::size_t o = static_cast<std::size_t>(y) * vp.width + x;
       if (s.count_coverage) out.coverage.pixels[o] = s.coverage[idx];
-      resolve_sample(s, idx, o, triangle_object, out);
+      resolve_sample(s, idx, o, out);
     }
   }
 }
@@ -512,10 +503,9 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp,
 }  // namespace
 
 void rasterize_tile(int tile, int lanes, const TileGrid& grid, const Viewport& viewport,
-                    const std::vector<BinnedChunk>& chunks,
-                    const std::vector<std::uint32_t>& triangle_object, VisibilityBuffer& out) {
+                    const TileBins& bins, VisibilityBuffer& out) {
   par::dispatch_lanes(lanes, [&](auto w) {
-    rasterize_tile_w<decltype(w)::value>(tile, grid, viewport, chunks, triangle_object, out);
+    rasterize_tile_w<decltype(w)::value>(tile, grid, viewport, bins, out);
   });
 }
 

@@ -11,11 +11,10 @@
 
 namespace speculum::raster {
 
-// Rasterizes tile `tile` of `grid` from every chunk's list (chunk order, then list order)
-// and writes that tile's region of `out`. One call owns its tile: calls for different
-// tiles may run concurrently. `lanes` is 1, 4, 8 or 16 (same bits for each).
+// Rasterizes tile `tile` of `grid` from its list in `bins` (submission order) and writes
+// that tile's region of `out`. One call owns its tile: calls for different tiles may run
+// concurrently. `lanes` is 1, 4, 8 or 16 (same bits for each).
 void rasterize_tile(int tile, int lanes, const TileGrid& grid, const Viewport& viewport,
-                    const std::vector<BinnedChunk>& chunks,
-                    const std::vector<std::uint32_t>& triangle_object, VisibilityBuffer& out);
+                    const TileBins& bins, VisibilityBuffer& out);
 
 }  // namespace speculum::raster

@@ -55,8 +55,8 @@ inline bool project_and_snap(const glm::vec4& clip, const Viewport& vp, std::int
 
 // Emits a snapped triangle if it has area, faces the right way and covers a sample centre.
 void emit(std::int32_t x0, std::int32_t y0, float w0, std::int32_t x1, std::int32_t y1, float w1,
-          std::int32_t x2, std::int32_t y2, float w2, std::uint32_t triangle, const Viewport& vp,
-          int cull_sign, const ClipMap* map, std::vector<SetupTriangle>& out,
+          std::int32_t x2, std::int32_t y2, float w2, std::uint32_t triangle, std::uint32_t object,
+          const Viewport& vp, int cull_sign, const ClipMap* map, std::vector<SetupTriangle>& out,
           std::vector<ClipMap>& clip_maps) {
   // area = E_01(v2); screen y points down, so OpenGL front faces (CCW in NDC) are negative.
   const std::int64_t area = (std::int64_t(y0) - y1) * x2 + (std::int64_t(x1) - x0) * y2 +
@@ -68,12 +68,14 @@ void emit(std::int32_t x0, std::int32_t y0, float w0, std::int32_t x1, std::int3
   const std::int32_t minx = std::min({x0, x1, x2}), maxx = std::max({x0, x1, x2});
   const std::int32_t miny = std::min({y0, y1, y2}), maxy = std::max({y0, y1, y2});
   SetupTriangle t;
-  t.px0 = std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits);
-  t.py0 = std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits);
-  t.px1 = std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits);
-  t.py1 = std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits);
-  if (t.px0 > t.px1 || t.py0 > t.py1) return;  // covers no sample centre
+  const std::int32_t px0 = std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits);
+  const std::int32_t py0 = std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits);
+  const std::int32_t px1 = std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits);
+  const std::int32_t py1 = std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits);
+  if (px0 > px1 || py0 > py1) return;  // covers no sample centre
+  t.px0 = std::int16_t(px0), t.py0 = std::int16_t(py0), t.px1 = std::int16_t(px1), t.py1 = std::int16_t(py1);
   t.triangle = triangle;
+  t.object = object;
   const bool swap = area < 0;  // make E_i >= 0 inside
   t.x[0] = x0, t.y[0] = y0, t.inv_w[0] = w0;
   t.x[1] = swap ? x2 : x1, t.y[1] = swap ? y2 : y1, t.inv_w[1] = swap ? w2 : w1;
@@ -96,7 +98,7 @@ struct ClipVertex {
 };
 
 void clip_and_emit(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenVertex& v2,
-                   std::uint32_t triangle, const Viewport& vp, int cull_sign,
+                   std::uint32_t triangle, std::uint32_t object, const Viewport& vp, int cull_sign,
                    std::vector<SetupTriangle>& out, std::vector<ClipMap>& clip_maps) {
   const GuardBand g = guard_band(vp);
   // A triangle clipped by 6 planes has at most 9 vertices.
@@ -137,8 +139,8 @@ void clip_and_emit(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenV
     if (!project_and_snap(poly[i].p, vp, xs[i], ys[i], ws[i])) return;
   for (int i = 1; i + 1 < n; ++i) {
     const ClipMap map{{poly[0].b, poly[i].b, poly[i + 1].b}};
-    emit(xs[0], ys[0], ws[0], xs[i], ys[i], ws[i], xs[i + 1], ys[i + 1], ws[i + 1], triangle, vp,
-         cull_sign, &map, out, clip_maps);
+    emit(xs[0], ys[0], ws[0], xs[i], ys[i], ws[i], xs[i + 1], ys[i + 1], ws[i + 1], triangle,
+         object, vp, cull_sign, &map, out, clip_maps);
   }
 }
 
@@ -273,15 +275,15 @@ void make_screen_vertices(const glm::mat4& view_projection, const glm::vec3* pos
 }
 
 void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenVertex& v2,
-                    std::uint32_t triangle, const Viewport& vp, int cull_sign,
+                    std::uint32_t triangle, std::uint32_t object, const Viewport& vp, int cull_sign,
                     std::vector<SetupTriangle>& out, std::vector<ClipMap>& clip_maps) {
   // Trivial reject: all three vertices outside one viewport plane.
   if ((v0.outcode & v1.outcode & v2.outcode) & 0x3fu) return;
   if ((v0.outcode | v1.outcode | v2.outcode) & kNeedsClip) {
-    clip_and_emit(v0, v1, v2, triangle, vp, cull_sign, out, clip_maps);
+    clip_and_emit(v0, v1, v2, triangle, object, vp, cull_sign, out, clip_maps);
     return;
   }
-  emit(v0.x, v0.y, v0.inv_w, v1.x, v1.y, v1.inv_w, v2.x, v2.y, v2.inv_w, triangle, vp,
+  emit(v0.x, v0.y, v0.inv_w, v1.x, v1.y, v1.inv_w, v2.x, v2.y, v2.inv_w, triangle, object, vp,
        cull_sign, nullptr, out, clip_maps);
 }
 
@@ -297,10 +299,8 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
   SetupTriangle* dst = out.data();
   const int half = kSubpixelOne / 2;
   for (std::size_t t = begin; t < end; ++t) {
-    if (!excluded.empty()) {
-      const std::uint32_t object = triangle_object[t];
-      if (object < excluded.size() && excluded[object]) continue;
-    }
+    const std::uint32_t object = triangle_object[t];
+    if (!excluded.empty() && object < excluded.size() && excluded[object]) continue;
     const std::uint32_t* idx = &indices[3 * t];
     const ScreenVertex& v0 = vertices[idx[0]];
     const ScreenVertex& v1 = vertices[idx[1]];
@@ -311,7 +311,8 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
       // and re-initializes its tail) and only when a triangle yields more than one piece.
       thread_local std::vector<SetupTriangle> pieces;
       pieces.clear();
-      clip_and_emit(v0, v1, v2, static_cast<std::uint32_t>(t), vp, cull_sign, pieces, clip_maps);
+      clip_and_emit(v0, v1, v2, static_cast<std::uint32_t>(t), object, vp, cull_sign, pieces,
+                    clip_maps);
       const std::size_t need = n + pieces.size() + (end - t - 1);
       if (need > out.size()) {
         out.resize(need);
@@ -329,19 +330,22 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
     const std::int32_t minx = std::min({x0, x1, x2}), maxx = std::max({x0, x1, x2});
     const std::int32_t miny = std::min({y0, y1, y2}), maxy = std::max({y0, y1, y2});
     SetupTriangle& r = dst[n];
-    r.px0 = std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits);
-    r.py0 = std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits);
-    r.px1 = std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits);
-    r.py1 = std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits);
+    const std::int32_t px0 = std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits);
+    const std::int32_t py0 = std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits);
+    const std::int32_t px1 = std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits);
+    const std::int32_t py1 = std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits);
+    r.px0 = std::int16_t(px0), r.py0 = std::int16_t(py0), r.px1 = std::int16_t(px1), r.py1 = std::int16_t(py1);
     const bool swap = area < 0;
     r.x[0] = x0, r.y[0] = y0, r.inv_w[0] = v0.inv_w;
     r.x[1] = swap ? x2 : x1, r.y[1] = swap ? y2 : y1, r.inv_w[1] = swap ? v2.inv_w : v1.inv_w;
     r.x[2] = swap ? x1 : x2, r.y[2] = swap ? y1 : y2, r.inv_w[2] = swap ? v1.inv_w : v2.inv_w;
     r.triangle = static_cast<std::uint32_t>(t);
+    r.object = object;
     r.clip_map = -1;
     r.swapped = swap ? 1u : 0u;
+    r.reserved = 0;
     const bool culled = (cull_sign > 0 && area > 0) || (cull_sign < 0 && area < 0);
-    const bool keep = (area != 0) & !culled & (r.px0 <= r.px1) & (r.py0 <= r.py1);
+    const bool keep = (area != 0) & !culled & (px0 <= px1) & (py0 <= py1);
     n += keep ? 1 : 0;
   }
   return n;

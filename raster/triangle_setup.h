@@ -30,15 +30,19 @@ struct ScreenVertex {
 constexpr std::uint32_t kNeedsClip = 1u << 8;
 
 // A triangle ready to rasterize: positive area (E_i ≥ 0 inside), bounding box of the
-// pixels whose centres it may cover, clamped to the viewport.
-struct SetupTriangle {
+// pixels whose centres it may cover, clamped to the viewport. Exactly one 64-byte cache
+// line, aligned, so the bins (tile_binning.h) copy and stream whole lines.
+struct alignas(64) SetupTriangle {
   std::int32_t x[3], y[3];
   float inv_w[3];
-  std::int32_t px0, py0, px1, py1;  // inclusive pixel bounding box
+  std::int16_t px0, py0, px1, py1;  // inclusive pixel bounding box (sides ≤ kMaxTargetSide)
   std::uint32_t triangle;           // index in the scene's triangle soup
-  std::int32_t clip_map = -1;       // index into the chunk's ClipMaps, -1: not clipped
+  std::uint32_t object;             // its object id (the resolve needs no scene lookup)
+  std::int32_t clip_map = -1;       // index into the ClipMaps, -1: not clipped
   std::uint32_t swapped = 0;        // vertices 1 and 2 exchanged to make the area positive
+  std::uint32_t reserved = 0;       // zero: records compare equal byte for byte
 };
+static_assert(sizeof(SetupTriangle) == 64);
 
 // For a triangle produced by clipping: the original barycentrics of its three vertices.
 struct ClipMap {
@@ -62,13 +66,14 @@ void make_screen_vertices(const glm::mat4& view_projection, const glm::vec3* pos
 // `out` (more than one only when it was clipped; those also append a ClipMap).
 // cull_sign: 0 keeps both faces, +1 drops back faces, -1 drops front faces.
 void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenVertex& v2,
-                    std::uint32_t triangle, const Viewport& viewport, int cull_sign,
+                    std::uint32_t triangle, std::uint32_t object, const Viewport& viewport,
+                    int cull_sign,
                     std::vector<SetupTriangle>& out, std::vector<ClipMap>& clip_maps);
 
-// setup_triangle over triangles [begin, end) of an indexed list (indices[3t..3t+2]) with
-// the same results, skipping triangles whose object is flagged in `excluded` (indexed by
-// object id; empty: none). Writes the records to out[first ..) in triangle order and
-// returns the end index; `out` grows as needed but never shrinks (entries past the end are
+// setup_triangle over triangles [begin, end) of an indexed list (indices[3t..3t+2]) and
+// objects triangle_object[t] with the same results, skipping triangles whose object is
+// flagged in `excluded` (indexed by object id; empty: none). Writes the records to
+// out[first ..) in triangle order and returns the end index; `out` grows as needed but never shrinks (entries past the end are
 // stale), so a buffer reused across frames is not re-initialized. The common case (no
 // clipping) appends without a branch on the triangle's outcome.
 std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,

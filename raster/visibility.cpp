@@ -15,6 +15,7 @@ namespace speculum::raster {
 namespace {
 constexpr std::size_t kVertexChunk = 16384;
 constexpr std::size_t kTriangleChunk = 4096;
+constexpr std::size_t kTileChunk = 64;  // tiles per bin_offsets task
 }  // namespace
 
 namespace {
@@ -41,24 +42,40 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
                                const std::vector<std::uint32_t>& indices,
                                const std::vector<std::uint32_t>& triangle_object, int width,
                                int height, const RasterOptions& options,
-                               std::vector<BinnedChunk>& chunks, VisibilityBuffer& out) {
+                               TileBins& bins, VisibilityBuffer& out) {
   check_target_size(width, height);
   const int lanes = options.lanes == 0 ? par::default_lanes() : options.lanes;
   const Viewport vp{width, height};
   const TileGrid grid = make_tile_grid(width, height);
   const std::size_t triangles = indices.size() / 3;
-  chunks.resize((triangles + kTriangleChunk - 1) / kTriangleChunk);
+  if (triangle_object.size() < triangles)
+    throw InputError("rasterizer", "fewer object ids (" + std::to_string(triangle_object.size()) +
+                                       ") than triangles (" + std::to_string(triangles) + ")");
+  const std::size_t chunks = (triangles + kTriangleChunk - 1) / kTriangleChunk;
+  const std::size_t tiles = static_cast<std::size_t>(grid.count());
+  bins.chunks.resize(chunks);
+  bins.chunk_tile.resize(chunks * tiles);
+  bins.tile_offsets.resize(tiles + 1);
   const auto& excluded = options.excluded_objects;
   const int cull = cull_sign(options.cull);
   executor.parallel_for(
       "raster.setup_bin", triangles, kTriangleChunk, [&](std::size_t begin, std::size_t end) {
-        BinnedChunk& chunk = chunks[begin / kTriangleChunk];
+        const std::size_t c = begin / kTriangleChunk;
+        BinnedChunk& chunk = bins.chunks[c];
         chunk.clip_maps.clear();
         chunk.count = setup_triangles(vertices.data(), indices.data(), begin, end,
                                       triangle_object.data(), excluded, vp, cull, 0,
                                       chunk.triangles, chunk.clip_maps);
-        bin_chunk(chunk, grid);
+        count_chunk(bins, c, grid);
       });
+  executor.parallel_for("raster.bin_offsets", tiles, kTileChunk,
+                        [&](std::size_t begin, std::size_t end) {
+                          bin_offsets(bins, begin, end, grid);
+                        });
+  finish_offsets(bins, grid);
+  executor.parallel_for("raster.bin_scatter", chunks, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) scatter_chunk(bins, c, grid);
+  });
 
   out.width = width;
   out.height = height;
@@ -71,8 +88,7 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
   executor.parallel_for("raster.tiles", static_cast<std::size_t>(grid.count()), 1,
                         [&](std::size_t begin, std::size_t end) {
                           for (std::size_t tile = begin; tile < end; ++tile)
-                            rasterize_tile(static_cast<int>(tile), lanes, grid, vp, chunks,
-                                           triangle_object, out);
+                            rasterize_tile(static_cast<int>(tile), lanes, grid, vp, bins, out);
                         });
 }
 
@@ -82,10 +98,10 @@ VisibilityBuffer rasterize_screen_vertices(par::Executor& executor,
                                            const std::vector<std::uint32_t>& triangle_object,
                                            int width, int height,
                                            const RasterOptions& options) {
-  std::vector<BinnedChunk> chunks;
+  TileBins bins;
   VisibilityBuffer out;
   rasterize_screen_vertices(executor, vertices, indices, triangle_object, width, height, options,
-                            chunks, out);
+                            bins, out);
   return out;
 }
 
@@ -106,7 +122,7 @@ void render_visibility(par::Executor& executor, const Scene& scene, const Camera
                                                end - begin, vp, &vertices[begin]);
                         });
   rasterize_screen_vertices(executor, vertices, mesh.indices, mesh.triangle_object, width, height,
-                            options, workspace.chunks, out);
+                            options, workspace.bins, out);
 }
 
 VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,

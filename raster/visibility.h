@@ -57,7 +57,7 @@ VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,
 // do not allocate and fault in fresh pages every frame.
 struct RasterWorkspace {
   std::vector<ScreenVertex> vertices;
-  std::vector<BinnedChunk> chunks;
+  TileBins bins;
 };
 
 // As above, reusing `workspace` and `out` (resized only when the size changes).
@@ -77,6 +77,6 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
                                const std::vector<std::uint32_t>& indices,
                                const std::vector<std::uint32_t>& triangle_object, int width,
                                int height, const RasterOptions& options,
-                               std::vector<BinnedChunk>& chunks, VisibilityBuffer& out);
+                               TileBins& bins, VisibilityBuffer& out);
 
 }  // namespace speculum::raster

@@ -399,7 +399,7 @@ TEST(RasterSetup, ChunkedSetupEqualsPerTriangleSetup) {
         if (!skip.empty() && objects[t] < skip.size() && skip[objects[t]]) continue;
         const std::uint32_t* idx = &indices[3 * t];
         setup_triangle(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]],
-                       static_cast<std::uint32_t>(t), viewport, cull, one, one_maps);
+                       static_cast<std::uint32_t>(t), objects[t], viewport, cull, one, one_maps);
       }
       const std::size_t end = setup_triangles(vertices.data(), indices.data(), 0,
                                               objects.size(), objects.data(), skip, viewport,
