@@ -94,18 +94,26 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   const std::size_t workers = std::min<std::size_t>(std::size_t(ex.threads()), chunks);
   ex.parallel_for(launch_name(name, "chained_scan"), workers, 1, [&](std::size_t, std::size_t) {
     std::vector<T> sums;
-    for (;;) {
-      const std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
-      if (c >= chunks) return;
+    // Each thread claims its next chunk before scanning the current one, so the kernel can
+    // prefetch it (a claimed chunk whose thread stalls costs its successors one extra
+    // reduction in look_back, never a wait).
+    std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
+    while (c < chunks) {
+      const std::size_t following = next.fetch_add(1, std::memory_order_relaxed);
       ScanLink<T>& link = links[c];
       link.sum = sum_of(c);
       link.state.store(ScanLink<T>::kSum, std::memory_order_release);
       const T offset = look_back(links.get(), c, init, op, sum_of, sums);
       link.prefix = op(offset, link.sum);
       link.state.store(ScanLink<T>::kPrefix, std::memory_order_release);
-      const std::size_t b = c * chunk;
-      scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
-                                          streaming);
+      const std::size_t b = c * chunk, fb = following * chunk;
+      if (following < chunks)
+        scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
+                                            streaming, src + fb, std::min(n, fb + chunk) - fb);
+      else
+        scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
+                                            streaming);
+      c = following;
     }
   });
   return links[chunks - 1].prefix;

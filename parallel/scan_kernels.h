@@ -99,15 +99,33 @@ inline __m256i prefix8(__m256i x) {
   return _mm256_add_epi32(x, _mm256_permute2x128_si256(low_total, low_total, 0x08));
 }
 
+// Prefetch::next / end: the lines of the chunk this thread scans next, fetched into L2 one
+// line per 16 elements of this chunk's scan, so its reduction reads cache while this scan,
+// bound by arithmetic and writes, would otherwise leave the memory reads idle.
+struct Prefetch {
+  const char* next = nullptr;
+  const char* end = nullptr;
+  void step() {
+    if (next < end) {
+      _mm_prefetch(next, _MM_HINT_T1);
+      next += 64;
+    }
+  }
+  void rest() {
+    for (; next < end; next += 64) _mm_prefetch(next, _MM_HINT_T1);
+  }
+};
+
 template <bool Inclusive, bool Streaming>
 std::uint32_t scan_sum32(const std::uint32_t* in, std::uint32_t* out, std::size_t m,
-                         std::uint32_t acc) {
+                         std::uint32_t acc, Prefetch& prefetch) {
   std::size_t i = Streaming ? to_line(out, m) : 0;
   std::plus<std::uint32_t> plus;
   acc = scan_scalar<Inclusive>(in, out, i, acc, plus);
   __m256i carry = _mm256_set1_epi32(int(acc));
   const __m256i last = _mm256_set1_epi32(7);
   for (; i + 16 <= m; i += 16) {
+    prefetch.step();
     const __m256i x0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i));
     const __m256i x1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i + 8));
     const __m256i p0 = prefix8(x0);
@@ -153,19 +171,28 @@ T scan_streaming(const T* in, T* out, std::size_t m, T acc, Op& op) {
 }  // namespace detail
 
 // Scans in[0, m) from `offset` into out[0, m) (out may equal in). Streaming: full output
-// lines bypass the caches (followed by a store fence, so the join publishes them).
+// lines bypass the caches (followed by a store fence, so the join publishes them), and the
+// `next_count` elements at `next` (the thread's next chunk, none when null) are prefetched
+// into L2 during the scan.
 template <bool Inclusive, class T, class Op>
-void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool streaming) {
+void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool streaming,
+                const T* next = nullptr, std::size_t next_count = 0) {
 #if defined(__AVX2__)
   if constexpr (kSimdSum32<T, Op>) {
     const auto* i32 = reinterpret_cast<const std::uint32_t*>(in);
     auto* o32 = reinterpret_cast<std::uint32_t*>(out);
+    detail::Prefetch prefetch;
+    if (streaming && next != nullptr) {
+      prefetch.next = reinterpret_cast<const char*>(next);
+      prefetch.end = reinterpret_cast<const char*>(next + next_count);
+    }
     if (streaming) {
-      detail::scan_sum32<Inclusive, true>(i32, o32, m, std::uint32_t(offset));
+      detail::scan_sum32<Inclusive, true>(i32, o32, m, std::uint32_t(offset), prefetch);
       _mm_sfence();
     } else {
-      detail::scan_sum32<Inclusive, false>(i32, o32, m, std::uint32_t(offset));
+      detail::scan_sum32<Inclusive, false>(i32, o32, m, std::uint32_t(offset), prefetch);
     }
+    prefetch.rest();
     return;
   }
   if constexpr (std::is_trivially_copyable_v<T> && 64 % sizeof(T) == 0) {
@@ -176,7 +203,7 @@ void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool strea
     }
   }
 #endif
-  (void)streaming;
+  (void)streaming, (void)next, (void)next_count;
   detail::scan_scalar<Inclusive>(in, out, m, offset, op);
 }
 
