@@ -24,6 +24,14 @@
 //     }
 //   }
 //   dispatch_lanes(default_lanes(), [&](auto w) { scale<decltype(w)::value>(x, y, n, 2.f); });
+//
+// Which kernels take W (what `--lanes` changes): map_lanes (stream.h) and the tile
+// rasterizer's coverage and depth test (raster/tile_rasterizer.cpp). The bandwidth-bound
+// primitives (scan_kernels.h, compact.cpp, radix_sort.cpp), the G-buffer resolve and the
+// BVH traversal kernels are written with fixed 8-wide AVX2 intrinsics instead (measured
+// faster than fixed_size_simd, whose min/max were out-of-line calls); they do integer work or
+// the same IEEE operations per element as their scalar tests, so their bits do not depend on
+// W either — but they are not instantiated per W.
 #pragma once
 
 #include <experimental/simd>
