@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 #include "primitive_test_util.h"
@@ -87,15 +88,24 @@ TEST(Compact, EveryRatioFromZeroToHundredPercent) {
   }
 }
 
+// 16M flags at a middle ratio and at the ends, both forms, 1/2/8 threads (the serial filter
+// is the reference, so every thread count gives the same indices).
 TEST(Compact, SixteenMillion) {
-  const std::size_t n = std::size_t(16) << 20;
-  const auto keep = flags(n, 37, 5);
-  const auto ref = serial_filter(keep);
-  EXPECT_EQ(run_scatter(executor(2), keep), ref);
-  std::vector<std::uint32_t> out(n), scratch;
-  const auto c = compact_hierarchical(executor(2), "h16M", keep, out, 64, &scratch);
-  out.resize(c);
-  EXPECT_EQ(out, ref);
+  const std::size_t n = (std::size_t(16) << 20) + 5;
+  for (int percent : {37, 0, 100}) {
+    const auto keep = flags(n, percent, 5);
+    const auto ref = serial_filter(keep);
+    std::vector<std::uint32_t> out, scratch;
+    for (int t : kThreadCounts) {
+      out.assign(n, 0xdeadbeefu);
+      ASSERT_EQ(compact_scatter(executor(t), "s16M", keep, out), ref.size()) << percent << "% t=" << t;
+      ASSERT_TRUE(std::equal(ref.begin(), ref.end(), out.begin())) << percent << "% t=" << t;
+      out.assign(n, 0xdeadbeefu);
+      ASSERT_EQ(compact_hierarchical(executor(t), "h16M", keep, out, 64, &scratch), ref.size())
+          << percent << "% t=" << t;
+      ASSERT_TRUE(std::equal(ref.begin(), ref.end(), out.begin())) << percent << "% t=" << t;
+    }
+  }
 }
 
 // Flags made by a width-generic kernel, then compacted: identical for every W and thread

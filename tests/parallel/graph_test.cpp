@@ -149,6 +149,127 @@ TEST(Graph, RejectsTypeMismatch) {
   EXPECT_TRUE(contains(access, "node 'w': port 'v' is declared as float but accessed as double")) << access;
 }
 
+// Node → node: "x" produced as one type and read as another is rejected at compile (and by
+// run() before any node executes); the message names the consumer, the resource, the
+// producer and both types — whichever node was added first, and for a cross-frame read too.
+TEST(Graph, RejectsTypeMismatchBetweenNodes) {
+  bool ran = false;
+  auto make = [&](NodeContext& c) { ran = true; c.output<std::vector<float>>("x") = {1.f}; };
+  auto use = [&](NodeContext& c) { ran = true; c.output<int>("y") = int(c.input<double>("x")); };
+  for (bool producer_first : {true, false}) {
+    Graph g;
+    if (producer_first) g.add("make", make).writes<std::vector<float>>("x");
+    g.add("use", use).reads<double>("x").writes<int>("y");
+    if (!producer_first) g.add("make", make).writes<std::vector<float>>("x");
+    const auto msg = error_of([&] { g.compile(); });
+    EXPECT_TRUE(contains(msg, "node 'use' reads resource 'x' as double")) << msg;
+    EXPECT_TRUE(contains(msg, "node 'make' provides std::vector<float>")) << msg;
+    Executor ex(2);
+    EXPECT_EQ(error_of([&] { g.run(ex); }), msg);
+    EXPECT_FALSE(ran);
+  }
+  Graph prev;
+  prev.add("make", make).writes<std::vector<float>>("x");
+  prev.add("late", [](NodeContext&) {}).reads_previous<float>("x").writes<int>("z");
+  const auto msg = error_of([&] { prev.compile(); });
+  EXPECT_TRUE(contains(msg, "node 'late' reads resource 'x' as float")) << msg;
+  EXPECT_TRUE(contains(msg, "node 'make' provides std::vector<float>")) << msg;
+}
+
+std::size_t occurrences(const std::string& s, const std::string& part) {
+  std::size_t count = 0;
+  for (std::size_t at = s.find(part); at != std::string::npos; at = s.find(part, at + 1)) ++count;
+  return count;
+}
+
+// Per-node wall time is recorded (a node that sleeps 2 ms reports at least 2 ms, and a
+// node starts only after the nodes it reads have ended), and the Chrome trace holds exactly
+// one complete event per executed node and one per named kernel launch (culled nodes and
+// their launches absent; a launch outside the graph included), for 1, 2 and 8 threads.
+TEST(Graph, RecordsNodeTimesAndTraceHasOneEventPerNodeAndLaunch) {
+  constexpr std::int64_t kSleepNs = 2'000'000;
+  auto launch = [](NodeContext& c, const char* name, std::size_t n) {
+    c.executor().parallel_for(name, n, 16, [&](std::size_t b, std::size_t e) { c.count("elements", e - b); });
+  };
+  for (int threads : {1, 2, 8}) {
+    Executor ex(threads);
+    ex.clear_launches();
+    ex.parallel_for("outside/k", 40, 16, [](std::size_t, std::size_t) {});
+    Graph g;
+    g.add("sleep", [&](NodeContext& c) {
+       std::this_thread::sleep_for(std::chrono::nanoseconds(kSleepNs));
+       launch(c, "sleep/k", 100);
+       c.output<int>("a") = 1;
+     }).writes<int>("a");
+    g.add("work", [&](NodeContext& c) {
+       launch(c, "work/k0", 1000);
+       launch(c, "work/k1", 0);  // an empty launch is still a named launch
+       c.output<int>("w") = c.input<int>("a") + 1;
+     }).reads<int>("a").writes<int>("w");
+    g.add("side", [&](NodeContext& c) {
+       for (const char* k : {"side/k0", "side/k1", "side/k2"}) launch(c, k, 33);
+       c.output<int>("b") = 10;
+     }).writes<int>("b");
+    g.add("join", [](NodeContext& c) { c.output<int>("out") = c.input<int>("w") + c.input<int>("b"); })
+        .reads<int>("w").reads<int>("b").writes<int>("out");
+    g.add("culled", [&](NodeContext& c) {
+       launch(c, "culled/k", 10);
+       c.output<int>("unused") = 0;
+     }).writes<int>("unused");
+    g.request("out");
+    const RunReport report = g.run(ex);
+    ASSERT_EQ(g.get<int>("out"), 12);
+    ASSERT_EQ(report.nodes.size(), 4u) << threads;
+    const NodeRecord* sleep = report.find("sleep");
+    const NodeRecord* work = report.find("work");
+    const NodeRecord* side = report.find("side");
+    const NodeRecord* join = report.find("join");
+    ASSERT_TRUE(sleep && work && side && join);
+    EXPECT_EQ(report.find("culled"), nullptr);
+    EXPECT_GE(sleep->duration_ns, kSleepNs) << threads;
+    for (const auto& n : report.nodes) {
+      EXPECT_GE(n.duration_ns, 0) << n.name;
+      EXPECT_GE(n.start_ns, report.start_ns) << n.name;
+      EXPECT_LE(n.start_ns + n.duration_ns, report.start_ns + report.duration_ns) << n.name;
+    }
+    EXPECT_GE(work->start_ns, sleep->start_ns + sleep->duration_ns) << threads;
+    EXPECT_GE(join->start_ns, work->start_ns + work->duration_ns) << threads;
+    EXPECT_GE(join->start_ns, side->start_ns + side->duration_ns) << threads;
+    EXPECT_GE(report.duration_ns, sleep->duration_ns);
+    EXPECT_EQ(work->counters.at("elements"), 1000u);
+    EXPECT_EQ(side->counters.at("elements"), 99u);
+
+    const auto launches = ex.launches();
+    const std::vector<std::pair<std::string, std::string>> expected = {
+        {"outside/k", ""},     {"sleep/k", "sleep"},  {"work/k0", "work"}, {"work/k1", "work"},
+        {"side/k0", "side"}, {"side/k1", "side"}, {"side/k2", "side"}};
+    ASSERT_EQ(launches.size(), expected.size()) << threads;
+    for (const auto& [name, scope] : expected) {
+      std::size_t found = 0;
+      for (const auto& l : launches)
+        if (l.name == name) {
+          ++found;
+          EXPECT_EQ(l.scope, scope) << name;
+        }
+      EXPECT_EQ(found, 1u) << name;
+    }
+    const std::string trace = chrome_trace_json(report, launches);
+    EXPECT_EQ(occurrences(trace, "\"ph\":\"X\""), report.nodes.size() + launches.size()) << trace;
+    EXPECT_EQ(occurrences(trace, "\"cat\":\"node\""), report.nodes.size()) << trace;
+    EXPECT_EQ(occurrences(trace, "\"cat\":\"launch\""), launches.size()) << trace;
+    for (const char* node : {"sleep", "work", "side", "join"})
+      EXPECT_EQ(occurrences(trace, std::string("{\"name\":\"") + node + "\",\"cat\":\"node\""), 1u) << node;
+    for (const auto& [name, scope] : expected)
+      EXPECT_EQ(occurrences(trace, "{\"name\":\"" + name + "\",\"cat\":\"launch\""), 1u) << name;
+    EXPECT_FALSE(contains(trace, "culled")) << trace;
+    // The sleeping node's event lasts at least its 2 ms (durations are in µs).
+    const std::string sleep_event = "{\"name\":\"sleep\",\"cat\":\"node\"";
+    const std::size_t at = trace.find("\"dur\":", trace.find(sleep_event));
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_GE(std::stod(trace.substr(at + 6)), 2000.0) << trace;
+  }
+}
+
 TEST(Graph, RejectsTwoProducersAndBadNames) {
   Graph g;
   g.add("a", [](NodeContext&) {}).writes<int>("r");

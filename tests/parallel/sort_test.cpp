@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <limits>
 #include <numeric>
 
@@ -130,7 +131,20 @@ TEST(RadixSort, SixteenMillion32BitKeys) {
     }
     const auto original = keys;
     RadixSortScratch<std::uint32_t> scratch;
+    // 1 and 8 threads give exactly the 2-thread result checked below (keys and payload).
+    std::vector<std::vector<std::uint32_t>> other_keys, other_payload;
+    for (int t : {1, 8}) {
+      std::vector<std::uint32_t> k = original, p(n);
+      std::iota(p.begin(), p.end(), 0u);
+      radix_sort(executor(t), "radix16M", std::span(k), std::span(p), &scratch);
+      other_keys.push_back(std::move(k));
+      other_payload.push_back(std::move(p));
+    }
     radix_sort(executor(2), "radix16M", std::span(keys), std::span(payload), &scratch);
+    for (std::size_t k = 0; k < other_keys.size(); ++k) {
+      ASSERT_TRUE(other_keys[k] == keys) << std::hex << mask << " t=" << (k ? 8 : 1);
+      ASSERT_TRUE(other_payload[k] == payload) << std::hex << mask << " t=" << (k ? 8 : 1);
+    }
     // Sorted, stable, and payload is a permutation mapping back to the original keys.
     std::vector<bool> seen(n, false);
     for (std::size_t i = 0; i < n; ++i) {
@@ -144,9 +158,11 @@ TEST(RadixSort, SixteenMillion32BitKeys) {
         }
       }
     }
-    auto bare = original;  // keys only: the same keys in the same order
-    radix_sort(executor(2), "radix16M_keys", std::span(bare), {}, &scratch);
-    ASSERT_EQ(bare, keys) << std::hex << mask;
+    for (int t : kThreadCounts) {
+      auto bare = original;  // keys only: the same keys in the same order
+      radix_sort(executor(t), "radix16M_keys", std::span(bare), {}, &scratch);
+      ASSERT_TRUE(bare == keys) << std::hex << mask << " t=" << t;
+    }
   }
 }
 
@@ -184,6 +200,104 @@ TEST(SegmentedMin, ClosestHitPerRayEqualsSerial) {
   std::vector<float> v(2), t = {1, 2};
   std::vector<std::uint32_t> ix(2);
   EXPECT_THROW(segmented_min_sorted(executor(1), "bad", unsorted, t, 2, v, ix), std::invalid_argument);
+}
+
+// The documented edge semantics (segmented.h): an empty segment (leading, middle, trailing,
+// past the largest id) gets +infinity and kNoIndex; NaN never wins, so a segment of only
+// NaNs has no winner either (+infinity, kNoIndex); +infinity is a real value (a segment
+// whose smallest value is +infinity reports its lowest index); ties, including -0 == +0,
+// go to the lowest element index and report that element's bits.
+TEST(SegmentedMin, NaNNeverWinsAndEmptySegmentsGetInfinityAndNoIndex) {
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  const std::uint32_t segments = 10;
+  // Sorted ids; segments 0, 3, 8 and 9 are empty.
+  const std::vector<std::uint32_t> seg = {1, 1, 1, 1, 1, 2, 2, 4, 4, 4, 5, 5, 6, 6, 6, 7, 7};
+  const std::vector<float> val = {nan, 3, nan, 2, 2, nan, nan, inf, nan, inf, nan, inf, 1, -0.f, 0.f, -inf, nan};
+  const std::vector<float> want_v = {inf, 2, inf, inf, inf, inf, -0.f, -inf, inf, inf};
+  const std::vector<std::uint32_t> want_i = {kNoIndex, 3, kNoIndex, kNoIndex, 7, 11, 13, 15, kNoIndex, kNoIndex};
+  // The same elements in reverse order (ids now unsorted): element j is element 16 - j.
+  const std::vector<std::uint32_t> rseg(seg.rbegin(), seg.rend());
+  const std::vector<float> rval(val.rbegin(), val.rend());
+  const std::vector<float> want_rv = {inf, 2, inf, inf, inf, inf, 0.f, -inf, inf, inf};  // +0 is now first
+  const std::vector<std::uint32_t> want_ri = {kNoIndex, 12, kNoIndex, kNoIndex, 7, 5, 2, 1, kNoIndex, kNoIndex};
+  auto bits = [](const std::vector<float>& v) {
+    std::vector<std::uint32_t> b;
+    for (float x : v) b.push_back(std::bit_cast<std::uint32_t>(x));
+    return b;
+  };
+  for (int t : kThreadCounts) {
+    std::vector<float> v(segments, 42.f);
+    std::vector<std::uint32_t> ix(segments, 42);
+    segmented_min_sorted(executor(t), "edges_sorted", seg, val, segments, v, ix);
+    EXPECT_EQ(bits(v), bits(want_v)) << "t=" << t;
+    EXPECT_EQ(ix, want_i) << "t=" << t;
+    v.assign(segments, 42.f);
+    ix.assign(segments, 42);
+    segmented_min(executor(t), "edges", seg, val, segments, v, ix);
+    EXPECT_EQ(bits(v), bits(want_v)) << "t=" << t;
+    EXPECT_EQ(ix, want_i) << "t=" << t;
+    v.assign(segments, 42.f);
+    ix.assign(segments, 42);
+    segmented_min(executor(t), "edges_reversed", rseg, rval, segments, v, ix);
+    EXPECT_EQ(bits(v), bits(want_rv)) << "t=" << t;
+    EXPECT_EQ(ix, want_ri) << "t=" << t;
+    EXPECT_THROW(segmented_min_sorted(executor(t), "reversed", rseg, rval, segments, v, ix), std::invalid_argument);
+    // No elements at all: every segment is empty.
+    v.assign(3, 42.f);
+    ix.assign(3, 42);
+    segmented_min_sorted(executor(t), "none_sorted", {}, {}, 3, v, ix);
+    EXPECT_EQ(v, std::vector<float>(3, inf));
+    EXPECT_EQ(ix, std::vector<std::uint32_t>(3, kNoIndex));
+    v.assign(3, 42.f);
+    ix.assign(3, 42);
+    segmented_min(executor(t), "none", {}, {}, 3, v, ix);
+    EXPECT_EQ(v, std::vector<float>(3, inf));
+    EXPECT_EQ(ix, std::vector<std::uint32_t>(3, kNoIndex));
+    segmented_min(executor(t), "zero_segments", {}, {}, 0, std::span<float>(), std::span<std::uint32_t>());
+  }
+  // Out-of-range ids are rejected by both forms.
+  const std::vector<std::uint32_t> high = {0, 1, 3};
+  const std::vector<std::uint32_t> high_unsorted = {3, 0, 1};
+  const std::vector<float> three = {1, 2, 3};
+  std::vector<float> v(3);
+  std::vector<std::uint32_t> ix(3);
+  EXPECT_THROW(segmented_min_sorted(executor(2), "high", high, three, 3, v, ix), std::invalid_argument);
+  EXPECT_THROW(segmented_min(executor(2), "high", high_unsorted, three, 3, v, ix), std::invalid_argument);
+}
+
+// Many more segments than elements, across the 4096-segment chunks of the per-segment pass:
+// each chunk starts its search in a long run of empty segments; only the few occupied
+// segments have a winner, every other one is +infinity / kNoIndex, for 1/2/8 threads.
+TEST(SegmentedMin, SparseSegmentsAcrossChunksEqualSerial) {
+  const std::uint32_t segments = 3 * 4096 + 17;
+  const std::size_t n = 301;
+  std::vector<std::uint32_t> seg(n);
+  std::vector<float> val(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    seg[i] = hash32(i * 31) % segments;
+    val[i] = hash32(i + 1) % 5 == 0 ? std::numeric_limits<float>::quiet_NaN() : float(hash32(i + 2) % 8);
+  }
+  seg[0] = 4095, seg[1] = 4096, seg[2] = segments - 1;  // chunk edges and the last segment
+  std::vector<float> ref_v(segments, std::numeric_limits<float>::infinity());
+  std::vector<std::uint32_t> ref_i(segments, kNoIndex);
+  for (std::size_t i = 0; i < n; ++i)
+    if (val[i] < ref_v[seg[i]]) ref_v[seg[i]] = val[i], ref_i[seg[i]] = std::uint32_t(i);
+  auto sorted_seg = seg;
+  std::sort(sorted_seg.begin(), sorted_seg.end());
+  std::vector<float> ref_sv(segments, std::numeric_limits<float>::infinity());
+  std::vector<std::uint32_t> ref_si(segments, kNoIndex);
+  for (std::size_t i = 0; i < n; ++i)
+    if (val[i] < ref_sv[sorted_seg[i]]) ref_sv[sorted_seg[i]] = val[i], ref_si[sorted_seg[i]] = std::uint32_t(i);
+  for (int t : kThreadCounts) {
+    std::vector<float> v(segments);
+    std::vector<std::uint32_t> ix(segments);
+    segmented_min(executor(t), "sparse", seg, val, segments, v, ix);
+    ASSERT_EQ(v, ref_v) << "t=" << t;
+    ASSERT_EQ(ix, ref_i) << "t=" << t;
+    segmented_min_sorted(executor(t), "sparse_sorted", sorted_seg, val, segments, v, ix);
+    ASSERT_EQ(v, ref_sv) << "t=" << t;
+    ASSERT_EQ(ix, ref_si) << "t=" << t;
+  }
 }
 
 TEST(Histogram, CountsEqualSerial) {
