@@ -49,6 +49,9 @@ Camera resolve_camera(const Scene& scene, const CameraOverrides& o) {
   if (!o.target.empty()) cam.target = parse_vec3("--target", o.target);
   if (!o.up.empty()) cam.up = parse_vec3("--up", o.up);
   if (o.fov != 0.0f) cam.vfov_degrees = o.fov;
+  // The scene's near/far planes suit where the scene put its camera (a mesh file's framing
+  // camera has them tight around the bounds): a moved or re-aimed camera gets its own.
+  if (!o.eye.empty() || !o.target.empty()) cam = fit_clip_planes(cam, scene.bounds());
   validate_camera(cam, "camera options");
   return cam;
 }

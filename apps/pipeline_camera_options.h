@@ -18,8 +18,9 @@ struct CameraOverrides {
 
 void add_camera_options(CLI::App& cmd, CameraOverrides& overrides);
 
-// The chosen camera with overrides applied; throws InputError for unknown names, bad
-// vectors or a degenerate result.
+// The chosen camera with overrides applied; with --eye or --target its near/far planes are
+// refitted to the scene's bounds (fit_clip_planes), otherwise the scene's are kept. Throws
+// InputError for unknown names, bad vectors or a degenerate result.
 Camera resolve_camera(const Scene& scene, const CameraOverrides& overrides);
 
 }  // namespace speculum::pipeline

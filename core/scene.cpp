@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -99,9 +100,37 @@ Camera framing_camera(const Bounds& bounds) {
   const float dist = radius / std::tan(glm::radians(cam.vfov_degrees) * 0.5f) * 1.1f;
   cam.target = c;
   cam.eye = c + glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)) * dist;
-  cam.znear = std::max(dist - radius * 1.5f, dist * 1e-3f);
-  cam.zfar = dist + radius * 2.0f;
+  const ClipPlanes planes = sphere_clip_planes(dist, radius);
+  cam.znear = planes.znear;
+  cam.zfar = planes.zfar;
   return cam;
+}
+
+ClipPlanes sphere_clip_planes(float centre_depth, float radius) {
+  ClipPlanes p;
+  // A sphere wholly behind the eye is invisible: any valid pair will do.
+  p.zfar = std::max(centre_depth + radius * 2.0f, radius);
+  p.znear = std::max(centre_depth - radius * 1.5f, std::max(centre_depth * 1e-3f, p.zfar * 1e-4f));
+  return p;
+}
+
+Camera fit_clip_planes(Camera camera, const Bounds& bounds) {
+  if (!bounds.valid() || camera.eye == camera.target) return camera;  // validate_camera reports it
+  const glm::vec3 forward = glm::normalize(camera.target - camera.eye);
+  const float radius = std::max(0.5f * glm::length(bounds.extent()), 1e-3f);
+  ClipPlanes planes = sphere_clip_planes(glm::dot(bounds.center() - camera.eye, forward), radius);
+  // The sphere around a long thin box can be much larger than the box: its nearest corner
+  // (a linear function is smallest over a box at a corner) gives a tighter near plane.
+  float nearest = std::numeric_limits<float>::infinity();
+  for (int k = 0; k < 8; ++k) {
+    const glm::vec3 corner(k & 1 ? bounds.hi.x : bounds.lo.x, k & 2 ? bounds.hi.y : bounds.lo.y,
+                           k & 4 ? bounds.hi.z : bounds.lo.z);
+    nearest = std::min(nearest, glm::dot(corner - camera.eye, forward));
+  }
+  planes.znear = std::max(planes.znear, 0.9f * nearest);
+  camera.znear = planes.znear;
+  camera.zfar = planes.zfar;
+  return camera;
 }
 
 }  // namespace speculum

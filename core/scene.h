@@ -145,4 +145,20 @@ struct Scene {
 // A camera that frames the scene's bounds from the +Z side, slightly above.
 Camera framing_camera(const Bounds& bounds);
 
+// Near and far planes around a bounding sphere of radius `radius` whose centre lies
+// `centre_depth` ahead of the eye along the view axis (negative: behind): far = depth + 2r,
+// near = depth - 1.5r, or a small fraction of far (1e-4) when the eye is inside or close to
+// the sphere. framing_camera uses this rule.
+struct ClipPlanes {
+  float znear = 0.0f;
+  float zfar = 0.0f;
+};
+ClipPlanes sphere_clip_planes(float centre_depth, float radius);
+
+// `camera` with znear/zfar recomputed for its own eye and view direction so that all of
+// `bounds` lies between them: the sphere rule above on the sphere around the box, near pulled
+// up to 0.9 x the box's nearest corner depth when the box is wholly in front of the eye.
+// Unchanged when `bounds` is empty. For cameras moved away from where the scene put them.
+Camera fit_clip_planes(Camera camera, const Bounds& bounds);
+
 }  // namespace speculum
