@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
 #include "core/camera_rays.h"
@@ -27,6 +29,9 @@ ScreenVertex fixed_vertex(std::int32_t x, std::int32_t y) {
   v.inv_w = 1.0f;
   return v;
 }
+// How far (in pixels) snapping vertices to the sub-pixel grid can move an edge.
+constexpr double kSnapTolerancePixels = 1.0 / kSubpixelOne;
+
 constexpr std::int32_t centre_of(int pixel) { return pixel * kSubpixelOne + kSubpixelOne / 2; }
 
 TEST(RasterFillRule, EdgesThroughSampleCentresFollowTopLeft) {
@@ -126,6 +131,36 @@ TEST(RasterWatertight, ClosedTorusFrontCoverageEqualsBackCoverage) {
   EXPECT_GT(twice, 100u);  // the view sees through the hole: some rays cross it twice
 }
 
+// Signed distance in pixels from the centre of sample (x, y) to the image of triangle `t`
+// under `cam`: the smallest over its three edges, positive inside, negative outside. Each
+// edge is the plane through the eye and the edge, cut with the image plane (a line), so a
+// triangle crossing the near plane needs no clipping here. In double, from the camera basis.
+double signed_pixel_distance(const Scene& scene, std::uint32_t t, const Camera& cam, int w, int h,
+                             int x, int y) {
+  const glm::dvec3 e(cam.eye), f = glm::normalize(glm::dvec3(cam.target) - e);
+  const glm::dvec3 r = glm::normalize(glm::cross(f, glm::dvec3(cam.up))), u = glm::cross(r, f);
+  const double tan_half = std::tan(glm::radians(double(cam.vfov_degrees)) * 0.5);
+  const double aspect = double(w) / h;
+  // The sample centre on the image plane at unit depth, and pixels per image-plane unit.
+  const glm::dvec3 p = f + r * ((2.0 * (x + 0.5) / w - 1.0) * tan_half * aspect) +
+                       u * ((1.0 - 2.0 * (y + 0.5) / h) * tan_half);
+  const double pixels_per_unit = h / (2.0 * tan_half);
+  const TriangleMesh& m = scene.mesh;
+  glm::dvec3 v[3];
+  for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(m.positions[m.indices[3 * t + k]]) - e;
+  double inside = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec3 &a = v[k], &b = v[(k + 1) % 3], &c = v[(k + 2) % 3];
+    const glm::dvec3 n = glm::cross(a, b);
+    const glm::dvec3 n_image = n - glm::dot(n, f) * f;  // the line's normal within the image plane
+    const double side = glm::dot(n, c);                  // the third vertex is on the inside
+    if (glm::length(n_image) == 0.0 || side == 0.0) continue;
+    inside = std::min(inside, std::copysign(1.0, side) * glm::dot(n, p) / glm::length(n_image) *
+                                  pixels_per_unit);
+  }
+  return inside;
+}
+
 TEST(RasterOracle, VisibilityMatchesBruteForceRays) {
   // Overlapping random triangles in depth layers (no interpenetration) plus a floor that
   // crosses the near plane (exercises clipping).
@@ -148,21 +183,39 @@ TEST(RasterOracle, VisibilityMatchesBruteForceRays) {
     const auto vis = render_visibility(ex, scene, cam, w, h);
     const glm::dvec3 forward(glm::normalize(cam.target - cam.eye));
     std::size_t edge_samples = 0, mismatches_off_edge = 0, hits = 0;
-    double max_depth_rel = 0, max_bary = 0;
+    double max_depth_rel = 0, max_bary = 0, worst_outside = 0;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         const Ray ray = primary_ray(cam, w, h, x + 0.5f, y + 0.5f);
         const auto hit = testing::oracle_closest_hit(scene, ray, forward, cam.znear);
         const std::uint32_t got = vis.triangle.at(x, y);
         if (got != hit.triangle) {
-          // Within ~1e-3 of an edge (snapping moves edges by < 1/256 pixel), it is an edge sample.
-          if (hit.triangle != kNoId && hit.min_edge_distance < 2e-3) ++edge_samples;
-          else if (hit.triangle == kNoId) ++edge_samples;  // checked below: near an edge
-          else ++mismatches_off_edge;
+          // The oracle's triangle within 2e-3 (barycentric) of an edge: an edge sample.
+          if (hit.triangle != kNoId && hit.min_edge_distance < 2e-3) {
+            ++edge_samples;
+          } else if (hit.triangle == kNoId) {
+            // A hit where the oracle sees nothing: the sample centre must lie just outside
+            // (or on) an edge of the reported triangle. Vertex snapping to 1/256 pixel moves
+            // each coordinate by <= 1/512 pixel, hence edges by < 1/256 pixel.
+            const double d = signed_pixel_distance(scene, got, cam, w, h, x, y);
+            worst_outside = std::max(worst_outside, -d);
+            if (std::abs(d) <= kSnapTolerancePixels) {
+              ++edge_samples;
+            } else {
+              ++mismatches_off_edge;
+              ADD_FAILURE() << "sample " << x << "," << y << " reports triangle " << got
+                            << " at " << d << " px from its edges (inside > 0); the oracle misses";
+            }
+          } else {
+            ++mismatches_off_edge;
+          }
           continue;
         }
         if (got == kNoId) continue;
         ++hits;
+        // The distance helper agrees with the oracle where both see the same triangle.
+        EXPECT_GE(signed_pixel_distance(scene, got, cam, w, h, x, y), -kSnapTolerancePixels)
+            << x << "," << y;
         const double depth = hit.t * glm::dot(glm::dvec3(ray.direction), forward);
         max_depth_rel = std::max(max_depth_rel, std::abs(vis.depth.at(x, y) - depth) / depth);
         max_bary = std::max({max_bary, std::abs(vis.bary.at(x, y).x - hit.b1),
@@ -173,6 +226,10 @@ TEST(RasterOracle, VisibilityMatchesBruteForceRays) {
     EXPECT_GT(hits, static_cast<std::size_t>(w * h / 2));
     EXPECT_LT(max_depth_rel, 1e-4);
     EXPECT_LT(max_bary, 2e-3);  // includes the sub-pixel snapping of vertices
+    EXPECT_LE(worst_outside, kSnapTolerancePixels);  // 3.9e-4 px at the time of writing
+    const std::string suffix = "_threads" + std::to_string(threads);
+    RecordProperty("worst_outside_px" + suffix, std::to_string(worst_outside));
+    RecordProperty("edge_samples" + suffix, std::to_string(edge_samples));
   }
 }
 
