@@ -1,8 +1,13 @@
 // Tests of the envmap technique: Fresnel-weighted lookups against the shading model on
-// constant environments, and the whole recipe's determinism across threads and lanes.
+// constant environments, lookup directions against glm::reflect/refract on a direction-
+// encoding environment, and the whole recipe's determinism across threads and lanes.
 #include "raster/envmap_reflect.h"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstring>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -137,6 +142,137 @@ TEST(RenderCommand, WritesTheImageAndPrintsItsPath) {
   EXPECT_EQ(img.height, 48);
   const std::string bad = std::string(SPECULUM_BINARY) + " render --technique nosuch -q 2>/dev/null";
   EXPECT_EQ(WEXITSTATUS(std::system(bad.c_str())), 2);
+}
+
+// A varying environment that encodes its direction: towards unit d it is (d/‖d‖∞ + 1)/2,
+// the point where d leaves the cube [-1,1]³ mapped to [0,1]³. That is affine in the face
+// pixel coordinates, so the bilinear lookup of a cube map filled with it is exact away
+// from the half texel along face borders, and the colour a mirror sample returns gives
+// back its lookup direction.
+glm::vec3 direction_colour(const glm::vec3& d) {
+  const float m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+  return 0.5f * (d / m + 1.0f);
+}
+glm::vec3 colour_direction(const glm::vec3& c) { return glm::normalize(2.0f * c - 1.0f); }
+
+// Whether d lands at least two texels away from every edge of its face.
+bool away_from_face_edges(const glm::vec3& d, int size) {
+  const glm::vec3 a = glm::abs(d);
+  const float m = std::max({a.x, a.y, a.z});
+  const float minor = a.x + a.y + a.z - m - std::min({a.x, a.y, a.z});
+  return std::max(minor, std::min({a.x, a.y, a.z})) / m < 1.0f - 4.0f / size;
+}
+
+TEST(EnvmapReflect, LookupDirectionsAreGlmReflectAndRefract) {
+  constexpr int kSize = 256;
+  par::Executor ex(1);
+  std::array<ImageRGBA, kCubeFaces> faces;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    faces[f] = ImageRGBA(kSize, kSize);
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x)
+        faces[f].at(x, y) =
+            glm::vec4(direction_colour(cube_direction(f, {x + 0.5f, y + 0.5f}, kSize)), 1.0f);
+  }
+  const EnvironmentMap env = environment_from_faces(ex, faces, false, 1);
+
+  SurfaceParams white_mirror;
+  white_mirror.base_color = glm::vec3(1.0f);
+  white_mirror.metallic = 1.0f;
+  white_mirror.roughness = 0.0f;
+  white_mirror.phong_exponent = 1e6f;
+  SurfaceParams tinted_mirror = white_mirror;
+  tinted_mirror.base_color = {0.9f, 0.6f, 0.3f};
+  SurfaceParams glass;
+  glass.base_color = {1.0f, 0.5f, 0.25f};
+  glass.roughness = 0.0f;
+  glass.transmission = 1.0f;
+  glass.ior = 1.5f;
+  glass.phong_exponent = 1e6f;
+
+  struct Sample {
+    SurfaceParams s;
+    glm::vec3 n, v;  // unit normal; unit direction towards the eye
+  };
+  const glm::vec3 n0 = glm::normalize(glm::vec3(0.2f, 0.3f, 1.0f));
+  const glm::vec3 n1 = glm::normalize(glm::vec3(-0.5f, 1.0f, 0.25f));
+  const std::vector<Sample> samples = {
+      {white_mirror, n0, glm::normalize(glm::vec3(0.6f, -0.3f, 1.0f))},
+      {white_mirror, n0, glm::normalize(glm::vec3(-0.8f, 0.1f, 0.5f))},
+      {white_mirror, n1, glm::normalize(glm::vec3(0.3f, 0.7f, 0.6f))},
+      {tinted_mirror, n0, glm::normalize(glm::vec3(-0.7f, -0.6f, 0.45f))},  // grazing-ish
+      {tinted_mirror, n1, glm::normalize(glm::vec3(-0.2f, 0.9f, -0.1f))},
+      {glass, n0, glm::normalize(glm::vec3(0.5f, -0.2f, 1.0f))},           // entering
+      {glass, n1, glm::normalize(glm::vec3(0.6f, 0.5f, 0.7f))},            // entering, oblique
+      {glass, n0, glm::normalize(glm::vec3(0.1f, -0.15f, -1.0f))},         // leaving the glass
+      {glass, n1, glm::normalize(glm::vec3(0.98f, 0.05f, -0.09f))},         // leaving: TIR
+  };
+  GBuffer g;
+  g.width = int(samples.size()) + 1;  // the last sample is background
+  g.height = 1;
+  g.eye = glm::vec3(0.5f, -1.0f, 2.0f);
+  g.object = IdBuffer(g.width, 1, kNoId);
+  g.reflector = IdBuffer(g.width, 1, kNoId);
+  g.position = Buffer2D<glm::vec3>(g.width, 1);
+  g.normal = Buffer2D<glm::vec3>(g.width, 1, glm::vec3(0, 0, 1));
+  g.uv = Buffer2D<glm::vec2>(g.width, 1);
+  g.surface = Buffer2D<SurfaceParams>(g.width, 1);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    g.object.pixels[i] = g.reflector.pixels[i] = 0;
+    g.position.pixels[i] = g.eye - 3.0f * samples[i].v;
+    g.normal.pixels[i] = samples[i].n;
+    g.surface.pixels[i] = samples[i].s;
+  }
+  const ImageRGBA spec = envmap_reflect(ex, g, env);
+  EXPECT_EQ(spec.pixels.back(), glm::vec4(0, 0, 0, 1));
+
+  int refracted = 0, total_internal = 0;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    SCOPED_TRACE("sample " + std::to_string(i));
+    const Sample& smp = samples[i];
+    const glm::vec3 v = g.view_direction(i);  // as the node sees it (= smp.v up to rounding)
+    const glm::vec3 got(spec.pixels[i]);
+    glm::vec3 want;
+    if (!smp.s.is_refractor()) {
+      const glm::vec3 r = glm::reflect(-v, smp.n);
+      ASSERT_TRUE(away_from_face_edges(r, kSize)) << "pick another direction";
+      const float c = glm::dot(smp.n, v);
+      ASSERT_GT(c, 0.0f);
+      const glm::vec3 f0 = smp.s.base_color;  // metallic 1: F0 is the base colour
+      const glm::vec3 fresnel = f0 + (1.0f - f0) * std::pow(1.0f - c, 5.0f);
+      want = fresnel * direction_colour(r);
+      if (smp.s.base_color == glm::vec3(1.0f)) {
+        // F = 1: the colour is the lookup direction itself.
+        EXPECT_LT(glm::length(colour_direction(got) - r), 1e-3f)
+            << "looked up along " << colour_direction(got).x << "," << colour_direction(got).y
+            << "," << colour_direction(got).z;
+      }
+    } else {
+      // The normal facing the viewer; eta = n_incident / n_transmitted as glm::refract takes it.
+      const bool entering = glm::dot(smp.n, v) >= 0.0f;
+      const glm::vec3 n = entering ? smp.n : -smp.n;
+      const float eta = entering ? 1.0f / smp.s.ior : smp.s.ior;
+      const glm::vec3 r = glm::reflect(-v, n);
+      const glm::vec3 t = glm::refract(-v, n, eta);
+      ASSERT_TRUE(away_from_face_edges(r, kSize)) << "pick another direction";
+      if (t == glm::vec3(0.0f)) {  // total internal reflection: all reflected
+        ++total_internal;
+        want = direction_colour(r);
+      } else {
+        ++refracted;
+        ASSERT_TRUE(away_from_face_edges(t, kSize)) << "pick another direction";
+        const float f0 = (smp.s.ior - 1.0f) * (smp.s.ior - 1.0f) /
+                         ((smp.s.ior + 1.0f) * (smp.s.ior + 1.0f));  // 0.04
+        const float f = f0 + (1.0f - f0) * std::pow(1.0f - glm::dot(n, v), 5.0f);
+        want = f * direction_colour(r) + (1.0f - f) * smp.s.base_color * direction_colour(t);
+        // The two lookups are told apart: a swapped or unrefracted T would be far off.
+        EXPECT_GT(glm::length(direction_colour(t) - direction_colour(-v)), 0.02f);
+      }
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 2e-4f) << "channel " << c;
+  }
+  EXPECT_EQ(refracted, 3);
+  EXPECT_EQ(total_internal, 1);
 }
 
 }  // namespace
