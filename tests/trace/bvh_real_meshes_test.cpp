@@ -20,6 +20,7 @@
 #include "trace/bvh.h"
 #include "trace/packet_traversal.h"
 #include "trace/traversal.h"
+#include "tests/trace/oracle_checks.h"
 #include "tests/trace/test_meshes.h"
 
 namespace speculum::trace {
@@ -27,11 +28,7 @@ namespace {
 
 const std::string kModels = "/usr/share/assimp/models/";
 
-std::uint32_t bits(float f) {
-  std::uint32_t b;
-  std::memcpy(&b, &f, 4);
-  return b;
-}
+using testing::bits;
 
 struct Mesh {
   std::vector<glm::vec3> positions;
@@ -130,27 +127,11 @@ std::vector<Ray> rays_for(const Mesh& m, int budget) {
   return rays;
 }
 
-// Every query agrees with the oracle; returns the number of oracle hits.
+// Every query agrees with the oracle, single rays (tests/trace/oracle_checks.h) and packets;
+// returns the number of oracle hits.
 int expect_matches_oracle(const Mesh& m, const Bvh& bvh, const std::vector<Ray>& rays) {
-  int hits = 0;
   TraversalCounters c;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const Ray& r = rays[i];
-    const Hit o = closest_hit_oracle(m.positions, m.indices, r);
-    const Hit w = closest_hit(bvh, r, &c);
-    const Hit t = closest_hit_threaded(bvh, r, &c);
-    EXPECT_EQ(o.triangle, w.triangle) << "wide, ray " << i;
-    EXPECT_EQ(o.triangle, t.triangle) << "threaded, ray " << i;
-    if (o.hit()) {
-      ++hits;
-      EXPECT_EQ(bits(o.t), bits(w.t)) << "wide, ray " << i;
-      EXPECT_EQ(bits(o.t), bits(t.t)) << "threaded, ray " << i;
-    }
-    const bool oa = any_hit_oracle(m.positions, m.indices, r);
-    EXPECT_EQ(oa, o.hit()) << "ray " << i;
-    EXPECT_EQ(oa, any_hit(bvh, r, &c)) << "wide any, ray " << i;
-    EXPECT_EQ(oa, any_hit_threaded(bvh, r, &c)) << "threaded any, ray " << i;
-  }
+  const int hits = testing::expect_single_rays_match_oracle(m.positions, m.indices, bvh, rays, c);
   // Packets of consecutive rays (the coherent groups, e.g. the clipped triples and rays
   // aimed at one triangle's features, take the packet path; the others fall back).
   for (std::size_t i = 0; i < rays.size(); i += kPacketSize) {

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "trace/bvh.h"
 #include "trace/traversal.h"
+#include "tests/trace/oracle_checks.h"
 #include "tests/trace/test_meshes.h"
 
 namespace speculum::trace {
@@ -15,34 +16,13 @@ namespace {
 
 using testing::Soup;
 
-std::uint32_t bits(float f) {
-  std::uint32_t b;
-  std::memcpy(&b, &f, 4);
-  return b;
-}
+using testing::bits;
 
-// Every query agrees with the oracle; returns how many rays hit (so callers can assert the
-// case is not vacuous).
+// Every query agrees with the oracle (tests/trace/oracle_checks.h) without a stack overflow;
+// returns how many rays hit (so callers can assert the case is not vacuous).
 int expect_matches_oracle(const Soup& s, const Bvh& bvh, const std::vector<Ray>& rays) {
-  int hits = 0;
   TraversalCounters c;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const Ray& r = rays[i];
-    const Hit o = closest_hit_oracle(s.positions, s.indices, r);
-    const Hit w = closest_hit(bvh, r, &c);
-    const Hit t = closest_hit_threaded(bvh, r, &c);
-    EXPECT_EQ(o.triangle, w.triangle) << "wide, ray " << i;
-    EXPECT_EQ(o.triangle, t.triangle) << "threaded, ray " << i;
-    if (o.hit()) {
-      EXPECT_EQ(bits(o.t), bits(w.t)) << "ray " << i;
-      EXPECT_EQ(bits(o.t), bits(t.t)) << "ray " << i;
-      ++hits;
-    }
-    const bool oa = any_hit_oracle(s.positions, s.indices, r);
-    EXPECT_EQ(oa, o.hit());
-    EXPECT_EQ(oa, any_hit(bvh, r, &c)) << "ray " << i;
-    EXPECT_EQ(oa, any_hit_threaded(bvh, r, &c)) << "ray " << i;
-  }
+  const int hits = testing::expect_single_rays_match_oracle(s.positions, s.indices, bvh, rays, c);
   EXPECT_EQ(c.stack_overflows, 0u);
   return hits;
 }

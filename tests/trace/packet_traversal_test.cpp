@@ -11,6 +11,7 @@
 #include "trace/bvh.h"
 #include "trace/packet_traversal.h"
 #include "trace/traversal.h"
+#include "tests/trace/oracle_checks.h"
 #include "tests/trace/test_meshes.h"
 
 namespace speculum::trace {
@@ -18,11 +19,7 @@ namespace {
 
 using testing::Soup;
 
-std::uint32_t bits(float f) {
-  std::uint32_t b;
-  std::memcpy(&b, &f, 4);
-  return b;
-}
+using testing::bits;
 
 // Pinhole rays from `eye` through a `w` x `h` grid spanning `half_angle` (radians) around
 // the direction to `target`, row by row: consecutive rays are neighbours (coherent).

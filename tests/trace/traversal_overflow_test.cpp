@@ -14,16 +14,13 @@
 #include "trace/bvh.h"
 #include "trace/packet_traversal.h"
 #include "trace/traversal.h"
+#include "tests/trace/oracle_checks.h"
 #include "tests/trace/test_meshes.h"
 
 namespace speculum::trace {
 namespace {
 
-std::uint32_t bits(float f) {
-  std::uint32_t b;
-  std::memcpy(&b, &f, 4);
-  return b;
-}
+using testing::bits;
 
 struct Tunnel {
   testing::Soup soup;
