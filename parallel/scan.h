@@ -14,6 +14,7 @@
 #include <memory>
 #include <span>
 #include <stdexcept>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -50,15 +51,18 @@ inline constexpr unsigned kScanPatience = 1024;
 // (or init before chunk 0), then fold forward. The fold is the same left fold in chunk order
 // as a serial pass, (((init ⊕ s0) ⊕ s1) ⊕ ...), whichever prefix it starts from, so the
 // offset has the same bits for any timing. `sums` is the caller's scratch.
+// In place (`may_compute` false) a missing sum is awaited instead: its owner may publish it
+// and start overwriting the chunk's input while this thread would still be reading it.
 template <class T, class Op, class SumOf>
 T look_back(const ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum_of,
-            std::vector<T>& sums) {
+            bool may_compute, std::vector<T>& sums) {
   sums.clear();
   T base = init;
   for (std::size_t j = c; j-- > 0;) {
     std::uint32_t s = links[j].state.load(std::memory_order_acquire);
-    for (unsigned spin = 0; s == ScanLink<T>::kNone && spin < kScanPatience; ++spin) {
-      scan_kernels::cpu_relax();
+    for (unsigned spin = 0; s == ScanLink<T>::kNone && (spin < kScanPatience || !may_compute); ++spin) {
+      if (spin < kScanPatience) scan_kernels::cpu_relax();
+      else std::this_thread::yield();  // the owner sums without waiting on anyone: it will publish
       s = links[j].state.load(std::memory_order_acquire);
     }
     if (s == ScanLink<T>::kPrefix) {
@@ -88,32 +92,33 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   };
   std::unique_ptr<ScanLink<T>[]> links(new ScanLink<T>[chunks]);
   // Chunks are handed out in index order, so a chunk's predecessors are usually done or in
-  // flight on another thread, and the look-back stops after one or two links; no thread
-  // ever blocks on another (a missing sum is computed, not awaited).
+  // flight on another thread, and the look-back stops after one or two links; out of place,
+  // no thread ever blocks on another (a missing sum is computed, not awaited).
+  const auto addr = [](const T* p) { return reinterpret_cast<std::uintptr_t>(p); };
+  const bool in_place = addr(src) < addr(dst + n) && addr(dst) < addr(src + n);
   std::atomic<std::size_t> next{0};
   const std::size_t workers = std::min<std::size_t>(std::size_t(ex.threads()), chunks);
   ex.parallel_for(launch_name(name, "chained_scan"), workers, 1, [&](std::size_t, std::size_t) {
     std::vector<T> sums;
-    // Each thread claims its next chunk before scanning the current one, so the kernel can
-    // prefetch it (a claimed chunk whose thread stalls costs its successors one extra
-    // reduction in look_back, never a wait).
-    std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
-    while (c < chunks) {
-      const std::size_t following = next.fetch_add(1, std::memory_order_relaxed);
+    for (;;) {
+      const std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
+      if (c >= chunks) return;
       ScanLink<T>& link = links[c];
       link.sum = sum_of(c);
       link.state.store(ScanLink<T>::kSum, std::memory_order_release);
-      const T offset = look_back(links.get(), c, init, op, sum_of, sums);
+      const T offset = look_back(links.get(), c, init, op, sum_of, !in_place, sums);
       link.prefix = op(offset, link.sum);
       link.state.store(ScanLink<T>::kPrefix, std::memory_order_release);
-      const std::size_t b = c * chunk, fb = following * chunk;
-      if (following < chunks)
+      // With chunks taken in turn, this thread's next chunk is most likely c + workers: the
+      // kernel prefetches it while it scans (a prefetch reads nothing in the memory model, so
+      // a wrong guess only wastes bandwidth).
+      const std::size_t b = c * chunk, guess = (c + workers) * chunk;
+      if (guess < n)
         scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
-                                            streaming, src + fb, std::min(n, fb + chunk) - fb);
+                                            streaming, src + guess, std::min(n, guess + chunk) - guess);
       else
         scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
                                             streaming);
-      c = following;
     }
   });
   return links[chunks - 1].prefix;

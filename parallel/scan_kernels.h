@@ -99,9 +99,9 @@ inline __m256i prefix8(__m256i x) {
   return _mm256_add_epi32(x, _mm256_permute2x128_si256(low_total, low_total, 0x08));
 }
 
-// Prefetch::next / end: the lines of the chunk this thread scans next, fetched into L2 one
-// line per 16 elements of this chunk's scan, so its reduction reads cache while this scan,
-// bound by arithmetic and writes, would otherwise leave the memory reads idle.
+// Prefetch::next / end: the lines of the chunk this thread most likely scans next, fetched
+// into L2 one line per 16 elements of this chunk's scan, so its reduction reads cache while
+// this scan, bound by arithmetic and writes, would otherwise leave the memory reads idle.
 struct Prefetch {
   const char* next = nullptr;
   const char* end = nullptr;
@@ -172,7 +172,7 @@ T scan_streaming(const T* in, T* out, std::size_t m, T acc, Op& op) {
 
 // Scans in[0, m) from `offset` into out[0, m) (out may equal in). Streaming: full output
 // lines bypass the caches (followed by a store fence, so the join publishes them), and the
-// `next_count` elements at `next` (the thread's next chunk, none when null) are prefetched
+// `next_count` elements at `next` (the thread's likely next chunk, none when null) are prefetched
 // into L2 during the scan.
 template <bool Inclusive, class T, class Op>
 void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool streaming,

@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <chrono>
 #include <cstring>
 #include <memory>
 #include <numeric>
+#include <thread>
 
 #include "primitive_test_util.h"
 
@@ -189,7 +191,7 @@ TEST(Stream, ScanLookBackFoldsInChunkOrder) {
       return sum[c];
     };
     for (std::size_t c = 0; c < kChunks; ++c) {
-      const float offset = detail::look_back(links.get(), c, 0.25f, op, sum_of, scratch);
+      const float offset = detail::look_back(links.get(), c, 0.25f, op, sum_of, true, scratch);
       const float expected = c == 0 ? 0.25f : prefix[c - 1];
       EXPECT_EQ(std::bit_cast<std::uint32_t>(offset), std::bit_cast<std::uint32_t>(expected)) << c;
     }
@@ -200,6 +202,26 @@ TEST(Stream, ScanLookBackFoldsInChunkOrder) {
       EXPECT_EQ(computed, 0u);
     }
   }
+  // In place a missing sum is awaited, never computed (its owner may already be overwriting
+  // the chunk's input): the link is published late by another thread.
+  std::unique_ptr<Link[]> links(new Link[kChunks]);
+  for (std::size_t c = 0; c < kChunks; ++c) {
+    links[c].sum = sum[c];
+    links[c].state.store(c == 3 ? 0u : 1u);
+  }
+  std::size_t computed = 0;
+  auto sum_of = [&](std::size_t c) {
+    ++computed;
+    return sum[c];
+  };
+  std::thread owner([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    links[3].state.store(1u, std::memory_order_release);
+  });
+  const float offset = detail::look_back(links.get(), 6, 0.25f, op, sum_of, false, scratch);
+  owner.join();
+  EXPECT_EQ(std::bit_cast<std::uint32_t>(offset), std::bit_cast<std::uint32_t>(prefix[5]));
+  EXPECT_EQ(computed, 0u);
 }
 
 template <int W>
