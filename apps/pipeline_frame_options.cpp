@@ -60,6 +60,7 @@ FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
       throw InputError("--param", "expected name=number, got '" + item + "'");
     f.params[item.substr(0, eq)] = v;
   }
+  check_technique_params(find_technique(o.technique), f.params);
   f.camera = resolve_camera(scene, o.camera);
   return f;
 }

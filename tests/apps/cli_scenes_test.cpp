@@ -102,4 +102,74 @@ TEST(CliScenes, ListExportAndInfoAgree) {
   std::filesystem::remove_all(dir);
 }
 
+// `--param name=value` (render, inspect, profile): a name the chosen technique does not read,
+// or a value that is not a number, is bad input (exit 2, one stderr line naming the
+// parameter; for a name, also the technique's known ones), and no image is written.
+TEST(CliScenes, BadTechniqueParamExitsTwoNamingIt) {
+  const auto dir = scratch();
+  const auto output = dir / "out.png";
+  const std::string frame = " sphere-in-room --width 16 --height 16 ";
+  const std::string out = " -o '" + output.string() + "'";
+
+  const CommandResult unknown = run("render" + frame + "-t distance-map --param nosuch=1" + out, dir);
+  EXPECT_EQ(unknown.status, 2) << unknown.err;
+  EXPECT_EQ(lines(unknown.err), 1u) << unknown.err;
+  EXPECT_NE(unknown.err.find("nosuch"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("distance-map"), std::string::npos) << unknown.err;
+  for (const char* known : {"linear_steps", "secant_steps", "parallax"})
+    EXPECT_NE(unknown.err.find(known), std::string::npos) << known << ": " << unknown.err;
+  EXPECT_FALSE(std::filesystem::exists(output));
+
+  // A name is known per technique: multi-reflection's `rounds` is not distance-map's.
+  const CommandResult other = run("render" + frame + "-t distance-map --param rounds=2" + out, dir);
+  EXPECT_EQ(other.status, 2) << other.err;
+  EXPECT_NE(other.err.find("rounds"), std::string::npos) << other.err;
+  EXPECT_FALSE(std::filesystem::exists(output));
+
+  // A technique without parameters says so.
+  const CommandResult none = run("render" + frame + "-t envmap --param depth=2" + out, dir);
+  EXPECT_EQ(none.status, 2) << none.err;
+  EXPECT_EQ(lines(none.err), 1u) << none.err;
+  EXPECT_NE(none.err.find("depth"), std::string::npos) << none.err;
+  EXPECT_FALSE(std::filesystem::exists(output));
+
+  for (const std::string bad : {"linear_steps=abc", "linear_steps=", "linear_steps=4x", "=4",
+                                "linear_steps", "linear_steps=nan"}) {
+    SCOPED_TRACE(bad);
+    const CommandResult r = run("render" + frame + "-t distance-map --param '" + bad + "'" + out, dir);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("--param"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(output));
+  }
+
+  // inspect and profile share the check.
+  for (const std::string cmd : {"inspect", "profile"}) {
+    SCOPED_TRACE(cmd);
+    const CommandResult r = run(cmd + frame + "-t multi-reflection --param nosuch=1", dir);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("nosuch"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("lagged"), std::string::npos) << r.err;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliScenes, KnownTechniqueParamsRender) {
+  const auto dir = scratch();
+  const auto output = dir / "out.png";
+  for (const std::string args : {"-t distance-map --param linear_steps=8 --param secant_steps=2",
+                                 "-t multi-reflection --param rounds=2 --param lagged=0"}) {
+    SCOPED_TRACE(args);
+    std::filesystem::remove(output);
+    const CommandResult r = run("--quiet render sphere-in-room --width 16 --height 16 " + args +
+                                    " -o '" + output.string() + "'",
+                                dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(output));
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
