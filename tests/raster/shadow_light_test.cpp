@@ -1,8 +1,10 @@
 // Tests of shadow maps and direct light: the filtered shadow test against a geometric
 // oracle (a square occluder over a floor under a point light, and a directional light),
-// and unshadowed direct light equal to the shared shading model.
+// and unshadowed direct light equal to the shared shading model; a spot light's cone,
+// falloff and shadow in direct_light, and its SH ambient term.
 #include "raster/shadow_map.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -104,6 +106,132 @@ TEST(DirectLight, UnshadowedEqualsSharedShadingModel) {
     ++checked;
   }
   EXPECT_GT(checked, 1000u);
+}
+
+TEST(ShadowMap, SpotLightShadowMatchesGeometricOracle) {
+  // Spot lights share the point lights' distance cube: the shadow test ignores the cone.
+  Light l;
+  l.type = LightType::Spot;
+  l.position = {0.2f, 3.0f, 0.1f};
+  l.direction = {0.0f, -1.0f, 0.0f};
+  l.intensity = 10.0f;
+  l.inner_cone = 0.35f;
+  l.outer_cone = 0.7f;
+  check_against_oracle(l, 0.06f);
+}
+
+// The glTF KHR_lights_punctual spot falloff, written out independently of core/shading.cpp:
+// E = I/d² · clamp((cos θ − cos outer)/(cos inner − cos outer), 0, 1)², θ from the axis.
+float documented_spot_irradiance(const Light& l, const glm::vec3& p, float* cone_out) {
+  const glm::vec3 from_light = p - l.position;
+  const float d2 = glm::dot(from_light, from_light);
+  const float cos_theta = glm::dot(glm::normalize(from_light), glm::normalize(l.direction));
+  const float a = std::clamp((cos_theta - std::cos(l.outer_cone)) /
+                                 (std::cos(l.inner_cone) - std::cos(l.outer_cone)),
+                             0.0f, 1.0f);
+  *cone_out = a;
+  return l.intensity * a * a / d2;
+}
+
+TEST(DirectLight, SpotLightConeFalloffAndShadow) {
+  // A spot above a floor with a square blocker: floor points in the blocker's shadow and
+  // points outside the cone get no direct light; lit points inside the cone get the shading
+  // model with the documented falloff (full I/d² inside the inner cone).
+  Light l;
+  l.type = LightType::Spot;
+  l.position = {0.2f, 3.0f, 0.1f};
+  l.direction = {0.0f, -1.0f, 0.0f};
+  l.intensity = 10.0f;
+  l.color = {1.0f, 0.5f, 0.25f};
+  l.inner_cone = 0.35f;  // floor radius ≈ 1.09 around (0.2, 0.1)
+  l.outer_cone = 0.7f;   // ≈ 2.53
+  Scene scene = floor_and_occluder(l);
+  scene.materials[0].metallic = 0.0f;  // a diffuse floor (glTF's default is metallic)
+  scene.materials[0].base_color = {0.8f, 0.8f, 0.8f, 1.0f};
+  par::Executor ex(2);
+  const auto maps = render_shadow_maps(ex, scene, 256);
+  Environment black;
+  const EnvironmentMap env = build_environment(ex, black, 8);  // no ambient light
+  Camera cam;
+  cam.eye = {0.5f, 6.0f, 4.0f};
+  cam.target = {0, 0, 0};
+  const auto vis = render_visibility(ex, scene, cam, 320, 240);
+  const GBuffer g = resolve_gbuffer(ex, scene, vis, cam.eye);
+  const ImageRGBA direct = direct_light(ex, scene, g, cam, maps, env);
+  std::size_t outside = 0, shadowed = 0, inner = 0, falloff = 0;
+  for (std::size_t i = 0; i < g.object.size(); ++i) {
+    if (!g.covered(i) || g.object.pixels[i] != 0) continue;
+    const glm::vec3 p = g.position.pixels[i], n = g.normal.pixels[i], v = g.view_direction(i);
+    const glm::vec3 c = glm::vec3(direct.pixels[i]);
+    float a = 0.0f;
+    const float e = documented_spot_irradiance(l, p, &a);
+    const glm::vec3 to_light = glm::normalize(l.position - p);
+    if (a == 0.0f) {
+      ASSERT_EQ(c, glm::vec3(0.0f)) << "outside the cone: " << p.x << "," << p.z;
+      ++outside;
+      continue;
+    }
+    const float margin = occluder_margin(p, to_light);
+    if (std::abs(margin) < 0.06f) continue;  // penumbra of the 3×3 PCF
+    if (margin > 0.0f) {
+      ASSERT_EQ(c, glm::vec3(0.0f)) << "in the shadow: " << p.x << "," << p.z;
+      ++shadowed;
+      continue;
+    }
+    LightSample ls;
+    ls.direction = to_light;
+    ls.distance = glm::length(l.position - p);
+    ls.irradiance = l.color * e;
+    const glm::vec3 expected = shade_light(g.surface.pixels[i], n, v, ls);
+    ASSERT_GT(expected.x, 0.0f);
+    for (int ch = 0; ch < 3; ++ch)
+      ASSERT_NEAR(c[ch], expected[ch], 1e-4f * expected[ch] + 1e-7f) << p.x << "," << p.z;
+    ++(a == 1.0f ? inner : falloff);
+  }
+  EXPECT_GT(outside, 20000u);
+  EXPECT_GT(shadowed, 1000u);
+  EXPECT_GT(inner, 1000u);
+  EXPECT_GT(falloff, 10000u);
+}
+
+TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
+  // No lights; a constant environment of radiance L has irradiance π·L on every normal, so
+  // the ambient term f_d·E = (1 − F)(1 − metallic) base_color/π · π·L = (1 − F) base_color·L.
+  Light unused;
+  Scene scene = floor_and_occluder(unused);
+  scene.lights.clear();
+  scene.materials[0].metallic = 0.0f;
+  scene.materials[0].base_color = {0.8f, 0.6f, 0.4f, 1.0f};
+  Environment sky;
+  sky.constant = {0.5f, 1.0f, 2.0f};
+  par::Executor ex(2);
+  const EnvironmentMap env = build_environment(ex, sky, 8);
+  Camera cam;
+  cam.eye = {0.5f, 6.0f, 4.0f};
+  cam.target = {0, 0, 0};
+  const auto vis = render_visibility(ex, scene, cam, 64, 48);
+  const GBuffer g = resolve_gbuffer(ex, scene, vis, cam.eye);
+  const ImageRGBA direct = direct_light(ex, scene, g, cam, {}, env);
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < direct.size(); ++i) {
+    if (!g.covered(i)) continue;
+    const SurfaceParams& s = g.surface.pixels[i];
+    const float cos_nv = glm::dot(g.normal.pixels[i], g.view_direction(i));
+    const glm::vec3 expected =
+        (glm::vec3(1.0f) - specular_fresnel(s, cos_nv)) * glm::vec3(0.8f, 0.6f, 0.4f) * sky.constant;
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(direct.pixels[i][ch], expected[ch], 0.01f * expected[ch]) << i << " ch " << ch;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000u);
+
+  // A metal has no diffuse term, hence no SH ambient (its environment light is the
+  // specular layer's).
+  scene.materials[0].metallic = 1.0f;
+  const GBuffer gm = resolve_gbuffer(ex, scene, vis, cam.eye);
+  const ImageRGBA metal = direct_light(ex, scene, gm, cam, {}, env);
+  for (std::size_t i = 0; i < metal.size(); ++i)
+    if (gm.covered(i)) EXPECT_EQ(glm::vec3(metal.pixels[i]), glm::vec3(0.0f)) << i;
 }
 
 }  // namespace
