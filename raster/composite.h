@@ -16,7 +16,7 @@ ImageRGBA composite(par::Executor& executor, const ImageRGBA& direct, const Imag
 ImageRGBA resolve_supersamples(par::Executor& executor, const ImageRGBA& samples, int k);
 
 // Exposure then the Narkowicz ACES fit per channel; alpha set to 1. Output is linear in
-// [0, 1) — the PNG writer applies the sRGB curve.
+// [0, 1] (1 once exposure × value ≳ 7.24) — the PNG writer applies the sRGB curve.
 ImageRGBA tonemap(par::Executor& executor, const ImageRGBA& hdr, float exposure = 1.0f);
 
 }  // namespace speculum::raster
