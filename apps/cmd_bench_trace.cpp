@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "apps/cli.h"
+#include "apps/pipeline_camera_options.h"
 #include "core/error.h"
 #include "core/sampling.h"
 #include "core/scene_loader.h"
@@ -39,7 +40,7 @@ struct BenchTraceOptions {
   std::string output;
   int repeat = 5;
   int width = 1024, height = 1024;
-  std::vector<float> eye, target, up;
+  std::string eye, target, up;  // x,y,z (empty: default)
   float fov = 60.0f;
   std::uint32_t seed = 1;
   bool json = false;
@@ -265,9 +266,9 @@ Camera bench_camera(const BenchTraceOptions& o, const Scene& scene) {
   Camera cam;
   cam.eye = c + glm::vec3(0.0f, 0.25f * e.y, 0.475f * e.z);
   cam.target = c + glm::vec3(0.0f, -0.125f * e.y, 0.0f);
-  if (o.eye.size() == 3) cam.eye = {o.eye[0], o.eye[1], o.eye[2]};
-  if (o.target.size() == 3) cam.target = {o.target[0], o.target[1], o.target[2]};
-  if (o.up.size() == 3) cam.up = {o.up[0], o.up[1], o.up[2]};
+  if (!o.eye.empty()) cam.eye = pipeline::parse_vec3("--eye", o.eye);
+  if (!o.target.empty()) cam.target = pipeline::parse_vec3("--target", o.target);
+  if (!o.up.empty()) cam.up = pipeline::parse_vec3("--up", o.up);
   cam.vfov_degrees = o.fov;
   return cam;
 }
@@ -375,9 +376,9 @@ void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global) {
   cmd->add_option("-o,--output", opt->output, "Output file of --emit-rays / --make-mesh");
   cmd->add_option("--width", opt->width, "Image width for --emit-rays")->check(CLI::Range(1, 65536))->capture_default_str();
   cmd->add_option("--height", opt->height, "Image height for --emit-rays")->check(CLI::Range(1, 65536))->capture_default_str();
-  cmd->add_option("--eye", opt->eye, "Camera eye x y z (default: inside the mesh bounds)")->expected(3);
-  cmd->add_option("--target", opt->target, "Camera target x y z")->expected(3);
-  cmd->add_option("--up", opt->up, "Camera up x y z")->expected(3);
+  cmd->add_option("--eye", opt->eye, "Camera eye x,y,z (default: inside the mesh bounds)");
+  cmd->add_option("--target", opt->target, "Camera target x,y,z");
+  cmd->add_option("--up", opt->up, "Camera up x,y,z");
   cmd->add_option("--fov", opt->fov, "Vertical field of view, degrees")->check(CLI::Range(0.01, 179.0))->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the secondary ray directions")->capture_default_str();
   cmd->add_flag("--no-embree", opt->no_embree, "Skip the Embree comparison");

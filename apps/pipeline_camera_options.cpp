@@ -8,8 +8,6 @@
 #include "core/error.h"
 
 namespace speculum::pipeline {
-namespace {
-
 glm::vec3 parse_vec3(const std::string& option, const std::string& text) {
   std::istringstream in(text);
   glm::vec3 v;
@@ -19,8 +17,6 @@ glm::vec3 parse_vec3(const std::string& option, const std::string& text) {
     throw InputError(option, "expected three finite numbers x,y,z, got '" + text + "'");
   return v;
 }
-
-}  // namespace
 
 void add_camera_options(CLI::App& cmd, CameraOverrides& o) {
   cmd.add_option("--camera", o.camera, "Scene camera by name or index (default: the first)");

@@ -18,6 +18,9 @@ struct CameraOverrides {
 
 void add_camera_options(CLI::App& cmd, CameraOverrides& overrides);
 
+// "x,y,z" → a vector; InputError naming `option` unless three finite numbers.
+glm::vec3 parse_vec3(const std::string& option, const std::string& text);
+
 // The chosen camera with overrides applied; with --eye or --target its near/far planes are
 // refitted to the scene's bounds (fit_clip_planes), otherwise the scene's are kept. Throws
 // InputError for unknown names, bad vectors or a degenerate result.

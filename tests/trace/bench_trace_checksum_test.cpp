@@ -96,7 +96,7 @@ TEST(BenchTraceCli, ChecksumsEqualTheOracleForBothKernelsAndThreadCounts) {
   write_ply(mesh, s);
   const std::string bin = SPECULUM_BINARY;
   ASSERT_EQ(0, std::system((bin + " -q --threads 2 bench trace " + mesh +
-                            " --emit-rays primary --width 128 --height 96 --fov 20 --eye 0.3 0.8 3.5 --target 0 -0.2 0 -o " +
+                            " --emit-rays primary --width 128 --height 96 --fov 20 --eye 0.3,0.8,3.5 --target 0,-0.2,0 -o " +
                             primary)
                                .c_str()));
   // Incoherent rays with varied [tnear, tfar], so a kernel ignoring the file's interval
