@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "core/camera_rays.h"
 #include "trace/bvh.h"
@@ -59,16 +60,20 @@ struct BoxRay {
   std::uint32_t near_x, near_y, near_z, far_x, far_y, far_z;
 
   BoxRay(const glm::vec3& o, const glm::vec3& d, const glm::vec3& inv, float t0) {
-    glm::vec3 on = o, of = o;
+    glm::vec3 on = o, of = o, slope = inv;
     for (int a = 0; a < 3; ++a) {
       if (!(std::fabs(d[a]) < 1e-30f)) continue;
       const float delta = std::copysign(std::max(std::fabs(o[a]) * 0x1p-20f, 0x1p-60f), inv[a]);
       on[a] = o[a] + delta;
       of[a] = o[a] - delta;
+      // The largest finite slope, not the clamped 1e30: the slab then reaches past any
+      // distance a ray can have (a plane 0.15 away gave an end at 1.5e29 with 1e30; now it
+      // overflows to inf, which box_hits clamps), and (plane - o') * slope is never 0 · inf.
+      slope[a] = std::copysign(std::numeric_limits<float>::max(), inv[a]);
     }
     onx = _mm256_set1_ps(on.x); ony = _mm256_set1_ps(on.y); onz = _mm256_set1_ps(on.z);
     ofx = _mm256_set1_ps(of.x); ofy = _mm256_set1_ps(of.y); ofz = _mm256_set1_ps(of.z);
-    ix = _mm256_set1_ps(inv.x); iy = _mm256_set1_ps(inv.y); iz = _mm256_set1_ps(inv.z);
+    ix = _mm256_set1_ps(slope.x); iy = _mm256_set1_ps(slope.y); iz = _mm256_set1_ps(slope.z);
     tmin = _mm256_set1_ps(t0);
     constexpr std::uint32_t row = kWideArity * sizeof(float), hi = 3 * row;
     const bool nx = std::signbit(inv.x), ny = std::signbit(inv.y), nz = std::signbit(inv.z);

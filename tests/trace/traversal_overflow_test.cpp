@@ -30,9 +30,7 @@ struct Tunnel {
 
 // Clusters i = 0..149 of 16 triangles over x in [-1.2·1.5^i, -1.5^i] (up to 2.3e26); each
 // triangle spans y in [0, 1], z in [-1, 1] and misses the line y = z = 0.9. A backstop
-// square at x = -1e27 catches rays that pass y = z = 0.9 and are not clipped. (Farther
-// than ~1e28, axis-aligned rays meet the clamped-reciprocal limit of the wide box test:
-// see Bvh.AxisAlignedRayReachesFarBoxes.)
+// square at x = -1e27 catches rays that pass y = z = 0.9 and are not clipped.
 Tunnel make_tunnel() {
   Tunnel t;
   for (int i = 0; i < 150; ++i) {
@@ -147,9 +145,9 @@ TEST(TraversalOverflow, PacketKernelCountsOverflowsAtFullStackSize) {
 }
 
 // A ray with a zero direction component must reach boxes at any distance along it: the
-// oracle and the threaded layout find the far triangle; the 8-wide box test clamps the
-// reciprocal of the zero component to 1e30, so the slab on that axis ends at
-// (far plane - origin) * 1e30 and a box farther along the ray is culled.
+// oracle and the threaded layout find the far triangle; so must the 8-wide box test (it used
+// to scale the zero component's slab by the clamped reciprocal 1e30, so the slab ended at
+// (far plane - origin) * 1e30 and a box farther along the ray was culled).
 TEST(Bvh, AxisAlignedRayReachesFarBoxes) {
   testing::Soup s;
   s.add({-1, 0, -1}, {-1.2f, 1, 0}, {-1, 0, 1});          // near, beside the ray
@@ -164,10 +162,37 @@ TEST(Bvh, AxisAlignedRayReachesFarBoxes) {
   const Hit o = closest_hit_oracle(s.positions, s.indices, r);
   ASSERT_EQ(o.triangle, 1u);
   EXPECT_EQ(closest_hit_threaded(bvh, r).triangle, 1u);
-  const bool wide = closest_hit(bvh, r).triangle == 1u, wide_any = any_hit(bvh, r);
-  if (!wide || !wide_any)
-    GTEST_SKIP() << "known bug: the 8-wide kernels miss a box 1e30 away along an axis-aligned ray (closest "
-                 << wide << ", any " << wide_any << "); the oracle and the threaded layout hit it";
+  const Hit w = closest_hit(bvh, r);
+  EXPECT_EQ(w.triangle, 1u);
+  EXPECT_EQ(bits(w.t), bits(o.t));
+  EXPECT_TRUE(any_hit(bvh, r));
+  // Stopping short of the far triangle still misses it.
+  r.tmax = 0.5e30f;
+  EXPECT_FALSE(closest_hit(bvh, r).hit());
+  EXPECT_FALSE(any_hit(bvh, r));
+  // The same along every axis and both directions.
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const float sign : {-1.0f, 1.0f}) {
+      testing::Soup t;
+      auto place = [&](float along, float u, float v) {
+        glm::vec3 p(0.0f);
+        p[axis] = along;
+        p[(axis + 1) % 3] = u;
+        p[(axis + 2) % 3] = v;
+        return p;
+      };
+      t.add(place(sign * 1.0f, -1.0f, -1.0f), place(sign * 1.2f, 0.0f, 1.0f), place(sign * 1.0f, 1.0f, -1.0f));
+      t.add(place(sign * 1e30f, 0.8f, 0.8f), place(sign * 1e30f, 1.0f, 0.8f), place(sign * 1e30f, 0.8f, 1.0f));
+      const Bvh tb = Bvh::build(t.positions, t.indices, ex, one_per_leaf);
+      Ray q;
+      q.origin = place(0.0f, 0.85f, 0.85f);
+      q.direction = place(sign, 0.0f, 0.0f);
+      const Hit qo = closest_hit_oracle(t.positions, t.indices, q);
+      ASSERT_EQ(qo.triangle, 1u) << "axis " << axis << " sign " << sign;
+      EXPECT_EQ(closest_hit(tb, q).triangle, 1u) << "axis " << axis << " sign " << sign;
+      EXPECT_TRUE(any_hit(tb, q)) << "axis " << axis << " sign " << sign;
+    }
+  }
 }
 
 }  // namespace
