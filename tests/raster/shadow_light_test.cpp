@@ -35,6 +35,28 @@ float occluder_margin(const glm::vec3& p, const glm::vec3& towards_light) {
   return std::min(0.5f - std::abs(q.x), 0.5f - std::abs(q.z));
 }
 
+// The floor seen from above and in front: the camera every test here looks through.
+Camera overhead_camera() {
+  Camera cam;
+  cam.eye = {0.5f, 6.0f, 4.0f};
+  cam.target = {0, 0, 0};
+  return cam;
+}
+
+// The G-buffer of `scene` from overhead_camera() at width × height, and its direct light.
+struct LitFrame {
+  GBuffer g;
+  ImageRGBA direct;
+};
+LitFrame light_frame(par::Executor& ex, const Scene& scene, int width, int height, const std::vector<ShadowMap>& maps,
+                     const EnvironmentMap& env) {
+  const Camera cam = overhead_camera();
+  const auto vis = render_visibility(ex, scene, cam, width, height);
+  LitFrame f{resolve_gbuffer(ex, scene, vis, cam.eye), {}};
+  f.direct = direct_light(ex, scene, f.g, cam, maps, env);
+  return f;
+}
+
 // `footprint`: half-width (in scene units) of the 3×3 PCF kernel plus bias, where the
 // filtered result is legitimately fractional.
 void check_against_oracle(const Light& light, float footprint) {
@@ -42,9 +64,7 @@ void check_against_oracle(const Light& light, float footprint) {
   par::Executor ex(2);
   const auto maps = render_shadow_maps(ex, scene, 256);
   ASSERT_EQ(maps.size(), 1u);
-  Camera cam;
-  cam.eye = {0.5f, 6.0f, 4.0f};
-  cam.target = {0, 0, 0};
+  const Camera cam = overhead_camera();
   const auto vis = render_visibility(ex, scene, cam, 320, 240);
   const GBuffer g = resolve_gbuffer(ex, scene, vis, cam.eye);
   std::size_t shadowed = 0, lit = 0, penumbra = 0;
@@ -88,12 +108,7 @@ TEST(DirectLight, UnshadowedEqualsSharedShadingModel) {
   par::Executor ex(1);
   Environment black;
   const EnvironmentMap env = build_environment(ex, black, 8);
-  Camera cam;
-  cam.eye = {0.5f, 6.0f, 4.0f};
-  cam.target = {0, 0, 0};
-  const auto vis = render_visibility(ex, scene, cam, 64, 48);
-  const GBuffer g = resolve_gbuffer(ex, scene, vis, cam.eye);
-  const ImageRGBA direct = direct_light(ex, scene, g, cam, {}, env);
+  const auto [g, direct] = light_frame(ex, scene, 64, 48, {}, env);
   std::size_t checked = 0;
   for (std::size_t i = 0; i < direct.size(); ++i) {
     if (!g.covered(i)) continue;
@@ -152,12 +167,7 @@ TEST(DirectLight, SpotLightConeFalloffAndShadow) {
   const auto maps = render_shadow_maps(ex, scene, 256);
   Environment black;
   const EnvironmentMap env = build_environment(ex, black, 8);  // no ambient light
-  Camera cam;
-  cam.eye = {0.5f, 6.0f, 4.0f};
-  cam.target = {0, 0, 0};
-  const auto vis = render_visibility(ex, scene, cam, 320, 240);
-  const GBuffer g = resolve_gbuffer(ex, scene, vis, cam.eye);
-  const ImageRGBA direct = direct_light(ex, scene, g, cam, maps, env);
+  const auto [g, direct] = light_frame(ex, scene, 320, 240, maps, env);
   std::size_t outside = 0, shadowed = 0, inner = 0, falloff = 0;
   for (std::size_t i = 0; i < g.object.size(); ++i) {
     if (!g.covered(i) || g.object.pixels[i] != 0) continue;
@@ -206,12 +216,7 @@ TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
   sky.constant = {0.5f, 1.0f, 2.0f};
   par::Executor ex(2);
   const EnvironmentMap env = build_environment(ex, sky, 8);
-  Camera cam;
-  cam.eye = {0.5f, 6.0f, 4.0f};
-  cam.target = {0, 0, 0};
-  const auto vis = render_visibility(ex, scene, cam, 64, 48);
-  const GBuffer g = resolve_gbuffer(ex, scene, vis, cam.eye);
-  const ImageRGBA direct = direct_light(ex, scene, g, cam, {}, env);
+  const auto [g, direct] = light_frame(ex, scene, 64, 48, {}, env);
   std::size_t checked = 0;
   for (std::size_t i = 0; i < direct.size(); ++i) {
     if (!g.covered(i)) continue;
@@ -228,8 +233,7 @@ TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
   // A metal has no diffuse term, hence no SH ambient (its environment light is the
   // specular layer's).
   scene.materials[0].metallic = 1.0f;
-  const GBuffer gm = resolve_gbuffer(ex, scene, vis, cam.eye);
-  const ImageRGBA metal = direct_light(ex, scene, gm, cam, {}, env);
+  const auto [gm, metal] = light_frame(ex, scene, 64, 48, {}, env);
   for (std::size_t i = 0; i < metal.size(); ++i)
     if (gm.covered(i)) EXPECT_EQ(glm::vec3(metal.pixels[i]), glm::vec3(0.0f)) << i;
 }
