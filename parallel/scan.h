@@ -112,13 +112,9 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
       // With chunks taken in turn, this thread's next chunk is most likely c + workers: the
       // kernel prefetches it while it scans (a prefetch reads nothing in the memory model, so
       // a wrong guess only wastes bandwidth).
-      const std::size_t b = c * chunk, guess = (c + workers) * chunk;
-      if (guess < n)
-        scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
-                                            streaming, src + guess, std::min(n, guess + chunk) - guess);
-      else
-        scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
-                                            streaming);
+      const std::size_t b = c * chunk, guess = std::min(n, (c + workers) * chunk);
+      scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
+                                          streaming, src + guess, std::min(n, guess + chunk) - guess);
     }
   });
   return links[chunks - 1].prefix;
