@@ -53,6 +53,21 @@ inline bool project_and_snap(const glm::vec4& clip, const Viewport& vp, std::int
   return true;
 }
 
+// The inclusive box of pixels whose centres a triangle with these fixed-point bounds may
+// cover, clamped to the viewport (empty when x0 > x1 or y0 > y1).
+struct PixelBox {
+  std::int32_t x0, y0, x1, y1;
+  bool empty() const { return x0 > x1 || y0 > y1; }
+};
+inline PixelBox sample_centre_box(std::int32_t minx, std::int32_t miny, std::int32_t maxx,
+                                  std::int32_t maxy, const Viewport& vp) {
+  const int half = kSubpixelOne / 2;
+  return {std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits),
+          std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits),
+          std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits),
+          std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits)};
+}
+
 // Emits a snapped triangle if it has area, faces the right way and covers a sample centre.
 void emit(std::int32_t x0, std::int32_t y0, float w0, std::int32_t x1, std::int32_t y1, float w1,
           std::int32_t x2, std::int32_t y2, float w2, std::uint32_t triangle, std::uint32_t object,
@@ -63,17 +78,13 @@ void emit(std::int32_t x0, std::int32_t y0, float w0, std::int32_t x1, std::int3
                             (std::int64_t(x0) * y1 - std::int64_t(y0) * x1);
   if (area == 0) return;
   if ((cull_sign > 0 && area > 0) || (cull_sign < 0 && area < 0)) return;
-  const int half = kSubpixelOne / 2;
   // Pixel px is a candidate when its centre px*256+128 lies in [min, max].
   const std::int32_t minx = std::min({x0, x1, x2}), maxx = std::max({x0, x1, x2});
   const std::int32_t miny = std::min({y0, y1, y2}), maxy = std::max({y0, y1, y2});
   SetupTriangle t;
-  const std::int32_t px0 = std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits);
-  const std::int32_t py0 = std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits);
-  const std::int32_t px1 = std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits);
-  const std::int32_t py1 = std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits);
-  if (px0 > px1 || py0 > py1) return;  // covers no sample centre
-  t.px0 = std::int16_t(px0), t.py0 = std::int16_t(py0), t.px1 = std::int16_t(px1), t.py1 = std::int16_t(py1);
+  const PixelBox box = sample_centre_box(minx, miny, maxx, maxy, vp);
+  if (box.empty()) return;  // covers no sample centre
+  t.px0 = std::int16_t(box.x0), t.py0 = std::int16_t(box.y0), t.px1 = std::int16_t(box.x1), t.py1 = std::int16_t(box.y1);
   t.triangle = triangle;
   t.object = object;
   const bool swap = area < 0;  // make E_i >= 0 inside
@@ -297,7 +308,6 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
   std::size_t n = first;
   if (out.size() < n + (end - begin)) out.resize(n + (end - begin));
   SetupTriangle* dst = out.data();
-  const int half = kSubpixelOne / 2;
   for (std::size_t t = begin; t < end; ++t) {
     const std::uint32_t object = triangle_object[t];
     if (!excluded.empty() && object < excluded.size() && excluded[object]) continue;
@@ -330,11 +340,8 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
     const std::int32_t minx = std::min({x0, x1, x2}), maxx = std::max({x0, x1, x2});
     const std::int32_t miny = std::min({y0, y1, y2}), maxy = std::max({y0, y1, y2});
     SetupTriangle& r = dst[n];
-    const std::int32_t px0 = std::max<std::int32_t>(0, (minx - half + kSubpixelOne - 1) >> kSubpixelBits);
-    const std::int32_t py0 = std::max<std::int32_t>(0, (miny - half + kSubpixelOne - 1) >> kSubpixelBits);
-    const std::int32_t px1 = std::min<std::int32_t>(vp.width - 1, (maxx - half) >> kSubpixelBits);
-    const std::int32_t py1 = std::min<std::int32_t>(vp.height - 1, (maxy - half) >> kSubpixelBits);
-    r.px0 = std::int16_t(px0), r.py0 = std::int16_t(py0), r.px1 = std::int16_t(px1), r.py1 = std::int16_t(py1);
+    const PixelBox box = sample_centre_box(minx, miny, maxx, maxy, vp);
+    r.px0 = std::int16_t(box.x0), r.py0 = std::int16_t(box.y0), r.px1 = std::int16_t(box.x1), r.py1 = std::int16_t(box.y1);
     const bool swap = area < 0;
     r.x[0] = x0, r.y[0] = y0, r.inv_w[0] = v0.inv_w;
     r.x[1] = swap ? x2 : x1, r.y[1] = swap ? y2 : y1, r.inv_w[1] = swap ? v2.inv_w : v1.inv_w;
@@ -345,7 +352,7 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
     r.swapped = swap ? 1u : 0u;
     r.reserved = 0;
     const bool culled = (cull_sign > 0 && area > 0) || (cull_sign < 0 && area < 0);
-    const bool keep = (area != 0) & !culled & (px0 <= px1) & (py0 <= py1);
+    const bool keep = (area != 0) & !culled & (box.x0 <= box.x1) & (box.y0 <= box.y1);
     n += keep ? 1 : 0;
   }
   return n;
