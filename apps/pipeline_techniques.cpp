@@ -1,6 +1,8 @@
 // The technique table: see pipeline_techniques.h.
 #include "apps/pipeline_techniques.h"
 
+#include <algorithm>
+
 #include "apps/pipeline_distance_map.h"
 #include "apps/pipeline_planar_mirror.h"
 #include "apps/pipeline_ray_hierarchy.h"
@@ -81,9 +83,8 @@ void check_technique_params(const Technique& technique,
                             const std::map<std::string, double>& params) {
   for (const auto& entry : params) {
     const std::string& name = entry.first;
-    bool known = false;
-    for (const std::string& p : technique.params) known = known || p == name;
-    if (known) continue;
+    if (std::find(technique.params.begin(), technique.params.end(), name) != technique.params.end())
+      continue;
     std::string list;
     for (const std::string& p : technique.params) list += (list.empty() ? "" : ", ") + p;
     throw InputError("--param " + name,
