@@ -25,15 +25,18 @@ glm::vec4 pattern(int x, int y, float scale) {
                    scale * float((x * y) % 13), 0.25f * float((x + y) % 4));
 }
 
+// A w × h image of pattern(x, y, scale), or of pattern(y, x, scale) when `transposed`.
+ImageRGBA pattern_image(int w, int h, float scale, bool transposed = false) {
+  ImageRGBA im(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) im.at(x, y) = transposed ? pattern(y, x, scale) : pattern(x, y, scale);
+  return im;
+}
+
 TEST(Composite, IsDirectPlusSpecularPerChannelWithOpaqueAlpha) {
   // More pixels than one parallel chunk (8192), so every chunk is covered.
   const int w = 150, h = 70;
-  ImageRGBA direct(w, h), specular(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      direct.at(x, y) = pattern(x, y, 0.5f);
-      specular.at(x, y) = pattern(y, x, 0.125f);
-    }
+  const ImageRGBA direct = pattern_image(w, h, 0.5f), specular = pattern_image(w, h, 0.125f, true);
   par::Executor ex(2);
   const ImageRGBA out = composite(ex, direct, specular);
   ASSERT_EQ(out.width, w);
@@ -47,9 +50,7 @@ TEST(Composite, IsDirectPlusSpecularPerChannelWithOpaqueAlpha) {
 }
 
 TEST(Composite, ZeroSpecularKeepsDirectAndZeroDirectKeepsSpecular) {
-  ImageRGBA a(3, 2), zero(3, 2, glm::vec4(0.0f));
-  for (int y = 0; y < 2; ++y)
-    for (int x = 0; x < 3; ++x) a.at(x, y) = pattern(x, y, 0.3f);
+  const ImageRGBA a = pattern_image(3, 2, 0.3f), zero(3, 2, glm::vec4(0.0f));
   par::Executor ex(1);
   const ImageRGBA l = composite(ex, a, zero), r = composite(ex, zero, a);
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -59,9 +60,7 @@ TEST(Composite, ZeroSpecularKeepsDirectAndZeroDirectKeepsSpecular) {
 }
 
 TEST(ResolveSupersamples, OneByOneIsTheIdentity) {
-  ImageRGBA samples(5, 3);
-  for (int y = 0; y < 3; ++y)
-    for (int x = 0; x < 5; ++x) samples.at(x, y) = pattern(x, y, 1.5f);
+  const ImageRGBA samples = pattern_image(5, 3, 1.5f);
   par::Executor ex(2);
   const ImageRGBA out = resolve_supersamples(ex, samples, 1);
   ASSERT_EQ(out.width, 5);
@@ -92,9 +91,7 @@ TEST(ResolveSupersamples, KByKIsTheBlockMean) {
   for (int k : {2, 3, 4}) {
     SCOPED_TRACE(k);
     const int w = 7, h = 5;  // output size; samples are (w·k)×(h·k)
-    ImageRGBA s(w * k, h * k);
-    for (int y = 0; y < h * k; ++y)
-      for (int x = 0; x < w * k; ++x) s.at(x, y) = pattern(x, y, 0.25f);
+    const ImageRGBA s = pattern_image(w * k, h * k, 0.25f);
     par::Executor ex(2);
     const ImageRGBA out = resolve_supersamples(ex, s, k);
     ASSERT_EQ(out.width, w);
@@ -167,7 +164,9 @@ TEST(Tonemap, IsMonotoneAndSaturatesAtOne) {
     if (i == 0) continue;
     const float prev = out.at(i - 1, 0).x;
     ASSERT_GE(v, prev) << "x = " << hdr.at(i, 0).x;
-    if (hdr.at(i, 0).x < 7.0f) ASSERT_GT(v, prev) << "x = " << hdr.at(i, 0).x;
+    if (hdr.at(i, 0).x < 7.0f) {
+      ASSERT_GT(v, prev) << "x = " << hdr.at(i, 0).x;
+    }
   }
   EXPECT_EQ(out.at(n - 1, 0).x, 1.0f);
   EXPECT_EQ(out.at(0, 0).x, 0.0f);

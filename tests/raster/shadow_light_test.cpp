@@ -123,8 +123,9 @@ TEST(DirectLight, UnshadowedEqualsSharedShadingModel) {
   EXPECT_GT(checked, 1000u);
 }
 
-TEST(ShadowMap, SpotLightShadowMatchesGeometricOracle) {
-  // Spot lights share the point lights' distance cube: the shadow test ignores the cone.
+// A spot straight down over the floor, beside the blocker's centre: on the floor its inner
+// cone has radius ≈ 1.09 and its outer cone ≈ 2.53 around (0.2, 0.1).
+Light overhead_spot() {
   Light l;
   l.type = LightType::Spot;
   l.position = {0.2f, 3.0f, 0.1f};
@@ -132,7 +133,12 @@ TEST(ShadowMap, SpotLightShadowMatchesGeometricOracle) {
   l.intensity = 10.0f;
   l.inner_cone = 0.35f;
   l.outer_cone = 0.7f;
-  check_against_oracle(l, 0.06f);
+  return l;
+}
+
+TEST(ShadowMap, SpotLightShadowMatchesGeometricOracle) {
+  // Spot lights share the point lights' distance cube: the shadow test ignores the cone.
+  check_against_oracle(overhead_spot(), 0.06f);
 }
 
 // The glTF KHR_lights_punctual spot falloff, written out independently of core/shading.cpp:
@@ -152,14 +158,8 @@ TEST(DirectLight, SpotLightConeFalloffAndShadow) {
   // A spot above a floor with a square blocker: floor points in the blocker's shadow and
   // points outside the cone get no direct light; lit points inside the cone get the shading
   // model with the documented falloff (full I/d² inside the inner cone).
-  Light l;
-  l.type = LightType::Spot;
-  l.position = {0.2f, 3.0f, 0.1f};
-  l.direction = {0.0f, -1.0f, 0.0f};
-  l.intensity = 10.0f;
+  Light l = overhead_spot();
   l.color = {1.0f, 0.5f, 0.25f};
-  l.inner_cone = 0.35f;  // floor radius ≈ 1.09 around (0.2, 0.1)
-  l.outer_cone = 0.7f;   // ≈ 2.53
   Scene scene = floor_and_occluder(l);
   scene.materials[0].metallic = 0.0f;  // a diffuse floor (glTF's default is metallic)
   scene.materials[0].base_color = {0.8f, 0.8f, 0.8f, 1.0f};
@@ -234,8 +234,11 @@ TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
   // specular layer's).
   scene.materials[0].metallic = 1.0f;
   const auto [gm, metal] = light_frame(ex, scene, 64, 48, {}, env);
-  for (std::size_t i = 0; i < metal.size(); ++i)
-    if (gm.covered(i)) EXPECT_EQ(glm::vec3(metal.pixels[i]), glm::vec3(0.0f)) << i;
+  for (std::size_t i = 0; i < metal.size(); ++i) {
+    if (gm.covered(i)) {
+      EXPECT_EQ(glm::vec3(metal.pixels[i]), glm::vec3(0.0f)) << i;
+    }
+  }
 }
 
 }  // namespace
