@@ -5,23 +5,18 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "trace/packet_traversal.h"
 #include "trace/ray_file.h"
 #include "trace/traversal.h"
+#include "tests/apps/speculum_run.h"
 #include "tests/trace/test_meshes.h"
 
 namespace speculum::trace {
 namespace {
-
-std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("speculum_trace_cksum_" + name)).string();
-}
 
 // ASCII PLY, faces in the soup's order (the CLI's triangle index is the file's face index).
 void write_ply(const std::string& path, const testing::Soup& s) {
@@ -38,15 +33,11 @@ void write_ply(const std::string& path, const testing::Soup& s) {
     out << "3 " << s.indices[t] << ' ' << s.indices[t + 1] << ' ' << s.indices[t + 2] << '\n';
 }
 
-std::string run(const std::string& args) {
-  const std::string out = temp_path("out.json");
-  const std::string cmd = std::string(SPECULUM_BINARY) + " " + args + " > " + out;
-  EXPECT_EQ(0, std::system(cmd.c_str())) << cmd;
-  std::ifstream in(out);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::filesystem::remove(out);
-  return ss.str();
+// The CLI's stdout for `args`, which must succeed (tests/apps/speculum_run.h runs it).
+std::string run(const std::string& args, const std::filesystem::path& dir) {
+  const test::CommandResult r = test::run_speculum(args, dir);
+  EXPECT_EQ(r.status, 0) << args << ": " << r.err;
+  return r.out;
 }
 
 // The raw text of a top-level JSON number field (the first occurrence: the Embree block,
@@ -91,14 +82,13 @@ TEST(BenchTraceCli, ChecksumsEqualTheOracleForBothKernelsAndThreadCounts) {
   floor.add({-3, -1, -3}, {3, -1, 3}, {3, -1, -3});
   append(floor);
   append(testing::random_soup(400, 91, 0.08f));
-  const std::string mesh = temp_path("mesh.ply"), primary = temp_path("primary.spry"),
-                    random = temp_path("random.spry");
+  const std::filesystem::path dir = test::scratch_dir();
+  const std::string mesh = (dir / "mesh.ply").string(), primary = (dir / "primary.spry").string(),
+                    random = (dir / "random.spry").string();
   write_ply(mesh, s);
-  const std::string bin = SPECULUM_BINARY;
-  ASSERT_EQ(0, std::system((bin + " -q --threads 2 bench trace " + mesh +
-                            " --emit-rays primary --width 128 --height 96 --fov 20 --eye 0.3,0.8,3.5 --target 0,-0.2,0 -o " +
-                            primary)
-                               .c_str()));
+  run("-q --threads 2 bench trace " + mesh +
+          " --emit-rays primary --width 128 --height 96 --fov 20 --eye 0.3,0.8,3.5 --target 0,-0.2,0 -o " + primary,
+      dir);
   // Incoherent rays with varied [tnear, tfar], so a kernel ignoring the file's interval
   // differs from the oracle.
   RayStream rr;
@@ -121,7 +111,8 @@ TEST(BenchTraceCli, ChecksumsEqualTheOracleForBothKernelsAndThreadCounts) {
     for (const char* kernel : {"packet", "single"})
       for (int threads : {1, 2}) {
         const std::string json = run("--threads " + std::to_string(threads) + " bench trace " + mesh + " --rays " +
-                                     file + " --repeat 1 --no-embree --json --kernel " + kernel);
+                                     file + " --repeat 1 --no-embree --json --kernel " + kernel,
+                                     dir);
         SCOPED_TRACE(file + " --kernel " + kernel + " --threads " + std::to_string(threads) + ": " + json);
         EXPECT_EQ(field(json, "rays"), std::to_string(rays.size()));
         EXPECT_EQ(field(json, "triangles"), std::to_string(s.indices.size() / 3));
@@ -144,7 +135,7 @@ TEST(BenchTraceCli, ChecksumsEqualTheOracleForBothKernelsAndThreadCounts) {
     packet_path += closest_hit_packet(bvh, r, kPacketSize, h);
   }
   EXPECT_GT(packet_path, static_cast<int>(rays.size() / kPacketSize / 2));
-  for (const auto& p : {mesh, primary, random}) std::filesystem::remove(p);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
