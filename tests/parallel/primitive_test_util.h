@@ -31,6 +31,20 @@ inline std::uint32_t hash32(std::uint64_t x) {  // splitmix64 finalizer
 }
 inline float unit_float(std::uint64_t i) { return float(hash32(i) >> 8) * (1.f / 16777216.f); }
 
+// A width-generic map_lanes kernel (sqrt, abs, min, multiply-add over W lanes) for the
+// lane-width determinism tests: y = sqrt(|x|)·3 + min(x, x²), with min(a, b) = "b < a ? b : a".
+template <int W>
+std::vector<float> lanes_kernel(Executor& ex, const std::vector<float>& x) {
+  using L = Lanes<W>;
+  std::vector<float> y(x.size());
+  map_lanes<W>(ex, "lanes_kernel", x.size(), [&](std::size_t i, auto active) {
+    const int c = L::count(active);
+    const auto v = L::load_partial(x.data() + i, c);
+    L::store_partial(L::sqrt(L::abs(v)) * 3.f + L::min(v, v * v), y.data() + i, c);
+  });
+  return y;
+}
+
 // keep[i] = 1 with probability percent/100 (exactly 0 % and 100 % at the ends).
 inline std::vector<std::uint8_t> flags(std::size_t n, int percent, std::uint64_t seed) {
   std::vector<std::uint8_t> f(n);

@@ -52,18 +52,8 @@ TEST(SixteenMillion, MapAndGatherEqualSerial) {
   }
 }
 
-// A width-generic kernel over 16M elements: every W and thread count gives the bits of the
-// scalar loop (Lanes<W>::min(a, b) is "b < a ? b : a").
-template <int W>
-void lanes_kernel16M(Executor& ex, const std::vector<float>& x, std::vector<float>& y) {
-  using L = Lanes<W>;
-  map_lanes<W>(ex, "lanes16M", x.size(), [&](std::size_t i, auto active) {
-    const int c = L::count(active);
-    const auto v = L::load_partial(x.data() + i, c);
-    L::store_partial(L::sqrt(L::abs(v)) * 3.f + L::min(v, v * v), y.data() + i, c);
-  });
-}
-
+// The width-generic lanes_kernel (primitive_test_util.h) over 16M elements: every W and
+// thread count gives the bits of the scalar loop.
 TEST(SixteenMillion, MapLanesEveryWidthAndThreadCountEqualsScalarLoop) {
   const std::size_t n = k16M + 5;  // a partial last lane group for every W > 1
   std::vector<float> x(n);
@@ -73,11 +63,9 @@ TEST(SixteenMillion, MapLanesEveryWidthAndThreadCountEqualsScalarLoop) {
     const float v = x[i], sq = v * v;
     ref[i] = std::sqrt(std::fabs(v)) * 3.f + (sq < v ? sq : v);
   }
-  std::vector<float> y(n);
   for (int t : kThreadCounts)
     for (int w : {1, 4, 8, 16}) {
-      std::fill(y.begin(), y.end(), 0.f);
-      dispatch_lanes(w, [&](auto lw) { lanes_kernel16M<lw.value>(executor(t), x, y); });
+      const auto y = dispatch_lanes(w, [&](auto lw) { return lanes_kernel<lw.value>(executor(t), x); });
       ASSERT_TRUE(same_bytes(y, ref)) << "W=" << w << " t=" << t;
     }
 }

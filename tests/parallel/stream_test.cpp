@@ -224,18 +224,6 @@ TEST(Stream, ScanLookBackFoldsInChunkOrder) {
   EXPECT_EQ(computed, 0u);
 }
 
-template <int W>
-std::vector<float> lanes_kernel(Executor& ex, const std::vector<float>& x) {
-  using L = Lanes<W>;
-  std::vector<float> y(x.size());
-  map_lanes<W>(ex, "lanes_kernel", x.size(), [&](std::size_t i, auto active) {
-    const int c = L::count(active);
-    const auto v = L::load_partial(x.data() + i, c);
-    L::store_partial(L::sqrt(L::abs(v)) * 3.f + L::min(v, v * v), y.data() + i, c);
-  });
-  return y;
-}
-
 TEST(Stream, MapLanesBitIdenticalForEveryWidthAndThreadCount) {
   for (std::size_t n : {0u, 1u, 13u, 12345u}) {
     std::vector<float> x(n);
