@@ -8,45 +8,23 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <tuple>
 
 #include <glm/geometric.hpp>
 
 #include "core/camera_rays.h"
 #include "core/shading.h"
 #include "trace/reference_tracer.h"
+#include "tests/trace/reference_scenes.h"
 
 namespace speculum::trace {
 namespace {
 
-std::uint32_t material(Scene& s, glm::vec3 color, float metallic, float roughness, glm::vec3 emissive = {}) {
-  Material m;
-  m.base_color = glm::vec4(color, 1.0f);
-  m.metallic = metallic;
-  m.roughness = roughness;
-  m.emissive = emissive;
-  s.materials.push_back(m);
-  return static_cast<std::uint32_t>(s.materials.size() - 1);
-}
-
-void quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t mat) {
-  auto& m = s.mesh;
-  for (const auto& [p, q, r] : {std::tuple{a, b, c}, std::tuple{a, c, d}}) {
-    const auto base = static_cast<std::uint32_t>(m.positions.size());
-    const glm::vec3 n = glm::normalize(glm::cross(q - p, r - p));
-    m.positions.insert(m.positions.end(), {p, q, r});
-    m.normals.insert(m.normals.end(), {n, n, n});
-    m.uvs.insert(m.uvs.end(), 3, glm::vec2(0));
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
-    m.triangle_material.push_back(mat);
-    m.triangle_object.push_back(0);
-  }
-}
+using namespace testing;
 
 TEST(ReferenceTracer, MissReturnsTheEnvironmentRadiance) {
   Scene s;
-  const auto grey = material(s, glm::vec3(0.8f), 0, 0.9f, glm::vec3(5.0f));
-  quad(s, {-1, -1, 5}, {1, -1, 5}, {1, 1, 5}, {-1, 1, 5}, grey);  // behind the camera
+  const auto grey = add_material(s, glm::vec3(0.8f), 0, 0.9f, glm::vec3(5.0f));
+  add_quad(s, {-1, -1, 5}, {1, -1, 5}, {1, 1, 5}, {-1, 1, 5}, grey);  // behind the camera
   Light sun;
   sun.type = LightType::Directional;
   sun.direction = glm::vec3(0, -1, 0);
@@ -102,9 +80,9 @@ TEST(ReferenceTracer, DepthLimitBetweenFacingMirrors) {
   // -z with a narrow view: every camera ray bounces between them until the depth limit.
   Scene s;
   const glm::vec3 e(0.1f, 0.2f, 0.3f);
-  const auto mirror = material(s, glm::vec3(0.5f), 1, 0, e);
-  quad(s, {-50, -50, -1}, {50, -50, -1}, {50, 50, -1}, {-50, 50, -1}, mirror);
-  quad(s, {-50, -50, 1}, {-50, 50, 1}, {50, 50, 1}, {50, -50, 1}, mirror);
+  const auto mirror = add_material(s, glm::vec3(0.5f), 1, 0, e);
+  add_quad(s, {-50, -50, -1}, {50, -50, -1}, {50, 50, -1}, {-50, 50, -1}, mirror);
+  add_quad(s, {-50, -50, 1}, {-50, 50, 1}, {50, 50, 1}, {50, -50, 1}, mirror);
   s.environment.constant = glm::vec3(7.0f);  // never seen: the corridor is closed to it
   Camera cam;
   cam.eye = {0, 0, 0};
