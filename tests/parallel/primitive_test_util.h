@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "parallel/executor.h"
 #include "parallel/partition.h"
+#include "parallel/segmented.h"
 #include "parallel/stream.h"
 
 namespace speculum::par::test {
@@ -43,6 +45,20 @@ std::vector<float> lanes_kernel(Executor& ex, const std::vector<float>& x) {
     L::store_partial(L::sqrt(L::abs(v)) * 3.f + L::min(v, v * v), y.data() + i, c);
   });
   return y;
+}
+
+// Serial segmented min/argmin as parallel/segmented.h documents it: per segment the smallest
+// value and the lowest index holding it; NaN never wins; the first non-NaN value claims a
+// segment without a winner (so +inf can win); empty segments keep +inf and kNoIndex.
+inline void serial_segmented_min(const std::vector<std::uint32_t>& seg, const std::vector<float>& value,
+                                 std::uint32_t segments, std::vector<float>& v, std::vector<std::uint32_t>& ix) {
+  v.assign(segments, std::numeric_limits<float>::infinity());
+  ix.assign(segments, kNoIndex);
+  for (std::size_t i = 0; i < seg.size(); ++i)
+    if (value[i] < v[seg[i]] || (ix[seg[i]] == kNoIndex && value[i] == v[seg[i]])) {
+      v[seg[i]] = value[i];
+      ix[seg[i]] = std::uint32_t(i);
+    }
 }
 
 // keep[i] = 1 with probability percent/100 (exactly 0 % and 100 % at the ends).

@@ -227,18 +227,9 @@ TEST(SixteenMillion, SegmentedMinEqualsSerialLoop) {
     seg[i] = hash32(i * 13) % segments;
     value[i] = h % 97 == 0 ? nan : h % 89 == 0 ? inf : float(h % 64);
   }
-  auto serial = [&](const std::vector<std::uint32_t>& s, std::vector<float>& v, std::vector<std::uint32_t>& ix) {
-    v.assign(segments, inf);
-    ix.assign(segments, kNoIndex);
-    for (std::size_t i = 0; i < n; ++i)
-      if (value[i] < v[s[i]] || (ix[s[i]] == kNoIndex && value[i] == v[s[i]])) {
-        v[s[i]] = value[i];
-        ix[s[i]] = std::uint32_t(i);
-      }
-  };
   std::vector<float> ref_v;
   std::vector<std::uint32_t> ref_i;
-  serial(seg, ref_v, ref_i);
+  serial_segmented_min(seg, value, segments, ref_v, ref_i);
   std::size_t empty = 0, inf_won = 0;
   for (std::uint32_t s = 0; s < segments; ++s) {
     empty += ref_i[s] == kNoIndex;
@@ -256,7 +247,7 @@ TEST(SixteenMillion, SegmentedMinEqualsSerialLoop) {
   }
   std::vector<float> ref_sv;
   std::vector<std::uint32_t> ref_si;
-  serial(sorted_seg, ref_sv, ref_si);
+  serial_segmented_min(sorted_seg, value, segments, ref_sv, ref_si);
   std::vector<float> v(segments);
   std::vector<std::uint32_t> ix(segments);
   for (int t : kThreadCounts) {

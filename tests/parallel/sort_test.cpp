@@ -175,16 +175,12 @@ TEST(SegmentedMin, ClosestHitPerRayEqualsSerial) {
       seg[i] = hash32(i) % segments;
       t[i] = float(hash32(i + 5) % 50);  // coarse values: many ties
     }
-    std::vector<float> ref_v(segments, std::numeric_limits<float>::infinity());
-    std::vector<std::uint32_t> ref_i(segments, kNoIndex);
-    for (std::size_t i = 0; i < n; ++i)
-      if (t[i] < ref_v[seg[i]]) ref_v[seg[i]] = t[i], ref_i[seg[i]] = std::uint32_t(i);
+    std::vector<float> ref_v, ref_sv;
+    std::vector<std::uint32_t> ref_i, ref_si;
+    serial_segmented_min(seg, t, segments, ref_v, ref_i);
     auto sorted_seg = seg;
     std::sort(sorted_seg.begin(), sorted_seg.end());
-    std::vector<float> ref_sv(segments, std::numeric_limits<float>::infinity());
-    std::vector<std::uint32_t> ref_si(segments, kNoIndex);
-    for (std::size_t i = 0; i < n; ++i)
-      if (t[i] < ref_sv[sorted_seg[i]]) ref_sv[sorted_seg[i]] = t[i], ref_si[sorted_seg[i]] = std::uint32_t(i);
+    serial_segmented_min(sorted_seg, t, segments, ref_sv, ref_si);
     for (int th : kThreadCounts) {
       std::vector<float> v(segments);
       std::vector<std::uint32_t> ix(segments);
@@ -278,16 +274,12 @@ TEST(SegmentedMin, SparseSegmentsAcrossChunksEqualSerial) {
     val[i] = hash32(i + 1) % 5 == 0 ? std::numeric_limits<float>::quiet_NaN() : float(hash32(i + 2) % 8);
   }
   seg[0] = 4095, seg[1] = 4096, seg[2] = segments - 1;  // chunk edges and the last segment
-  std::vector<float> ref_v(segments, std::numeric_limits<float>::infinity());
-  std::vector<std::uint32_t> ref_i(segments, kNoIndex);
-  for (std::size_t i = 0; i < n; ++i)
-    if (val[i] < ref_v[seg[i]]) ref_v[seg[i]] = val[i], ref_i[seg[i]] = std::uint32_t(i);
+  std::vector<float> ref_v, ref_sv;
+  std::vector<std::uint32_t> ref_i, ref_si;
+  serial_segmented_min(seg, val, segments, ref_v, ref_i);
   auto sorted_seg = seg;
   std::sort(sorted_seg.begin(), sorted_seg.end());
-  std::vector<float> ref_sv(segments, std::numeric_limits<float>::infinity());
-  std::vector<std::uint32_t> ref_si(segments, kNoIndex);
-  for (std::size_t i = 0; i < n; ++i)
-    if (val[i] < ref_sv[sorted_seg[i]]) ref_sv[sorted_seg[i]] = val[i], ref_si[sorted_seg[i]] = std::uint32_t(i);
+  serial_segmented_min(sorted_seg, val, segments, ref_sv, ref_si);
   for (int t : kThreadCounts) {
     std::vector<float> v(segments);
     std::vector<std::uint32_t> ix(segments);
