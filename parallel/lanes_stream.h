@@ -1,0 +1,163 @@
+// Lane operations the stream primitives need beyond element-wise math: in-register prefix
+// sums, a broadcast of the last lane, non-temporal (streaming) stores, byte flags to a lane
+// mask, and left-packing the indices of set lanes. Each is written once for every W with a
+// generic definition; where a width maps to one register (W = 8 on AVX2, some ops at W = 4
+// and 16) an intrinsic path replaces it. Every path computes the same bits (integer work only), so
+// a kernel written over these ops gives the same output for every W (lanes.h).
+#pragma once
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+
+#include "parallel/lanes.h"
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace speculum::par {
+
+template <int W>
+using LaneU32 = typename Lanes<W>::u32;
+
+namespace lanes_detail {
+
+#if defined(__AVX2__)
+// The 8-lane register type (its ABI holds a __m256i, also under AVX-512), converted to and
+// from the fixed-size lanes at no cost.
+using Native8 = stdx::simd<std::uint32_t, stdx::simd_abi::deduce_t<std::uint32_t, 8>>;
+inline __m256i native(const LaneU32<8>& v) { return static_cast<__m256i>(stdx::static_simd_cast<Native8>(v)); }
+inline LaneU32<8> from_native(__m256i m) { return stdx::static_simd_cast<LaneU32<8>>(Native8(m)); }
+#endif
+
+// For each W-bit mask, the positions of its set bits packed to the front, one byte each.
+template <int W>
+struct LeftPackTable {
+  static_assert(W == 4 || W == 8);
+  alignas(64) std::uint64_t lanes[1 << W];
+  constexpr LeftPackTable() : lanes() {
+    for (unsigned m = 0; m < (1u << W); ++m) {
+      std::uint64_t packed = 0;
+      unsigned k = 0;
+      for (unsigned b = 0; b < unsigned(W); ++b)
+        if (m >> b & 1) packed |= std::uint64_t(b) << (8 * k++);
+      lanes[m] = packed;
+    }
+  }
+};
+template <int W>
+inline constexpr LeftPackTable<W> kLeftPack{};
+
+}  // namespace lanes_detail
+
+// Inclusive prefix sum across the lanes: r[i] = v[0] + ... + v[i] (mod 2^32).
+template <int W>
+LaneU32<W> prefix_sum(const LaneU32<W>& v) {
+#if defined(__AVX2__)
+  if constexpr (W == 8) {
+    __m256i x = lanes_detail::native(v);
+    x = _mm256_add_epi32(x, _mm256_slli_si256(x, 4));
+    x = _mm256_add_epi32(x, _mm256_slli_si256(x, 8));
+    // Carry the low half's total (lane 3) into every lane of the high half.
+    const __m256i low_total = _mm256_shuffle_epi32(x, 0xff);
+    return lanes_detail::from_native(_mm256_add_epi32(x, _mm256_permute2x128_si256(low_total, low_total, 0x08)));
+  }
+#endif
+  // Hillis–Steele: log2(W) shifted adds.
+  LaneU32<W> r = v;
+  for (int shift = 1; shift < W; shift *= 2)
+    r += LaneU32<W>([&](auto i) { return int(i) >= shift ? std::uint32_t(r[int(i) - shift]) : 0u; });
+  return r;
+}
+
+// Every lane = v[W - 1].
+template <int W>
+LaneU32<W> last_lane(const LaneU32<W>& v) {
+#if defined(__AVX2__)
+  if constexpr (W == 8)
+    return lanes_detail::from_native(_mm256_permutevar8x32_epi32(lanes_detail::native(v), _mm256_set1_epi32(7)));
+#endif
+  return LaneU32<W>(std::uint32_t(v[W - 1]));
+}
+
+// Stores v to p[0, W) bypassing the caches; p must be aligned to 4·W bytes (a line-aligned
+// output is aligned for every W). Call stream_fence() before other threads read the output.
+template <int W>
+void stream_store(const LaneU32<W>& v, std::uint32_t* p) {
+#if defined(__AVX2__)
+  if constexpr (W == 8) {
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(p), lanes_detail::native(v));
+    return;
+  }
+  if constexpr (W == 16) {
+    alignas(64) std::uint32_t tmp[16];
+    v.copy_to(tmp, stdx::element_aligned);
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(p), _mm256_load_si256(reinterpret_cast<const __m256i*>(tmp)));
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(p) + 1,
+                        _mm256_load_si256(reinterpret_cast<const __m256i*>(tmp + 8)));
+    return;
+  }
+#endif
+#if defined(__SSE2__)
+  if constexpr (W == 4) {
+    alignas(16) std::uint32_t tmp[4];
+    v.copy_to(tmp, stdx::element_aligned);
+    _mm_stream_si128(reinterpret_cast<__m128i*>(p), _mm_load_si128(reinterpret_cast<const __m128i*>(tmp)));
+    return;
+  }
+  if constexpr (W == 1) {
+    _mm_stream_si32(reinterpret_cast<int*>(p), int(std::uint32_t(v[0])));
+    return;
+  }
+#endif
+  v.copy_to(p, stdx::element_aligned);
+}
+
+// Orders this thread's streaming stores before its later stores (e.g. before a join
+// publishes the output).
+inline void stream_fence() {
+#if defined(__SSE2__)
+  _mm_sfence();
+#endif
+}
+
+// Bit k set iff flags[k] != 0, for k < W.
+template <int W>
+unsigned nonzero_bits(const std::uint8_t* flags) {
+#if defined(__SSE2__)
+  if constexpr (W == 8 || W == 16) {
+    const __m128i v = W == 8 ? _mm_loadl_epi64(reinterpret_cast<const __m128i*>(flags))
+                             : _mm_loadu_si128(reinterpret_cast<const __m128i*>(flags));
+    const unsigned zero = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_setzero_si128())));
+    return ~zero & ((1u << W) - 1);
+  }
+#endif
+  unsigned m = 0;
+  for (int k = 0; k < W; ++k) m |= unsigned(flags[k] != 0) << k;
+  return m;
+}
+
+// Lanes [0, popcount(bits)) = first + the positions of the set bits of `bits`, ascending;
+// the other lanes are unspecified (a kernel stores all W and lets later stores overwrite).
+template <int W>
+LaneU32<W> left_pack(unsigned bits, std::uint32_t first) {
+#if defined(__AVX2__)
+  if constexpr (W == 8) {
+    const __m256i pos =
+        _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(lanes_detail::kLeftPack<8>.lanes[bits & 0xff])));
+    return lanes_detail::from_native(_mm256_add_epi32(pos, _mm256_set1_epi32(int(first))));
+  }
+#endif
+  if constexpr (W == 4) {
+    const std::uint64_t packed = lanes_detail::kLeftPack<4>.lanes[bits & 0xf];
+    return LaneU32<W>([&](auto i) { return first + std::uint32_t(packed >> (8 * int(i)) & 0xff); });
+  }
+  std::uint32_t pos[W] = {};
+  int k = 0;
+  for (int b = 0; b < W; ++b)
+    if (bits >> b & 1) pos[k++] = first + std::uint32_t(b);
+  return LaneU32<W>(pos, stdx::element_aligned);
+}
+
+}  // namespace speculum::par
