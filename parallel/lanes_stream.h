@@ -9,6 +9,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
 #include "parallel/lanes.h"
 
@@ -29,6 +30,17 @@ namespace lanes_detail {
 using Native8 = stdx::simd<std::uint32_t, stdx::simd_abi::deduce_t<std::uint32_t, 8>>;
 inline __m256i native(const LaneU32<8>& v) { return static_cast<__m256i>(stdx::static_simd_cast<Native8>(v)); }
 inline LaneU32<8> from_native(__m256i m) { return stdx::static_simd_cast<LaneU32<8>>(Native8(m)); }
+using Native4 = stdx::simd<std::uint32_t, stdx::simd_abi::deduce_t<std::uint32_t, 4>>;
+inline __m128i native(const LaneU32<4>& v) { return static_cast<__m128i>(stdx::static_simd_cast<Native4>(v)); }
+inline LaneU32<4> from_native(__m128i m) { return stdx::static_simd_cast<LaneU32<4>>(Native4(m)); }
+// W = 16 (two registers under AVX2) as its two 8-lane halves.
+[[gnu::always_inline]] inline std::pair<LaneU32<8>, LaneU32<8>> halves(const LaneU32<16>& v) {
+  const auto [lo, hi] = stdx::split<8, 8>(v);
+  return {stdx::static_simd_cast<LaneU32<8>>(lo), stdx::static_simd_cast<LaneU32<8>>(hi)};
+}
+[[gnu::always_inline]] inline LaneU32<16> join(const LaneU32<8>& lo, const LaneU32<8>& hi) {
+  return stdx::static_simd_cast<LaneU32<16>>(stdx::concat(lo, hi));
+}
 #endif
 
 // For each W-bit mask, the positions of its set bits packed to the front, one byte each.
@@ -51,9 +63,15 @@ inline constexpr LeftPackTable<W> kLeftPack{};
 
 }  // namespace lanes_detail
 
+template <int W>
+[[gnu::always_inline]] inline LaneU32<W> last_lane(const LaneU32<W>& v);
+
+// The ops are forced inline: they are one to a few instructions each, and an out-of-line
+// call per vector (GCC's choice for the 16-lane forms) costs more than the op.
+
 // Inclusive prefix sum across the lanes: r[i] = v[0] + ... + v[i] (mod 2^32).
 template <int W>
-LaneU32<W> prefix_sum(const LaneU32<W>& v) {
+[[gnu::always_inline]] inline LaneU32<W> prefix_sum(const LaneU32<W>& v) {
 #if defined(__AVX2__)
   if constexpr (W == 8) {
     __m256i x = lanes_detail::native(v);
@@ -62,6 +80,16 @@ LaneU32<W> prefix_sum(const LaneU32<W>& v) {
     // Carry the low half's total (lane 3) into every lane of the high half.
     const __m256i low_total = _mm256_shuffle_epi32(x, 0xff);
     return lanes_detail::from_native(_mm256_add_epi32(x, _mm256_permute2x128_si256(low_total, low_total, 0x08)));
+  }
+  if constexpr (W == 4) {
+    __m128i x = lanes_detail::native(v);
+    x = _mm_add_epi32(x, _mm_slli_si128(x, 4));
+    return lanes_detail::from_native(_mm_add_epi32(x, _mm_slli_si128(x, 8)));
+  }
+  if constexpr (W == 16) {
+    const auto [lo, hi] = lanes_detail::halves(v);
+    const LaneU32<8> plo = prefix_sum<8>(lo);
+    return lanes_detail::join(plo, prefix_sum<8>(hi) + last_lane<8>(plo));
   }
 #endif
   // Hillis–Steele: log2(W) shifted adds.
@@ -73,10 +101,11 @@ LaneU32<W> prefix_sum(const LaneU32<W>& v) {
 
 // Every lane = v[W - 1].
 template <int W>
-LaneU32<W> last_lane(const LaneU32<W>& v) {
+[[gnu::always_inline]] inline LaneU32<W> last_lane(const LaneU32<W>& v) {
 #if defined(__AVX2__)
   if constexpr (W == 8)
     return lanes_detail::from_native(_mm256_permutevar8x32_epi32(lanes_detail::native(v), _mm256_set1_epi32(7)));
+  if constexpr (W == 4) return lanes_detail::from_native(_mm_shuffle_epi32(lanes_detail::native(v), 0xff));
 #endif
   return LaneU32<W>(std::uint32_t(v[W - 1]));
 }
@@ -84,28 +113,24 @@ LaneU32<W> last_lane(const LaneU32<W>& v) {
 // Stores v to p[0, W) bypassing the caches; p must be aligned to 4·W bytes (a line-aligned
 // output is aligned for every W). Call stream_fence() before other threads read the output.
 template <int W>
-void stream_store(const LaneU32<W>& v, std::uint32_t* p) {
+[[gnu::always_inline]] inline void stream_store(const LaneU32<W>& v, std::uint32_t* p) {
 #if defined(__AVX2__)
   if constexpr (W == 8) {
     _mm256_stream_si256(reinterpret_cast<__m256i*>(p), lanes_detail::native(v));
     return;
   }
   if constexpr (W == 16) {
-    alignas(64) std::uint32_t tmp[16];
-    v.copy_to(tmp, stdx::element_aligned);
-    _mm256_stream_si256(reinterpret_cast<__m256i*>(p), _mm256_load_si256(reinterpret_cast<const __m256i*>(tmp)));
-    _mm256_stream_si256(reinterpret_cast<__m256i*>(p) + 1,
-                        _mm256_load_si256(reinterpret_cast<const __m256i*>(tmp + 8)));
+    const auto [lo, hi] = lanes_detail::halves(v);
+    stream_store<8>(lo, p);
+    stream_store<8>(hi, p + 8);
+    return;
+  }
+  if constexpr (W == 4) {
+    _mm_stream_si128(reinterpret_cast<__m128i*>(p), lanes_detail::native(v));
     return;
   }
 #endif
 #if defined(__SSE2__)
-  if constexpr (W == 4) {
-    alignas(16) std::uint32_t tmp[4];
-    v.copy_to(tmp, stdx::element_aligned);
-    _mm_stream_si128(reinterpret_cast<__m128i*>(p), _mm_load_si128(reinterpret_cast<const __m128i*>(tmp)));
-    return;
-  }
   if constexpr (W == 1) {
     _mm_stream_si32(reinterpret_cast<int*>(p), int(std::uint32_t(v[0])));
     return;
@@ -124,7 +149,7 @@ inline void stream_fence() {
 
 // Bit k set iff flags[k] != 0, for k < W.
 template <int W>
-unsigned nonzero_bits(const std::uint8_t* flags) {
+[[gnu::always_inline]] inline unsigned nonzero_bits(const std::uint8_t* flags) {
 #if defined(__SSE2__)
   if constexpr (W == 8 || W == 16) {
     const __m128i v = W == 8 ? _mm_loadl_epi64(reinterpret_cast<const __m128i*>(flags))
@@ -141,7 +166,7 @@ unsigned nonzero_bits(const std::uint8_t* flags) {
 // Lanes [0, popcount(bits)) = first + the positions of the set bits of `bits`, ascending;
 // the other lanes are unspecified (a kernel stores all W and lets later stores overwrite).
 template <int W>
-LaneU32<W> left_pack(unsigned bits, std::uint32_t first) {
+[[gnu::always_inline]] inline LaneU32<W> left_pack(unsigned bits, std::uint32_t first) {
 #if defined(__AVX2__)
   if constexpr (W == 8) {
     const __m256i pos =

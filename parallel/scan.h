@@ -2,8 +2,8 @@
 // chained scan with decoupled look-back, DESIGN.md "Stream constraints"): each fixed chunk
 // is reduced, gets its offset from the prefixes its predecessors publish, and is scanned
 // again from cache; big outputs go out with streaming stores. The association (chunk sums
-// folded in chunk order from init) is fixed, so results are the same for any thread count
-// and timing, floats included.
+// folded in chunk order from init) is fixed, so results are the same for any thread count,
+// lane width and timing, floats included.
 #pragma once
 
 #include <algorithm>
@@ -75,7 +75,7 @@ T look_back(const ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum
   return base;
 }
 
-template <bool Inclusive, class T, class Op>
+template <int W, bool Inclusive, class T, class Op>
 T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out, T init, Op op,
        std::size_t chunk) {
   const std::size_t n = in.size();
@@ -88,7 +88,7 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   T* const dst = out.data();
   auto sum_of = [&](std::size_t c) {
     const std::size_t b = c * chunk;
-    return scan_kernels::chunk_sum(src + b, std::min(n, b + chunk) - b, op);
+    return scan_kernels::chunk_sum<W>(src + b, std::min(n, b + chunk) - b, op);
   };
   std::unique_ptr<ScanLink<T>[]> links(new ScanLink<T>[chunks]);
   // Chunks are handed out in index order, so a chunk's predecessors are usually done or in
@@ -113,26 +113,40 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
       // kernel prefetches it while it scans (a prefetch reads nothing in the memory model, so
       // a wrong guess only wastes bandwidth).
       const std::size_t b = c * chunk, guess = std::min(n, (c + workers) * chunk);
-      scan_kernels::chunk_scan<Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
+      scan_kernels::chunk_scan<W, Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b, offset, op,
                                           streaming, src + guess, std::min(n, guess + chunk) - guess);
     }
   });
   return links[chunks - 1].prefix;
 }
+
+// W = 0: the width `--lanes` chose (default_lanes()).
+template <int W, bool Inclusive, class T, class Op>
+T scan_at_width(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out, T init,
+                Op op, std::size_t chunk) {
+  if constexpr (W == 0) {
+    return dispatch_lanes(default_lanes(), [&](auto w) {
+      return scan<decltype(w)::value, Inclusive>(ex, name, in, out, init, op, chunk);
+    });
+  } else {
+    return scan<W, Inclusive>(ex, name, in, out, init, op, chunk);
+  }
+}
 }  // namespace detail
 
 // out[i] = init ⊕ in[0] ⊕ ... ⊕ in[i-1]; returns the total init ⊕ in[0..n). out may alias in.
-template <class T, class Op = std::plus<T>>
+// W: lane width of the kernels (1, 4, 8, 16; 0 = default_lanes()); the bits do not depend on it.
+template <int W = 0, class T, class Op = std::plus<T>>
 T exclusive_scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out,
                  T init = T{}, Op op = {}, std::size_t chunk = kStreamChunk) {
-  return detail::scan<false>(ex, name, in, out, init, op, chunk);
+  return detail::scan_at_width<W, false>(ex, name, in, out, init, op, chunk);
 }
 
 // out[i] = init ⊕ in[0] ⊕ ... ⊕ in[i]; returns the total. out may alias in.
-template <class T, class Op = std::plus<T>>
+template <int W = 0, class T, class Op = std::plus<T>>
 T inclusive_scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out,
                  T init = T{}, Op op = {}, std::size_t chunk = kStreamChunk) {
-  return detail::scan<true>(ex, name, in, out, init, op, chunk);
+  return detail::scan_at_width<W, true>(ex, name, in, out, init, op, chunk);
 }
 
 }  // namespace speculum::par

@@ -1,6 +1,7 @@
 // Per-chunk kernels of the chained scan (scan.h): chunk sum and chunk scan from an offset,
-// generic over T and Op, with AVX2 versions for 32-bit integer sums (exact in any order)
-// and optional streaming (cache-bypassing) stores for outputs too big to stay cached.
+// generic over T and Op, written over Lanes<W> for 32-bit integer sums (exact in any order,
+// so every W gives the same bits), with optional streaming (cache-bypassing) stores for
+// outputs too big to stay cached.
 #pragma once
 
 #include <cstddef>
@@ -9,48 +10,51 @@
 #include <functional>
 #include <type_traits>
 
-#if defined(__AVX2__)
+#if defined(__SSE__)
 #include <immintrin.h>
 #endif
+
+#include "parallel/lanes.h"
+#include "parallel/lanes_stream.h"
 
 namespace speculum::par::scan_kernels {
 
 inline void cpu_relax() {
-#if defined(__AVX2__)
+#if defined(__SSE2__)
   _mm_pause();
 #endif
 }
 
-// 32-bit integer sums take the SIMD path: wrap-around addition is associative, so any
-// grouping gives the serial fold's bits.
+// 32-bit integer sums take the lane path: wrap-around addition is associative, so any
+// grouping gives the serial fold's bits, and every lane width W gives the same result.
+// Other types and operators fold element by element in the documented order (a float sum's
+// association must not depend on W), so for them W changes nothing.
 template <class T, class Op>
-inline constexpr bool kSimdSum32 =
+inline constexpr bool kLaneSum32 =
     std::is_integral_v<T> && sizeof(T) == 4 &&
     (std::is_same_v<Op, std::plus<T>> || std::is_same_v<Op, std::plus<>>);
 
 // in[0] ⊕ in[1] ⊕ ... ⊕ in[m-1], folded left from in[0] (the documented float association).
 // m >= 1.
-template <class T, class Op>
+template <int W, class T, class Op>
 T chunk_sum(const T* in, std::size_t m, Op& op) {
-#if defined(__AVX2__)
-  if constexpr (kSimdSum32<T, Op>) {
-    __m256i a0 = _mm256_setzero_si256(), a1 = a0, a2 = a0, a3 = a0;
+  if constexpr (kLaneSum32<T, Op>) {
+    using L = Lanes<W>;
+    using V = LaneU32<W>;
+    const auto* u = reinterpret_cast<const std::uint32_t*>(in);
+    // Four independent accumulators keep four loads in flight per step.
+    V a0(0u), a1(0u), a2(0u), a3(0u);
     std::size_t i = 0;
-    for (; i + 32 <= m; i += 32) {
-      a0 = _mm256_add_epi32(a0, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i)));
-      a1 = _mm256_add_epi32(a1, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i + 8)));
-      a2 = _mm256_add_epi32(a2, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i + 16)));
-      a3 = _mm256_add_epi32(a3, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i + 24)));
+    for (; i + 4 * W <= m; i += 4 * W) {
+      a0 += L::load(u + i);
+      a1 += L::load(u + i + W);
+      a2 += L::load(u + i + 2 * W);
+      a3 += L::load(u + i + 3 * W);
     }
-    const __m256i a = _mm256_add_epi32(_mm256_add_epi32(a0, a1), _mm256_add_epi32(a2, a3));
-    __m128i h = _mm_add_epi32(_mm256_castsi256_si128(a), _mm256_extracti128_si256(a, 1));
-    h = _mm_add_epi32(h, _mm_shuffle_epi32(h, 0x4e));
-    h = _mm_add_epi32(h, _mm_shuffle_epi32(h, 0xb1));
-    std::uint32_t s = std::uint32_t(_mm_cvtsi128_si32(h));
-    for (; i < m; ++i) s += std::uint32_t(in[i]);
+    std::uint32_t s = L::hadd(V((a0 + a1) + (a2 + a3)));
+    for (; i < m; ++i) s += u[i];
     return T(s);
   }
-#endif
   T acc = in[0];
   for (std::size_t i = 1; i < m; ++i) acc = op(acc, in[i]);
   return acc;
@@ -83,22 +87,6 @@ std::size_t to_line(const T* p, std::size_t m) {
   return k < m ? k : m;
 }
 
-#if defined(__AVX2__)
-// Streams one 64-byte line (64-byte aligned dst) out of two registers.
-inline void stream_line(void* dst, __m256i lo, __m256i hi) {
-  _mm256_stream_si256(static_cast<__m256i*>(dst), lo);
-  _mm256_stream_si256(static_cast<__m256i*>(dst) + 1, hi);
-}
-
-// Inclusive prefix sum of the 8 lanes of x.
-inline __m256i prefix8(__m256i x) {
-  x = _mm256_add_epi32(x, _mm256_slli_si256(x, 4));
-  x = _mm256_add_epi32(x, _mm256_slli_si256(x, 8));
-  // Carry the low half's total (lane 3) into every lane of the high half.
-  const __m256i low_total = _mm256_shuffle_epi32(x, 0xff);
-  return _mm256_add_epi32(x, _mm256_permute2x128_si256(low_total, low_total, 0x08));
-}
-
 // Prefetch::next / end: the lines of the chunk this thread most likely scans next, fetched
 // into L2 one line per 16 elements of this chunk's scan, so its reduction reads cache while
 // this scan, bound by arithmetic and writes, would otherwise leave the memory reads idle.
@@ -106,79 +94,91 @@ struct Prefetch {
   const char* next = nullptr;
   const char* end = nullptr;
   void step() {
+#if defined(__SSE__)
     if (next < end) {
       _mm_prefetch(next, _MM_HINT_T1);
       next += 64;
     }
+#endif
   }
   void rest() {
+#if defined(__SSE__)
     for (; next < end; next += 64) _mm_prefetch(next, _MM_HINT_T1);
+#endif
   }
 };
 
-template <bool Inclusive, bool Streaming>
+// The 32-bit sum scan over Lanes<W>, 2W elements per step: prefix sums within the lanes,
+// then the running carry. Streaming: the output is written from its first 64-byte line
+// boundary with stream_store (aligned for every W).
+template <int W, bool Inclusive, bool Streaming>
 std::uint32_t scan_sum32(const std::uint32_t* in, std::uint32_t* out, std::size_t m,
                          std::uint32_t acc, Prefetch& prefetch) {
+  using L = Lanes<W>;
+  using V = LaneU32<W>;
+  constexpr std::size_t kStep = 2 * W;
   std::size_t i = Streaming ? to_line(out, m) : 0;
   std::plus<std::uint32_t> plus;
   acc = scan_scalar<Inclusive>(in, out, i, acc, plus);
-  __m256i carry = _mm256_set1_epi32(int(acc));
-  const __m256i last = _mm256_set1_epi32(7);
-  for (; i + 16 <= m; i += 16) {
-    prefetch.step();
-    const __m256i x0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i));
-    const __m256i x1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in + i + 8));
-    const __m256i p0 = prefix8(x0);
+  V carry(acc);
+  for (std::size_t step = 0; i + kStep <= m; i += kStep, ++step) {
+    if constexpr (kStep >= 16) {
+      for (std::size_t k = 0; k < kStep / 16; ++k) prefetch.step();
+    } else if (step % (16 / kStep) == 0) {
+      prefetch.step();
+    }
+    const V x0 = L::load(in + i);
+    const V x1 = L::load(in + i + W);
+    const V p0 = prefix_sum<W>(x0);
     // Everything but the carry update is independent of the carry, so the loop-carried
-    // chain is one add per 16 elements (a cross-lane broadcast in it would cost its latency).
-    const __m256i p1 = _mm256_add_epi32(prefix8(x1), _mm256_permutevar8x32_epi32(p0, last));
-    __m256i s0 = _mm256_add_epi32(p0, carry);
-    __m256i s1 = _mm256_add_epi32(p1, carry);
-    carry = _mm256_add_epi32(carry, _mm256_permutevar8x32_epi32(p1, last));
+    // chain is one add per 2W elements (a cross-lane broadcast in it would cost its latency).
+    const V p1 = prefix_sum<W>(x1) + last_lane<W>(p0);
+    V s0 = p0 + carry;
+    V s1 = p1 + carry;
+    carry += last_lane<W>(p1);
     if constexpr (!Inclusive) {
-      s0 = _mm256_sub_epi32(s0, x0);
-      s1 = _mm256_sub_epi32(s1, x1);
+      s0 -= x0;
+      s1 -= x1;
     }
     if constexpr (Streaming) {
-      stream_line(out + i, s0, s1);
+      stream_store<W>(s0, out + i);
+      stream_store<W>(s1, out + i + W);
     } else {
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i), s0);
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i + 8), s1);
+      L::store(s0, out + i);
+      L::store(s1, out + i + W);
     }
   }
-  acc = std::uint32_t(_mm256_cvtsi256_si32(carry));
+  acc = carry[0];
   return scan_scalar<Inclusive>(in + i, out + i, m - i, acc, plus);
 }
 
-// Generic streaming: scan a block into an aligned buffer in cache, then stream it out.
-template <bool Inclusive, class T, class Op>
+// Generic streaming: scan a block into an aligned buffer in cache, then stream it out as
+// 32-bit lanes (a copy: any T whose size divides a line).
+template <int W, bool Inclusive, class T, class Op>
 T scan_streaming(const T* in, T* out, std::size_t m, T acc, Op& op) {
   constexpr std::size_t kBlock = 2048 / sizeof(T);  // a multiple of a line when 64 % sizeof(T) == 0
   std::size_t i = to_line(out, m);
   acc = scan_scalar<Inclusive>(in, out, i, acc, op);
   alignas(64) T buf[kBlock];
+  const auto* words = reinterpret_cast<const std::uint32_t*>(buf);
   for (; i + kBlock <= m; i += kBlock) {
     acc = scan_scalar<Inclusive>(in + i, buf, kBlock, acc, op);
-    for (std::size_t k = 0; k < kBlock * sizeof(T); k += 64)
-      stream_line(reinterpret_cast<char*>(out + i) + k,
-                  _mm256_load_si256(reinterpret_cast<const __m256i*>(reinterpret_cast<const char*>(buf) + k)),
-                  _mm256_load_si256(reinterpret_cast<const __m256i*>(reinterpret_cast<const char*>(buf) + k + 32)));
+    auto* dst = reinterpret_cast<std::uint32_t*>(out + i);
+    for (std::size_t k = 0; k < kBlock * sizeof(T) / 4; k += W) stream_store<W>(Lanes<W>::load(words + k), dst + k);
   }
   return scan_scalar<Inclusive>(in + i, out + i, m - i, acc, op);
 }
-#endif
 
 }  // namespace detail
 
-// Scans in[0, m) from `offset` into out[0, m) (out may equal in). Streaming: full output
-// lines bypass the caches (followed by a store fence, so the join publishes them), and the
-// `next_count` elements at `next` (the thread's likely next chunk, none when null) are prefetched
-// into L2 during the scan.
-template <bool Inclusive, class T, class Op>
+// Scans in[0, m) from `offset` into out[0, m) (out may equal in) with lane width W.
+// Streaming: full output lines bypass the caches (followed by a store fence, so the join
+// publishes them), and the `next_count` elements at `next` (the thread's likely next chunk,
+// none when null) are prefetched into L2 during the scan.
+template <int W, bool Inclusive, class T, class Op>
 void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool streaming,
                 const T* next = nullptr, std::size_t next_count = 0) {
-#if defined(__AVX2__)
-  if constexpr (kSimdSum32<T, Op>) {
+  if constexpr (kLaneSum32<T, Op>) {
     const auto* i32 = reinterpret_cast<const std::uint32_t*>(in);
     auto* o32 = reinterpret_cast<std::uint32_t*>(out);
     detail::Prefetch prefetch;
@@ -187,22 +187,21 @@ void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool strea
       prefetch.end = reinterpret_cast<const char*>(next + next_count);
     }
     if (streaming) {
-      detail::scan_sum32<Inclusive, true>(i32, o32, m, std::uint32_t(offset), prefetch);
-      _mm_sfence();
+      detail::scan_sum32<W, Inclusive, true>(i32, o32, m, std::uint32_t(offset), prefetch);
+      stream_fence();
     } else {
-      detail::scan_sum32<Inclusive, false>(i32, o32, m, std::uint32_t(offset), prefetch);
+      detail::scan_sum32<W, Inclusive, false>(i32, o32, m, std::uint32_t(offset), prefetch);
     }
     prefetch.rest();
     return;
   }
-  if constexpr (std::is_trivially_copyable_v<T> && 64 % sizeof(T) == 0) {
+  if constexpr (std::is_trivially_copyable_v<T> && 64 % sizeof(T) == 0 && sizeof(T) % 4 == 0) {
     if (streaming) {
-      detail::scan_streaming<Inclusive>(in, out, m, offset, op);
-      _mm_sfence();
+      detail::scan_streaming<W, Inclusive>(in, out, m, offset, op);
+      stream_fence();
       return;
     }
   }
-#endif
   (void)streaming, (void)next, (void)next_count;
   detail::scan_scalar<Inclusive>(in, out, m, offset, op);
 }

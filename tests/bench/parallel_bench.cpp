@@ -104,14 +104,18 @@ void BM_StreamCopy(benchmark::State& state) {
   state.counters["GBps"] = benchmark::Counter(double(n) * 8e-9, benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// Args: n, threads, lane width W (8 unless given: the native width of this build).
 void BM_ExclusiveScan(benchmark::State& state) {
   const std::size_t n = state.range(0);
   const int threads = int(state.range(1));
   std::vector<std::uint32_t> in(n), out(n);
   for (std::size_t i = 0; i < n; ++i) in[i] = hash32(i) & 7;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(exclusive_scan(executor(threads), "scan", std::span<const std::uint32_t>(in), std::span(out)));
-  }
+  dispatch_lanes(state.range(2), [&](auto w) {
+    for (auto _ : state) {
+      benchmark::DoNotOptimize(exclusive_scan<w.value>(executor(threads), "scan", std::span<const std::uint32_t>(in),
+                                                       std::span(out)));
+    }
+  });
   report(state, n * 8, threads);
 }
 
@@ -121,9 +125,12 @@ void BM_InclusiveScan(benchmark::State& state) {
   const int threads = int(state.range(1));
   std::vector<std::uint32_t> data(n);
   for (std::size_t i = 0; i < n; ++i) data[i] = hash32(i) & 7;
-  for (auto _ : state) {  // rescans its own output (wrapping sums): the same work every time
-    benchmark::DoNotOptimize(inclusive_scan(executor(threads), "scan", std::span<const std::uint32_t>(data), std::span(data)));
-  }
+  dispatch_lanes(state.range(2), [&](auto w) {
+    for (auto _ : state) {  // rescans its own output (wrapping sums): the same work every time
+      benchmark::DoNotOptimize(inclusive_scan<w.value>(executor(threads), "scan", std::span<const std::uint32_t>(data),
+                                                       std::span(data)));
+    }
+  });
   report(state, n * 8, threads);
 }
 
@@ -224,8 +231,15 @@ void sizes_threads(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_Memcpy)->Apply(sizes_threads);
 BENCHMARK(BM_StreamCopy)->Apply(sizes_threads);
-BENCHMARK(BM_ExclusiveScan)->Apply(sizes_threads);
-BENCHMARK(BM_InclusiveScan)->Apply(sizes_threads);
+// The scans at W = 8, plus W = 1 (the scalar reference), 4 and 16 at 16M on one thread.
+void scan_args(benchmark::internal::Benchmark* b) {
+  for (long n : {1L << 20, 16L << 20})
+    for (long t : {1, 2}) b->Args({n, t, 8});
+  for (long w : {1, 4, 16}) b->Args({16L << 20, 1, w});
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+BENCHMARK(BM_ExclusiveScan)->Apply(scan_args);
+BENCHMARK(BM_InclusiveScan)->Apply(scan_args);
 BENCHMARK(BM_Reduce)->Apply(sizes_threads);
 BENCHMARK(BM_CompactScatter)->Apply(sizes_threads);
 BENCHMARK(BM_CompactHierarchical)->Apply([](benchmark::internal::Benchmark* b) {

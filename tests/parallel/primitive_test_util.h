@@ -19,6 +19,13 @@ inline Executor& executor(int threads) {
 }
 inline constexpr int kThreadCounts[] = {1, 2, 8};
 
+// f(std::integral_constant<int, W>) for every lane width W ∈ {1, 4, 8, 16}: the kernels are
+// instantiated at each width in the test binary.
+template <class F>
+void for_each_lane_width(F&& f) {
+  for (int w : {1, 4, 8, 16}) dispatch_lanes(w, f);
+}
+
 // 0, 1, odd, just over a stream chunk, just over a scatter chunk (16M cases are separate).
 inline const std::vector<std::size_t>& sizes() {
   static const std::vector<std::size_t> s = {0, 1, 7, 12345, kStreamChunk + 1, kScatterChunk + 3};

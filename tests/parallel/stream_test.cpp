@@ -36,7 +36,7 @@ TEST(Stream, MapGatherMatchSerial) {
   }
 }
 
-TEST(Stream, IntegerScansAndReduceEqualSerial) {
+TEST(Stream, IntegerScansAndReduceEqualSerialForEveryWidthAndThreadCount) {
   for (std::size_t n : sizes()) {
     std::vector<std::uint32_t> in(n);
     for (std::size_t i = 0; i < n; ++i) in[i] = hash32(i) % 1000;
@@ -45,11 +45,14 @@ TEST(Stream, IntegerScansAndReduceEqualSerial) {
     std::inclusive_scan(in.begin(), in.end(), in_ref.begin(), std::plus<>(), 5u);
     const std::uint32_t total = std::accumulate(in.begin(), in.end(), 5u);
     for (int t : kThreadCounts) {
-      std::vector<std::uint32_t> a(n), b(in);
-      EXPECT_EQ(exclusive_scan(executor(t), "ex", std::span<const std::uint32_t>(in), std::span(a), 5u), total);
-      EXPECT_EQ(inclusive_scan(executor(t), "in", std::span<const std::uint32_t>(b), std::span(b), 5u), total);  // in place
-      EXPECT_EQ(a, ex_ref) << n << " " << t;
-      EXPECT_EQ(b, in_ref) << n << " " << t;
+      for_each_lane_width([&](auto w) {
+        constexpr int W = w.value;
+        std::vector<std::uint32_t> a(n), b(in);
+        EXPECT_EQ(exclusive_scan<W>(executor(t), "ex", std::span<const std::uint32_t>(in), std::span(a), 5u), total);
+        EXPECT_EQ(inclusive_scan<W>(executor(t), "in", std::span<const std::uint32_t>(b), std::span(b), 5u), total);
+        EXPECT_EQ(a, ex_ref) << n << " " << t << " W=" << W;
+        EXPECT_EQ(b, in_ref) << n << " " << t << " W=" << W;  // in place
+      });
       // reduce() needs a true identity (it seeds every chunk with it).
       EXPECT_EQ(reduce(executor(t), "sum", std::span<const std::uint32_t>(in), 0u, std::plus<>()), total - 5u);
       auto mx = reduce(executor(t), "max", std::span<const std::uint32_t>(in), 0u,
@@ -99,16 +102,20 @@ TEST(Stream, FloatScanAcrossTilesMatchesChunkAssociation) {
     running += sum;
   }
   for (int t : kThreadCounts) {
-    std::vector<float> out(n);
-    const float total = inclusive_scan(executor(t), "scan_tiles", std::span<const float>(in), std::span(out), 1.5f);
-    EXPECT_EQ(std::bit_cast<std::uint32_t>(total), std::bit_cast<std::uint32_t>(running)) << t;
-    ASSERT_EQ(0, std::memcmp(out.data(), oracle.data(), n * sizeof(float))) << t;
+    for_each_lane_width([&](auto w) {
+      std::vector<float> out(n);
+      const float total = inclusive_scan<w.value>(executor(t), "scan_tiles", std::span<const float>(in),
+                                                  std::span(out), 1.5f);
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(total), std::bit_cast<std::uint32_t>(running)) << t;
+      ASSERT_EQ(0, std::memcmp(out.data(), oracle.data(), n * sizeof(float))) << t << " W=" << w.value;
+    });
   }
 }
 
-// 16M u32 (the streaming-store path): exclusive and inclusive, 1/2/8 threads, into an
-// output one element off line alignment (unaligned head and tail per chunk) and in place.
-TEST(Stream, Scan16MEverySpanAndThreadCount) {
+// 16M u32 (the streaming-store path): exclusive and inclusive, 1/2/8 threads × every lane
+// width, into an output one element off line alignment (unaligned head and tail per chunk)
+// and in place.
+TEST(Stream, Scan16MEverySpanWidthAndThreadCount) {
   const std::size_t n = std::size_t(16) << 20;
   std::vector<std::uint32_t> in(n);
   for (std::size_t i = 0; i < n; ++i) in[i] = hash32(i) & 1023;
@@ -118,12 +125,16 @@ TEST(Stream, Scan16MEverySpanAndThreadCount) {
   const std::uint32_t total = in_ref.back();
   std::vector<std::uint32_t> buf(n + 1);
   for (int t : kThreadCounts) {
-    const std::span<std::uint32_t> shifted(buf.data() + 1, n);
-    EXPECT_EQ(exclusive_scan(executor(t), "ex16M", std::span<const std::uint32_t>(in), shifted, 3u), total);
-    ASSERT_TRUE(std::equal(shifted.begin(), shifted.end(), ex_ref.begin())) << t;
-    std::vector<std::uint32_t> b(in);
-    EXPECT_EQ(inclusive_scan(executor(t), "in16M", std::span<const std::uint32_t>(b), std::span(b), 3u), total);
-    ASSERT_TRUE(b == in_ref) << t;
+    for_each_lane_width([&](auto w) {
+      constexpr int W = w.value;
+      const std::span<std::uint32_t> shifted(buf.data() + 1, n);
+      std::fill(buf.begin(), buf.end(), 0u);
+      EXPECT_EQ(exclusive_scan<W>(executor(t), "ex16M", std::span<const std::uint32_t>(in), shifted, 3u), total);
+      ASSERT_TRUE(std::equal(shifted.begin(), shifted.end(), ex_ref.begin())) << t << " W=" << W;
+      std::vector<std::uint32_t> b(in);
+      EXPECT_EQ(inclusive_scan<W>(executor(t), "in16M", std::span<const std::uint32_t>(b), std::span(b), 3u), total);
+      ASSERT_TRUE(b == in_ref) << t << " W=" << W;
+    });
   }
 }
 
@@ -146,7 +157,7 @@ TEST(Stream, ScansOffTheSimdPathEqualSerial) {
   std::inclusive_scan(inu.begin(), inu.end(), refmax.begin(), max_op, 0u);
   for (int t : kThreadCounts) {
     std::vector<std::uint64_t> out64(n);
-    EXPECT_EQ(inclusive_scan(executor(t), "u64", std::span<const std::uint64_t>(in64), std::span(out64),
+    EXPECT_EQ(inclusive_scan<1>(executor(t), "u64", std::span<const std::uint64_t>(in64), std::span(out64),
                              std::uint64_t(7)), ref64.back());
     ASSERT_TRUE(out64 == ref64) << t;
     std::vector<std::int32_t> outs(m);
