@@ -1,6 +1,6 @@
 // Lane operations the stream primitives need beyond element-wise math: in-register prefix
-// sums, a broadcast of the last lane, non-temporal (streaming) stores, byte flags to a lane
-// mask, and left-packing the indices of set lanes. Each is written once for every W with a
+// sums, a broadcast of the last lane, non-temporal (streaming) stores, even/odd word
+// deinterleaving, byte flags to a lane mask, and left-packing the indices of set lanes. Each is written once for every W with a
 // generic definition; where a width maps to one register (W = 8 on AVX2, some ops at W = 4
 // and 16) an intrinsic path replaces it. Every path computes the same bits (integer work only), so
 // a kernel written over these ops gives the same output for every W (lanes.h).
@@ -137,6 +137,28 @@ template <int W>
   }
 #endif
   v.copy_to(p, stdx::element_aligned);
+}
+
+// The even and odd words of p[0, 2W): {p[0], p[2], ...} and {p[1], p[3], ...} — the low and
+// high halves of W packed 64-bit words on a little-endian machine.
+template <int W>
+[[gnu::always_inline]] inline std::pair<LaneU32<W>, LaneU32<W>> deinterleave(const std::uint32_t* p) {
+#if defined(__AVX2__)
+  if constexpr (W == 8) {
+    const __m256 a = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
+    const __m256 b = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + 8)));
+    // Pick per 128-bit lane, then put the quadwords back in order.
+    const auto pick = [](__m256 x) { return _mm256_permute4x64_epi64(_mm256_castps_si256(x), _MM_SHUFFLE(3, 1, 2, 0)); };
+    return {lanes_detail::from_native(pick(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)))),
+            lanes_detail::from_native(pick(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1))))};
+  }
+  if constexpr (W == 16) {
+    const auto [e0, o0] = deinterleave<8>(p);
+    const auto [e1, o1] = deinterleave<8>(p + 16);
+    return {lanes_detail::join(e0, e1), lanes_detail::join(o0, o1)};
+  }
+#endif
+  return {LaneU32<W>([&](auto i) { return p[2 * int(i)]; }), LaneU32<W>([&](auto i) { return p[2 * int(i) + 1]; })};
 }
 
 // Orders this thread's streaming stores before its later stores (e.g. before a join

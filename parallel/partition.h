@@ -41,6 +41,16 @@ struct RadixSortScratch {
 // (skewed keys) makes it fall back to the 64-bit keys' method: least-significant-digit
 // passes of <= 11 bits over the whole array with write-combining scatters.
 // payload may be empty (keys only); otherwise it must have keys.size() elements.
+// radix_sort<W> runs its kernels at lane width W (1, 4, 8, 16); the plain overloads use
+// default_lanes(). The output does not depend on W.
+template <int W>
+void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
+                std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch = nullptr,
+                std::size_t chunk = kScatterChunk);
+template <int W>
+void radix_sort(Executor& ex, std::string_view name, std::span<std::uint64_t> keys,
+                std::span<std::uint32_t> payload, RadixSortScratch<std::uint64_t>* scratch = nullptr,
+                std::size_t chunk = kScatterChunk);
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch = nullptr,
                 std::size_t chunk = kScatterChunk);

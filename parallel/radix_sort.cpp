@@ -2,7 +2,9 @@
 // digit into cache-sized buckets, then each bucket sorted in cache by LSD passes (ROGER §4.5
 // bucket sort as the first level). 64-bit keys, and 32-bit keys whose top digit is badly
 // skewed: LSD passes over the whole array. A stable sort's output is unique, so every path
-// gives the same bytes for any thread count.
+// gives the same bytes for any thread count and lane width W. The kernels are written over
+// Lanes<W>: digits are extracted W keys at a time, output lines go out as W-lane streaming
+// stores; the scatters themselves place elements one by one, in element order.
 #include <algorithm>
 #include <bit>
 #include <cstring>
@@ -10,11 +12,8 @@
 #include <stdexcept>
 #include <string>
 
-#if defined(__AVX2__)
-#include <immintrin.h>
-#endif
-
 #include "parallel/chunk_counts.h"
+#include "parallel/lanes_stream.h"
 #include "parallel/partition.h"
 
 namespace speculum::par {
@@ -22,6 +21,24 @@ namespace speculum::par {
 namespace {
 
 constexpr unsigned kMaxDigitBits = 11;  // 2048 buckets: counts and line buffers fit in L2
+
+// f(i, key, digit) for every i in [b, e), in order, with digit = (key >> shift) & mask
+// computed for W keys at a time in lanes. (Key may be a packed word: the shift then
+// reaches into its key half.)
+template <int W, class Key, class F>
+[[gnu::always_inline]] inline void for_each_digit(const Key* keys, std::size_t b, std::size_t e,
+                                                  unsigned shift, Key mask, F&& f) {
+  using V = stdx::fixed_size_simd<Key, W>;
+  std::size_t i = b;
+  alignas(64) Key digit[W];
+  for (; i + W <= e; i += W) {
+    // The digits go through a W-word buffer: reading it back costs a load per lane, where
+    // extracting lanes from the register costs a shuffle each.
+    ((V(keys + i, stdx::element_aligned) >> int(shift)) & V(mask)).copy_to(digit, stdx::vector_aligned);
+    for (int j = 0; j < W; ++j) f(i + std::size_t(j), keys[i + std::size_t(j)], std::size_t(digit[j]));
+  }
+  for (; i < e; ++i) f(i, keys[i], std::size_t((keys[i] >> shift) & mask));
+}
 
 // ---------------------------------------------------------------------------------------
 // LSD over the whole array (64-bit keys; fallback for skewed 32-bit keys).
@@ -51,21 +68,26 @@ WriteCombine<Key>& thread_write_combine(std::size_t buckets) {
 }
 
 // OR over i of keys[i] ^ keys[0]: the bits that differ between keys (0: all equal).
-template <class Key>
+template <int W, class Key>
 Key varying_bits(Executor& ex, std::string_view name, std::span<const Key> keys, std::size_t chunk) {
+  using V = stdx::fixed_size_simd<Key, W>;
   const Key first = keys[0];
   return ex.parallel_reduce(
       launch_name(name, "varying_bits"), keys.size(), chunk, Key{0},
       [&](std::size_t b, std::size_t e) {
+        V lanes(Key{0});
+        std::size_t i = b;
+        for (; i + W <= e; i += W) lanes |= V(keys.data() + i, stdx::element_aligned) ^ V(first);
         Key v = 0;
-        for (std::size_t i = b; i < e; ++i) v |= keys[i] ^ first;
+        for (int j = 0; j < W; ++j) v |= Key(lanes[j]);  // OR: any grouping gives the same bits
+        for (; i < e; ++i) v |= keys[i] ^ first;
         return v;
       },
       [](Key a, Key b) { return Key(a | b); });
 }
 
 // Sorts on bits [lo_bit, lo_bit + bits) only (the others are equal in every key).
-template <class Key>
+template <int W, class Key>
 void lsd_sort(Executor& ex, std::string_view name, std::span<Key> keys, std::span<std::uint32_t> payload,
               RadixSortScratch<Key>& s, std::size_t chunk, unsigned lo_bit, unsigned bits) {
   const std::size_t n = keys.size();
@@ -90,7 +112,7 @@ void lsd_sort(Executor& ex, std::string_view name, std::span<Key> keys, std::spa
       const unsigned sh = shift;
       const Key m = mask;
       std::fill(count, count + buckets, 0u);
-      for (std::size_t i = b; i < e; ++i) ++count[(in_k[i] >> sh) & m];
+      for_each_digit<W>(in_k, b, e, sh, m, [&](std::size_t, Key, std::size_t d) { ++count[d]; });
     });
     const auto totals = chunk_offsets(s.counts, chunks, buckets);
     if (std::find(totals.begin(), totals.end(), n) != totals.end()) continue;  // digit constant
@@ -111,9 +133,7 @@ void lsd_sort(Executor& ex, std::string_view name, std::span<Key> keys, std::spa
       const Key m = mask;
       const bool pay = with_payload;
       std::fill(fill, fill + buckets, 0u);
-      for (std::size_t i = b; i < e; ++i) {
-        const Key k = in_k[i];
-        const std::size_t d = std::size_t((k >> sh) & m);
+      for_each_digit<W>(in_k, b, e, sh, m, [&](std::size_t i, Key k, std::size_t d) {
         const std::uint32_t f = fill[d];
         buf_k[d * L + f] = k;
         if (pay) buf_p[d * L + f] = in_p[i];
@@ -125,7 +145,7 @@ void lsd_sort(Executor& ex, std::string_view name, std::span<Key> keys, std::spa
         } else {
           fill[d] = f + 1;
         }
-      }
+      });
       for (std::size_t d = 0; d < buckets; ++d) {  // partial lines, in bucket order
         std::copy_n(buf_k + d * L, fill[d], out_k + offset[d]);
         if (pay) std::copy_n(buf_p + d * L, fill[d], out_p + offset[d]);
@@ -205,21 +225,11 @@ ThreadBuffers<E>& thread_buffers() {
 
 // Writes one full 64-byte line, 64-byte aligned, bypassing the caches (the scatter target
 // is not read again before the whole pass is done, so caching it only evicts the sources).
-inline void stream_line(void* dst, const void* src) {
-#if defined(__AVX2__)
-  const __m256i a = _mm256_load_si256(static_cast<const __m256i*>(src));
-  const __m256i b = _mm256_load_si256(static_cast<const __m256i*>(src) + 1);
-  _mm256_stream_si256(static_cast<__m256i*>(dst), a);
-  _mm256_stream_si256(static_cast<__m256i*>(dst) + 1, b);
-#else
-  std::memcpy(dst, src, 64);
-#endif
-}
-
-inline void store_fence() {
-#if defined(__AVX2__)
-  _mm_sfence();  // streaming stores are weakly ordered: publish them before the join
-#endif
+template <int W>
+void stream_line(void* dst, const void* src) {
+  const auto* from = static_cast<const std::uint32_t*>(src);
+  auto* to = static_cast<std::uint32_t*>(dst);
+  for (int k = 0; k < 16; k += W) stream_store<W>(Lanes<W>::load(from + k), to + k);
 }
 
 // Elements before dst + k is 64-byte aligned (at most m).
@@ -231,43 +241,28 @@ inline std::size_t to_line(const std::uint32_t* dst, std::size_t m) {
 // dst[i] = the high (Key = true) or low 32 bits of src[i], i < m; whole aligned lines of dst
 // go out as streaming stores (the sorted output is too big to stay cached, and a cached
 // store would first read its line from memory), the unaligned head and tail as plain stores.
-template <bool Key>
+template <int W, bool Key>
 void stream_halves(const std::uint64_t* src, std::size_t m, std::uint32_t* dst) {
   std::size_t i = to_line(dst, m);
   for (std::size_t j = 0; j < i; ++j) dst[j] = std::uint32_t(Key ? src[j] >> 32 : src[j]);
-#if defined(__AVX2__)
-  constexpr int kPick = Key ? _MM_SHUFFLE(3, 1, 3, 1) : _MM_SHUFFLE(2, 0, 2, 0);
-  // Two 4-word vectors -> 8 halves in order: pick per 128-bit lane, then fix the quadword order.
-  auto halves8 = [](const std::uint64_t* p) {
-    const __m256 a = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
-    const __m256 b = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + 4)));
-    return _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, kPick)),
-                                    _MM_SHUFFLE(3, 1, 2, 0));
-  };
-  for (; i + 16 <= m; i += 16) {
-    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i), halves8(src + i));
-    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i + 8), halves8(src + i + 8));
+  const auto* words = reinterpret_cast<const std::uint32_t*>(src);  // low, high, low, high, ...
+  for (; i + W <= m; i += W) {
+    const auto [low, high] = deinterleave<W>(words + 2 * i);
+    stream_store<W>(Key ? high : low, dst + i);
   }
-#endif
   for (; i < m; ++i) dst[i] = std::uint32_t(Key ? src[i] >> 32 : src[i]);
 }
 
-inline void stream_copy(const std::uint32_t* src, std::size_t m, std::uint32_t* dst) {
+template <int W>
+void stream_copy(const std::uint32_t* src, std::size_t m, std::uint32_t* dst) {
   std::size_t i = to_line(dst, m);
   std::copy_n(src, i, dst);
-#if defined(__AVX2__)
-  for (; i + 16 <= m; i += 16) {
-    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i),
-                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + i)));
-    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i + 8),
-                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src + i + 8)));
-  }
-#endif
+  for (; i + W <= m; i += W) stream_store<W>(Lanes<W>::load(src + i), dst + i);
   std::copy(src + i, src + m, dst + i);
 }
 
 // Writes a sorted bucket out unpacked: keys[i] (and payload[i]) from from[i], i < m.
-template <class E>
+template <int W, class E>
 void unpack_bucket(const E* from, std::size_t m, std::uint32_t* keys, std::uint32_t* payload,
                    bool streaming) {
   if (!streaming) {
@@ -275,10 +270,10 @@ void unpack_bucket(const E* from, std::size_t m, std::uint32_t* keys, std::uint3
     return;
   }
   if constexpr (sizeof(E) == 8) {
-    stream_halves<true>(from, m, keys);
-    stream_halves<false>(from, m, payload);
+    stream_halves<W, true>(from, m, keys);
+    stream_halves<W, false>(from, m, payload);
   } else {
-    stream_copy(from, m, keys);
+    stream_copy<W>(from, m, keys);
   }
 }
 
@@ -286,7 +281,7 @@ void unpack_bucket(const E* from, std::size_t m, std::uint32_t* keys, std::uint3
 // of bucket d. Each bucket's line buffer mirrors the line of `out` it is filling, so a
 // full line goes out as one aligned streaming store; the first line of a bucket's range
 // and its last partial line are written element-wise (they share lines with neighbours).
-template <class E>
+template <int W, class E>
 void top_scatter_chunk(const std::uint32_t* keys, const std::uint32_t* payload, std::size_t b,
                        std::size_t e, unsigned shift, std::uint32_t mask, std::uint32_t* offset,
                        std::size_t buckets, E* out) {
@@ -295,9 +290,7 @@ void top_scatter_chunk(const std::uint32_t* keys, const std::uint32_t* payload, 
   E* const line = tb.line_buffers(buckets);
   std::uint32_t* const fill = tb.fill.data();
   for (std::size_t d = 0; d < buckets; ++d) fill[d] = offset[d] & (L - 1);
-  for (std::size_t i = b; i < e; ++i) {
-    const std::uint32_t k = keys[i];
-    const std::size_t d = (k >> shift) & mask;
+  for_each_digit<W>(keys, b, e, shift, mask, [&](std::size_t i, std::uint32_t k, std::size_t d) {
     const std::uint32_t f = fill[d];
     line[d * L + f] = Packed<E>::pack(k, payload, i);
     if (f + 1 == L) {
@@ -305,7 +298,7 @@ void top_scatter_chunk(const std::uint32_t* keys, const std::uint32_t* payload, 
       const std::uint32_t start = o & (L - 1);
       E* const dst = out + (o - start);
       if (start == 0) {
-        stream_line(dst, line + d * L);
+        stream_line<W>(dst, line + d * L);
       } else {
         for (std::uint32_t j = start; j < L; ++j) dst[j] = line[d * L + j];
       }
@@ -314,21 +307,21 @@ void top_scatter_chunk(const std::uint32_t* keys, const std::uint32_t* payload, 
     } else {
       fill[d] = f + 1;
     }
-  }
+  });
   for (std::size_t d = 0; d < buckets; ++d) {
     const std::uint32_t o = offset[d];
     const std::uint32_t start = o & (L - 1);
     for (std::uint32_t j = start; j < fill[d]; ++j) out[o - start + j] = line[d * L + j];
   }
-  store_fence();
+  stream_fence();  // streaming stores are weakly ordered: publish them before the join
 }
 
 // Stable sort of one top-digit bucket src[0, m) on key bits [lo_bit, lo_bit + bits) (every
 // other bit is equal within the bucket), written unpacked to keys/payload[0, m).
-template <class E>
+template <int W, class E>
 void sort_bucket(E* src, std::size_t m, unsigned lo_bit, unsigned bits, std::uint32_t* keys,
                  std::uint32_t* payload, bool streaming) {
-  auto unpack_all = [&](const E* from) { unpack_bucket(from, m, keys, payload, streaming); };
+  auto unpack_all = [&](const E* from) { unpack_bucket<W>(from, m, keys, payload, streaming); };
   if (bits == 0 || m <= 1) return unpack_all(src);
   if (m <= 32) {  // insertion sort: stable (moves only past strictly greater keys)
     for (std::size_t i = 1; i < m; ++i) {
@@ -349,20 +342,23 @@ void sort_bucket(E* src, std::size_t m, unsigned lo_bit, unsigned bits, std::uin
   ThreadBuffers<E>& tb = thread_buffers<E>();
   tb.counts.assign(passes * radix, 0u);
   std::uint32_t* const count = tb.counts.data();
-  // One read counts every pass's digit (counts do not depend on the order).
+  // One read counts every pass's digit (counts do not depend on the order). The key sits in
+  // the high half of a packed word: its digits are digits of the word 32 bits further up.
+  constexpr unsigned kKeyShift = sizeof(E) == 8 ? 32 : 0;
+  const unsigned s0 = kKeyShift + lo_bit;
   if (passes == 2) {  // the common case (16M uniform keys), unrolled
     std::uint32_t* const c1 = count + radix;
-    const unsigned s0 = lo_bit, s1 = lo_bit + digit_bits;
-    for (std::size_t i = 0; i < m; ++i) {
-      const std::uint32_t k = Packed<E>::key(src[i]);
-      ++count[(k >> s0) & mask];
-      ++c1[(k >> s1) & mask];
-    }
+    const unsigned s1 = lo_bit + digit_bits;
+    for_each_digit<W>(src, 0, m, s0, E(mask), [&](std::size_t, E x, std::size_t d) {
+      ++count[d];
+      ++c1[(Packed<E>::key(x) >> s1) & mask];
+    });
   } else {
-    for (std::size_t i = 0; i < m; ++i) {
-      const std::uint32_t k = Packed<E>::key(src[i]);
-      for (unsigned p = 0; p < passes; ++p) ++count[p * radix + ((k >> (lo_bit + p * digit_bits)) & mask)];
-    }
+    for_each_digit<W>(src, 0, m, s0, E(mask), [&](std::size_t, E x, std::size_t d) {
+      ++count[d];
+      const std::uint32_t k = Packed<E>::key(x);
+      for (unsigned p = 1; p < passes; ++p) ++count[p * radix + ((k >> (lo_bit + p * digit_bits)) & mask)];
+    });
   }
   unsigned active[32];
   unsigned n_active = 0;
@@ -409,7 +405,7 @@ TopDigit top_digit(std::size_t n, unsigned lo_bit, unsigned bits) {
 }
 
 // s.counts already holds the per-chunk counts of the top digit when `counted`.
-template <class E>
+template <int W, class E>
 void msd_sort32(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>& s,
                 std::size_t chunk, unsigned lo_bit, unsigned bits, bool counted) {
@@ -429,12 +425,12 @@ void msd_sort32(Executor& ex, std::string_view name, std::span<std::uint32_t> ke
       const unsigned sh = shift;
       const std::uint32_t m = mask;
       std::fill(count, count + buckets, 0u);
-      for (std::size_t i = b; i < e; ++i) ++count[(in[i] >> sh) & m];
+      for_each_digit<W>(in, b, e, sh, m, [&](std::size_t, std::uint32_t, std::size_t d) { ++count[d]; });
     });
   }
   const auto totals = chunk_offsets(s.counts, chunks, buckets);
   if (local_bits > 0 && *std::max_element(totals.begin(), totals.end()) > kMaxLocalBucket)
-    return lsd_sort(ex, name, keys, payload, s, chunk, lo_bit, bits);
+    return lsd_sort<W>(ex, name, keys, payload, s, chunk, lo_bit, bits);
   std::vector<std::uint32_t> bucket_begin(buckets + 1);
   std::size_t running = 0;
   for (std::size_t d = 0; d < buckets; ++d) {
@@ -444,7 +440,7 @@ void msd_sort32(Executor& ex, std::string_view name, std::span<std::uint32_t> ke
   bucket_begin[buckets] = std::uint32_t(running);
   E* const packed = s.packed.reserve<E>(n);
   ex.parallel_for(launch_name(name, "top_scatter"), n, chunk, [&](std::size_t b, std::size_t e) {
-    top_scatter_chunk<E>(keys.data(), payload.data(), b, e, shift, mask,
+    top_scatter_chunk<W, E>(keys.data(), payload.data(), b, e, shift, mask,
                          s.counts.data() + (b / chunk) * buckets, buckets, packed);
   });
   // Fixed groups of buckets per task (uniform keys: ~8 buckets of n / 2048 elements each).
@@ -456,15 +452,15 @@ void msd_sort32(Executor& ex, std::string_view name, std::span<std::uint32_t> ke
                   [&](std::size_t b0, std::size_t b1) {
                     for (std::size_t d = b0; d < b1; ++d) {
                       const std::size_t first = bucket_begin[d];
-                      sort_bucket<E>(packed + first, bucket_begin[d + 1] - first, lo_bit, local_bits,
+                      sort_bucket<W, E>(packed + first, bucket_begin[d + 1] - first, lo_bit, local_bits,
                                      keys.data() + first,
                                      payload.empty() ? nullptr : payload.data() + first, streaming);
                     }
-                    if (streaming) store_fence();
+                    if (streaming) stream_fence();
                   });
 }
 
-template <class Key>
+template <int W, class Key>
 void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
                      std::span<std::uint32_t> payload, RadixSortScratch<Key>* scratch, std::size_t chunk) {
   const std::size_t n = keys.size();
@@ -492,10 +488,10 @@ void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
           const std::uint32_t m = std::uint32_t(buckets - 1);
           std::fill(count, count + buckets, 0u);
           Key v = 0;
-          for (std::size_t i = b; i < e; ++i) {
-            v |= in[i] ^ first;
-            ++count[(in[i] >> sh) & m];
-          }
+          for_each_digit<W>(in, b, e, sh, m, [&](std::size_t, std::uint32_t k, std::size_t d) {
+            v |= k ^ first;
+            ++count[d];
+          });
           return v;
         },
         [](Key a, Key b) { return Key(a | b); });
@@ -505,31 +501,54 @@ void radix_sort_impl(Executor& ex, std::string_view name, std::span<Key> keys,
     const TopDigit top = top_digit(n, lo_bit, bits);
     const bool counted = top.shift == guess.shift && top.bits == guess.bits;
     if (with_payload)
-      msd_sort32<std::uint64_t>(ex, name, keys, payload, s, chunk, lo_bit, bits, counted);
+      msd_sort32<W, std::uint64_t>(ex, name, keys, payload, s, chunk, lo_bit, bits, counted);
     else
-      msd_sort32<std::uint32_t>(ex, name, keys, payload, s, chunk, lo_bit, bits, counted);
+      msd_sort32<W, std::uint32_t>(ex, name, keys, payload, s, chunk, lo_bit, bits, counted);
   } else {
     // Only the bits that differ between keys need sorting: [lowest, highest] varying bit.
-    const Key varying = varying_bits<Key>(ex, name, keys, chunk);
+    const Key varying = varying_bits<W, Key>(ex, name, keys, chunk);
     if (varying == 0) return;  // all keys equal: a stable sort leaves everything in place
     const unsigned lo_bit = unsigned(std::countr_zero(varying));
     const unsigned bits = unsigned(std::bit_width(varying)) - lo_bit;
-    lsd_sort(ex, name, keys, payload, s, chunk, lo_bit, bits);
+    lsd_sort<W>(ex, name, keys, payload, s, chunk, lo_bit, bits);
   }
 }
 
 }  // namespace
 
+template <int W>
+void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
+                std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch, std::size_t chunk) {
+  radix_sort_impl<W>(ex, name, keys, payload, scratch, chunk);
+}
+
+template <int W>
+void radix_sort(Executor& ex, std::string_view name, std::span<std::uint64_t> keys,
+                std::span<std::uint32_t> payload, RadixSortScratch<std::uint64_t>* scratch, std::size_t chunk) {
+  radix_sort_impl<W>(ex, name, keys, payload, scratch, chunk);
+}
+
+#define SPECULUM_RADIX_SORT_AT(W)                                                                       \
+  template void radix_sort<W>(Executor&, std::string_view, std::span<std::uint32_t>,                    \
+                              std::span<std::uint32_t>, RadixSortScratch<std::uint32_t>*, std::size_t); \
+  template void radix_sort<W>(Executor&, std::string_view, std::span<std::uint64_t>,                    \
+                              std::span<std::uint32_t>, RadixSortScratch<std::uint64_t>*, std::size_t);
+SPECULUM_RADIX_SORT_AT(1)
+SPECULUM_RADIX_SORT_AT(4)
+SPECULUM_RADIX_SORT_AT(8)
+SPECULUM_RADIX_SORT_AT(16)
+#undef SPECULUM_RADIX_SORT_AT
+
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch,
                 std::size_t chunk) {
-  radix_sort_impl(ex, name, keys, payload, scratch, chunk);
+  dispatch_lanes(default_lanes(), [&](auto w) { radix_sort<w.value>(ex, name, keys, payload, scratch, chunk); });
 }
 
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint64_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint64_t>* scratch,
                 std::size_t chunk) {
-  radix_sort_impl(ex, name, keys, payload, scratch, chunk);
+  dispatch_lanes(default_lanes(), [&](auto w) { radix_sort<w.value>(ex, name, keys, payload, scratch, chunk); });
 }
 
 }  // namespace speculum::par

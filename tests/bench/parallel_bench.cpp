@@ -185,22 +185,25 @@ void BM_Partition(benchmark::State& state) {
   report(state, n * 8, threads);
 }
 
+// Args: n, threads, lane width W.
 void BM_RadixSort32(benchmark::State& state) {
   const std::size_t n = state.range(0);
   const int threads = int(state.range(1));
   std::vector<std::uint32_t> original(n), keys(n), payload(n);
   for (std::size_t i = 0; i < n; ++i) original[i] = hash32(i);
   RadixSortScratch<std::uint32_t> scratch;
-  keys = original;  // warm-up: first touch of the scratch buffers (page faults) outside timing
-  radix_sort(executor(threads), "radix", std::span(keys), std::span(payload), &scratch);
-  for (auto _ : state) {
-    state.PauseTiming();
-    std::copy(original.begin(), original.end(), keys.begin());
-    std::iota(payload.begin(), payload.end(), 0u);
-    state.ResumeTiming();
-    radix_sort(executor(threads), "radix", std::span(keys), std::span(payload), &scratch);
-    benchmark::DoNotOptimize(keys.data());
-  }
+  dispatch_lanes(state.range(2), [&](auto w) {
+    keys = original;  // warm-up: first touch of the scratch buffers (page faults) outside timing
+    radix_sort<w.value>(executor(threads), "radix", std::span(keys), std::span(payload), &scratch);
+    for (auto _ : state) {
+      state.PauseTiming();
+      std::copy(original.begin(), original.end(), keys.begin());
+      std::iota(payload.begin(), payload.end(), 0u);
+      state.ResumeTiming();
+      radix_sort<w.value>(executor(threads), "radix", std::span(keys), std::span(payload), &scratch);
+      benchmark::DoNotOptimize(keys.data());
+    }
+  });
   report(state, n * 16, threads, n);  // keys + payload read and written once (minimum)
 }
 
@@ -231,7 +234,7 @@ void sizes_threads(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_Memcpy)->Apply(sizes_threads);
 BENCHMARK(BM_StreamCopy)->Apply(sizes_threads);
-// The scans at W = 8, plus W = 1 (the scalar reference), 4 and 16 at 16M on one thread.
+// W = 8, plus W = 1 (the scalar reference), 4 and 16 at 16M on one thread.
 void scan_args(benchmark::internal::Benchmark* b) {
   for (long n : {1L << 20, 16L << 20})
     for (long t : {1, 2}) b->Args({n, t, 8});
@@ -250,7 +253,7 @@ BENCHMARK(BM_CompactHierarchical)->Apply([](benchmark::internal::Benchmark* b) {
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 });
 BENCHMARK(BM_Partition)->Apply(sizes_threads);
-BENCHMARK(BM_RadixSort32)->Apply(sizes_threads);
+BENCHMARK(BM_RadixSort32)->Apply(scan_args);
 BENCHMARK(BM_RadixSort32Keys)->Apply(sizes_threads);
 
 }  // namespace

@@ -34,6 +34,14 @@ void check_ops(std::mt19937& rng) {
     stream_fence();
     for (int i = 0; i < W; ++i) ASSERT_EQ(streamed[i], x[i]) << "W=" << W;
 
+    std::uint32_t pairs[2 * W];
+    for (auto& w : pairs) w = any(rng);
+    const auto [even, odd] = deinterleave<W>(pairs);
+    for (int i = 0; i < W; ++i) {
+      ASSERT_EQ(std::uint32_t(even[i]), pairs[2 * i]) << "W=" << W;
+      ASSERT_EQ(std::uint32_t(odd[i]), pairs[2 * i + 1]) << "W=" << W;
+    }
+
     std::uint8_t flags[W];
     unsigned expect = 0;
     for (int k = 0; k < W; ++k) {
