@@ -21,7 +21,12 @@ struct HierarchicalCompactStats {
 
 // out[0, count) = indices i with keep[i] != 0, ascending; returns count. out.size() >= the
 // number kept (n is always enough). Phases: per-chunk counts, serial chunk offsets, per-chunk
-// scatter.
+// scatter. The template runs the count and the left-pack scatter over Lanes<W> (W = 1, 4, 8,
+// 16 are instantiated; every W gives the same output); the plain function uses
+// default_lanes() (`--lanes W`).
+template <int W>
+std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const std::uint8_t> keep,
+                            std::span<std::uint32_t> out, std::size_t chunk = kStreamChunk);
 std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const std::uint8_t> keep,
                             std::span<std::uint32_t> out, std::size_t chunk = kStreamChunk);
 
@@ -30,7 +35,14 @@ std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const
 // kept j with j - pSum[j] = i (the Fig.4.7 invariant) by a branch-free bisection; the block counts
 // are scanned into block displacements and every output slot gathers from its block
 // (concatenation, Fig.4.8). `scratch` holds the block-local results (resized to n rounded
-// up to s); pass one in to avoid reallocating it each call.
+// up to s); pass one in to avoid reallocating it each call. The template computes pSum with
+// in-register prefix sums over W flags and searches W output slots at once (same output and
+// search_steps for every W); the plain function uses default_lanes().
+template <int W>
+std::size_t compact_hierarchical(Executor& ex, std::string_view name,
+                                 std::span<const std::uint8_t> keep, std::span<std::uint32_t> out,
+                                 std::size_t block_size, std::vector<std::uint32_t>* scratch = nullptr,
+                                 HierarchicalCompactStats* stats = nullptr);
 std::size_t compact_hierarchical(Executor& ex, std::string_view name,
                                  std::span<const std::uint8_t> keep, std::span<std::uint32_t> out,
                                  std::size_t block_size, std::vector<std::uint32_t>* scratch = nullptr,
@@ -40,6 +52,9 @@ std::size_t compact_hierarchical(Executor& ex, std::string_view name,
 // writes the kept positions (block-local) to out[0, count) by the Fig.4.7 search (as a
 // branch-free bisection on j - pSum[j]) and returns count; `psum` receives the inclusive
 // empty counts. `steps` accumulates psum probes.
+template <int W>
+std::size_t compact_block_gather(std::span<const std::uint8_t> block, std::span<std::uint32_t> psum,
+                                 std::span<std::uint32_t> out, std::uint64_t& steps);
 std::size_t compact_block_gather(std::span<const std::uint8_t> block, std::span<std::uint32_t> psum,
                                  std::span<std::uint32_t> out, std::uint64_t& steps);
 

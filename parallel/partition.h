@@ -20,7 +20,14 @@ inline constexpr std::size_t kScatterChunk = 1 << 16;
 
 // out[0, n) = the element indices grouped by bucket[i] (0 <= bucket[i] < p), each bucket in
 // ascending index order; bucket_begin[0, p] receives the bucket boundaries (size p + 1).
-// A bucket id >= p throws std::invalid_argument.
+// A bucket id >= p throws std::invalid_argument. The template range-checks and counts over
+// Lanes<W> (count_ids_per_chunk<W>) and scatters W-groups lane by lane in element order (the
+// scatter is per element); every W gives the same output. The plain function uses
+// default_lanes().
+template <int W>
+void partition_stable(Executor& ex, std::string_view name, std::span<const std::uint32_t> bucket,
+                      std::uint32_t p, std::span<std::uint32_t> out,
+                      std::span<std::uint32_t> bucket_begin, std::size_t chunk = kScatterChunk);
 void partition_stable(Executor& ex, std::string_view name, std::span<const std::uint32_t> bucket,
                       std::uint32_t p, std::span<std::uint32_t> out,
                       std::span<std::uint32_t> bucket_begin, std::size_t chunk = kScatterChunk);

@@ -1,5 +1,6 @@
 // Both compactions against a sequential filter: every size class, every ratio 0..100 %,
-// block sizes s, 1/2/8 threads, lane widths; and the ROGER Fig.4.8 golden vector (s=16).
+// block sizes s, 1/2/8 threads, kernel lane widths W = 1, 4, 8, 16; and the ROGER Fig.4.8
+// golden vector (s=16).
 #include "parallel/compact.h"
 
 #include <gtest/gtest.h>
@@ -135,6 +136,88 @@ TEST(Compact, LaneWidthsAndThreadsGiveIdenticalResults) {
     for (int w : {1, 4, 8, 16})
       EXPECT_EQ(dispatch_lanes(w, [&](auto lw) { return cull_kernel<lw.value>(executor(t), d); }), ref)
           << "W=" << w << " t=" << t;
+}
+
+// Every kernel width W = 1, 4, 8, 16 (instantiated here, not taken from --lanes) at 1, 2 and 8
+// threads gives the serial filter's indices: every size class and ratio, both forms, and the
+// same search_steps for every W (probes per output slot do not depend on W).
+constexpr int kKernelWidths[] = {1, 4, 8, 16};
+
+TEST(Compact, EveryKernelWidthAndThreadCountEqualsSerial) {
+  for (std::size_t n : sizes()) {
+    for (int percent : {0, 3, 50, 97, 100}) {
+      const auto keep = flags(n, percent, n + 7);
+      const auto ref = serial_filter(keep);
+      for (std::size_t s : {1u, 16u, 64u}) {
+        std::uint64_t ref_steps = 0;
+        for (int w : kKernelWidths)
+          for (int t : kThreadCounts) {
+            std::vector<std::uint32_t> out(n, 0xdeadbeefu);
+            HierarchicalCompactStats stats;
+            const auto kept = dispatch_lanes(w, [&](auto lw) {
+              return compact_hierarchical<lw.value>(executor(t), "compact_hw", keep, out, s, nullptr, &stats);
+            });
+            out.resize(kept);
+            ASSERT_EQ(out, ref) << n << " " << percent << "% s=" << s << " W=" << w << " t=" << t;
+            if (w == 1 && t == 1) ref_steps = stats.search_steps;
+            ASSERT_EQ(stats.search_steps, ref_steps) << n << " " << percent << "% s=" << s << " W=" << w << " t=" << t;
+          }
+      }
+      for (int w : kKernelWidths)
+        for (int t : kThreadCounts) {
+          std::vector<std::uint32_t> out(n, 0xdeadbeefu);
+          out.resize(dispatch_lanes(w, [&](auto lw) { return compact_scatter<lw.value>(executor(t), "compact_w", keep, out); }));
+          ASSERT_EQ(out, ref) << n << " " << percent << "% W=" << w << " t=" << t;
+          // Small chunks: many chunks whose output ranges are shorter than a 32-flag step.
+          out.assign(n, 0xdeadbeefu);
+          out.resize(dispatch_lanes(w, [&](auto lw) { return compact_scatter<lw.value>(executor(t), "compact_w", keep, out, 37); }));
+          ASSERT_EQ(out, ref) << n << " " << percent << "% W=" << w << " t=" << t << " chunk=37";
+        }
+    }
+  }
+}
+
+TEST(Compact, EveryRatioAtEveryKernelWidth) {
+  const std::size_t n = 4099;
+  for (int percent = 0; percent <= 100; ++percent) {
+    const auto keep = flags(n, percent, 1000 + percent);
+    const auto ref = serial_filter(keep);
+    for (int w : kKernelWidths)
+      for (int t : kThreadCounts) {
+        std::vector<std::uint32_t> out(n);
+        out.resize(dispatch_lanes(w, [&](auto lw) { return compact_scatter<lw.value>(executor(t), "ratio_w", keep, out); }));
+        ASSERT_EQ(out, ref) << percent << "% W=" << w << " t=" << t;
+        for (std::size_t s = 8; s <= 1024; s *= 8) {
+          out.assign(n, 0);
+          out.resize(dispatch_lanes(w, [&](auto lw) {
+            return compact_hierarchical<lw.value>(executor(t), "ratio_hw", keep, out, s);
+          }));
+          ASSERT_EQ(out, ref) << percent << "% s=" << s << " W=" << w << " t=" << t;
+        }
+      }
+  }
+}
+
+// The within-block step of ROGER Fig.4.8 at every W: the same prefix sums and reduced block.
+TEST(Compact, RogerFig48BlockStepAtEveryKernelWidth) {
+  const std::string blocks = "43X192XX7X6X58X5" "431X2X6XX7X98XX5" "X87XX235XXX6XX1X" "1XXX45X7X6X8329X";
+  std::vector<std::uint8_t> keep;
+  for (char c : blocks) keep.push_back(c != 'X');
+  const char* psums[] = {"0011112334455566", "0001122344555677", "1112333345667889", "0123334455666667"};
+  const char* reduced[] = {"4319276585", "431267985", "8723561", "145768329"};
+  for (int w : kKernelWidths)
+    for (int b = 0; b < 4; ++b) {
+      std::vector<std::uint32_t> psum(16), out(16);
+      std::uint64_t steps = 0;
+      const auto c = dispatch_lanes(w, [&](auto lw) {
+        return compact_block_gather<lw.value>(std::span(keep).subspan(b * 16, 16), psum, out, steps);
+      });
+      std::string p, r;
+      for (auto v : psum) p += char('0' + v);
+      for (std::size_t k = 0; k < c; ++k) r += blocks[b * 16 + out[k]];
+      EXPECT_EQ(p, psums[b]) << "W=" << w;
+      EXPECT_EQ(r, reduced[b]) << "W=" << w;
+    }
 }
 
 TEST(Compact, RejectsBadArguments) {

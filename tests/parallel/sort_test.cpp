@@ -1,5 +1,6 @@
 // Stable partition, radix sort (32/64-bit keys with payload), segmented min/argmin and
-// histogram against serial references for every size class and 1/2/8 threads.
+// histogram against serial references for every size class and 1/2/8 threads; the
+// W-templated ones (partition, segmented min, histogram) at every kernel width W = 1, 4, 8, 16.
 #include "parallel/partition.h"
 #include "parallel/segmented.h"
 
@@ -16,6 +17,14 @@ namespace speculum::par {
 namespace {
 using namespace test;
 
+// The kernel widths every W-templated primitive is instantiated at here (W = 1 is the scalar
+// reference); each must give the serial reference's bits at 1, 2 and 8 threads.
+constexpr int kKernelWidths[] = {1, 4, 8, 16};
+template <class F>
+void for_each_width(F&& f) {
+  for (int w : kKernelWidths) dispatch_lanes(w, f);
+}
+
 TEST(Partition, StableBucketsEqualSerial) {
   for (std::size_t n : sizes())
     for (std::uint32_t p : {1u, 2u, 7u, 300u}) {
@@ -28,15 +37,26 @@ TEST(Partition, StableBucketsEqualSerial) {
           if (bucket[i] == d) ref.push_back(std::uint32_t(i));
       }
       ref_begin.push_back(std::uint32_t(n));
-      for (int t : kThreadCounts) {
-        std::vector<std::uint32_t> out(n), begin(p + 1);
-        partition_stable(executor(t), "partition", bucket, p, out, begin);
-        ASSERT_EQ(out, ref) << n << " p=" << p << " t=" << t;
-        ASSERT_EQ(begin, ref_begin);
-      }
+      for_each_width([&](auto w) {
+        for (int t : kThreadCounts) {
+          std::vector<std::uint32_t> out(n), begin(p + 1);
+          partition_stable<w.value>(executor(t), "partition", bucket, p, out, begin);
+          ASSERT_EQ(out, ref) << n << " p=" << p << " W=" << w.value << " t=" << t;
+          ASSERT_EQ(begin, ref_begin);
+        }
+      });
     }
   std::vector<std::uint32_t> bad = {0, 5}, out(2), begin(5);
   EXPECT_THROW(partition_stable(executor(2), "p", bad, 4, out, begin), std::invalid_argument);
+  // An out-of-range id in any lane of a group (or in the tail) is caught at every W.
+  for (std::size_t at : {0u, 3u, 8u, 16u, 18u}) {
+    std::vector<std::uint32_t> ids(19, 1), o(19), bb(5);
+    ids[at] = 4;
+    for_each_width([&](auto w) {
+      EXPECT_THROW(partition_stable<w.value>(executor(2), "p", ids, 4, o, bb), std::invalid_argument)
+          << "W=" << w.value << " at " << at;
+    });
+  }
 }
 
 template <class Key>
@@ -181,21 +201,40 @@ TEST(SegmentedMin, ClosestHitPerRayEqualsSerial) {
     auto sorted_seg = seg;
     std::sort(sorted_seg.begin(), sorted_seg.end());
     serial_segmented_min(sorted_seg, t, segments, ref_sv, ref_si);
-    for (int th : kThreadCounts) {
-      std::vector<float> v(segments);
-      std::vector<std::uint32_t> ix(segments);
-      segmented_min(executor(th), "closest_hit", seg, t, segments, v, ix);
-      ASSERT_EQ(v, ref_v);
-      ASSERT_EQ(ix, ref_i) << n << " t=" << th;
-      segmented_min_sorted(executor(th), "closest_hit_sorted", sorted_seg, t, segments, v, ix);
-      ASSERT_EQ(v, ref_sv);
-      ASSERT_EQ(ix, ref_si);
-    }
+    for_each_width([&](auto w) {
+      for (int th : kThreadCounts) {
+        std::vector<float> v(segments);
+        std::vector<std::uint32_t> ix(segments);
+        segmented_min<w.value>(executor(th), "closest_hit", seg, t, segments, v, ix);
+        ASSERT_EQ(v, ref_v);
+        ASSERT_EQ(ix, ref_i) << n << " W=" << w.value << " t=" << th;
+        segmented_min_sorted<w.value>(executor(th), "closest_hit_sorted", sorted_seg, t, segments, v, ix);
+        ASSERT_EQ(v, ref_sv);
+        ASSERT_EQ(ix, ref_si) << n << " W=" << w.value << " t=" << th;
+      }
+    });
   }
   std::vector<std::uint32_t> unsorted = {1, 0};
   std::vector<float> v(2), t = {1, 2};
   std::vector<std::uint32_t> ix(2);
   EXPECT_THROW(segmented_min_sorted(executor(1), "bad", unsorted, t, 2, v, ix), std::invalid_argument);
+  // A descent or an out-of-range id in any lane of a W-group (or the tail) is caught at every W.
+  for (std::size_t at : {1u, 5u, 8u, 15u, 17u}) {
+    std::vector<std::uint32_t> ids(19);
+    for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = std::uint32_t(i / 2);
+    std::vector<float> vals(19, 1.f), mv(10);
+    std::vector<std::uint32_t> mi(10);
+    for_each_width([&](auto w) {
+      auto down = ids;
+      down[at] = down[at - 1] - 1;
+      EXPECT_THROW(segmented_min_sorted<w.value>(executor(2), "down", down, vals, 10, mv, mi), std::invalid_argument)
+          << "W=" << w.value << " at " << at;
+      auto high = ids;
+      for (std::size_t i = at; i < high.size(); ++i) high[i] = 10;
+      EXPECT_THROW(segmented_min_sorted<w.value>(executor(2), "high", high, vals, 10, mv, mi), std::invalid_argument)
+          << "W=" << w.value << " at " << at;
+    });
+  }
 }
 
 // The documented edge semantics (segmented.h): an empty segment (leading, middle, trailing,
@@ -221,36 +260,38 @@ TEST(SegmentedMin, NaNNeverWinsAndEmptySegmentsGetInfinityAndNoIndex) {
     for (float x : v) b.push_back(std::bit_cast<std::uint32_t>(x));
     return b;
   };
-  for (int t : kThreadCounts) {
-    std::vector<float> v(segments, 42.f);
-    std::vector<std::uint32_t> ix(segments, 42);
-    segmented_min_sorted(executor(t), "edges_sorted", seg, val, segments, v, ix);
-    EXPECT_EQ(bits(v), bits(want_v)) << "t=" << t;
-    EXPECT_EQ(ix, want_i) << "t=" << t;
-    v.assign(segments, 42.f);
-    ix.assign(segments, 42);
-    segmented_min(executor(t), "edges", seg, val, segments, v, ix);
-    EXPECT_EQ(bits(v), bits(want_v)) << "t=" << t;
-    EXPECT_EQ(ix, want_i) << "t=" << t;
-    v.assign(segments, 42.f);
-    ix.assign(segments, 42);
-    segmented_min(executor(t), "edges_reversed", rseg, rval, segments, v, ix);
-    EXPECT_EQ(bits(v), bits(want_rv)) << "t=" << t;
-    EXPECT_EQ(ix, want_ri) << "t=" << t;
-    EXPECT_THROW(segmented_min_sorted(executor(t), "reversed", rseg, rval, segments, v, ix), std::invalid_argument);
-    // No elements at all: every segment is empty.
-    v.assign(3, 42.f);
-    ix.assign(3, 42);
-    segmented_min_sorted(executor(t), "none_sorted", {}, {}, 3, v, ix);
-    EXPECT_EQ(v, std::vector<float>(3, inf));
-    EXPECT_EQ(ix, std::vector<std::uint32_t>(3, kNoIndex));
-    v.assign(3, 42.f);
-    ix.assign(3, 42);
-    segmented_min(executor(t), "none", {}, {}, 3, v, ix);
-    EXPECT_EQ(v, std::vector<float>(3, inf));
-    EXPECT_EQ(ix, std::vector<std::uint32_t>(3, kNoIndex));
-    segmented_min(executor(t), "zero_segments", {}, {}, 0, std::span<float>(), std::span<std::uint32_t>());
-  }
+  for_each_width([&](auto w) {
+    for (int t : kThreadCounts) {
+      std::vector<float> v(segments, 42.f);
+      std::vector<std::uint32_t> ix(segments, 42);
+      segmented_min_sorted<w.value>(executor(t), "edges_sorted", seg, val, segments, v, ix);
+      EXPECT_EQ(bits(v), bits(want_v)) << "W=" << w.value << " t=" << t;
+      EXPECT_EQ(ix, want_i) << "W=" << w.value << " t=" << t;
+      v.assign(segments, 42.f);
+      ix.assign(segments, 42);
+      segmented_min<w.value>(executor(t), "edges", seg, val, segments, v, ix);
+      EXPECT_EQ(bits(v), bits(want_v)) << "W=" << w.value << " t=" << t;
+      EXPECT_EQ(ix, want_i) << "W=" << w.value << " t=" << t;
+      v.assign(segments, 42.f);
+      ix.assign(segments, 42);
+      segmented_min<w.value>(executor(t), "edges_reversed", rseg, rval, segments, v, ix);
+      EXPECT_EQ(bits(v), bits(want_rv)) << "W=" << w.value << " t=" << t;
+      EXPECT_EQ(ix, want_ri) << "W=" << w.value << " t=" << t;
+      EXPECT_THROW(segmented_min_sorted<w.value>(executor(t), "reversed", rseg, rval, segments, v, ix), std::invalid_argument);
+      // No elements at all: every segment is empty.
+      v.assign(3, 42.f);
+      ix.assign(3, 42);
+      segmented_min_sorted<w.value>(executor(t), "none_sorted", {}, {}, 3, v, ix);
+      EXPECT_EQ(v, std::vector<float>(3, inf));
+      EXPECT_EQ(ix, std::vector<std::uint32_t>(3, kNoIndex));
+      v.assign(3, 42.f);
+      ix.assign(3, 42);
+      segmented_min<w.value>(executor(t), "none", {}, {}, 3, v, ix);
+      EXPECT_EQ(v, std::vector<float>(3, inf));
+      EXPECT_EQ(ix, std::vector<std::uint32_t>(3, kNoIndex));
+      segmented_min<w.value>(executor(t), "zero_segments", {}, {}, 0, std::span<float>(), std::span<std::uint32_t>());
+    }
+  });
   // Out-of-range ids are rejected by both forms.
   const std::vector<std::uint32_t> high = {0, 1, 3};
   const std::vector<std::uint32_t> high_unsorted = {3, 0, 1};
@@ -280,16 +321,18 @@ TEST(SegmentedMin, SparseSegmentsAcrossChunksEqualSerial) {
   auto sorted_seg = seg;
   std::sort(sorted_seg.begin(), sorted_seg.end());
   serial_segmented_min(sorted_seg, val, segments, ref_sv, ref_si);
-  for (int t : kThreadCounts) {
-    std::vector<float> v(segments);
-    std::vector<std::uint32_t> ix(segments);
-    segmented_min(executor(t), "sparse", seg, val, segments, v, ix);
-    ASSERT_EQ(v, ref_v) << "t=" << t;
-    ASSERT_EQ(ix, ref_i) << "t=" << t;
-    segmented_min_sorted(executor(t), "sparse_sorted", sorted_seg, val, segments, v, ix);
-    ASSERT_EQ(v, ref_sv) << "t=" << t;
-    ASSERT_EQ(ix, ref_si) << "t=" << t;
-  }
+  for_each_width([&](auto w) {
+    for (int t : kThreadCounts) {
+      std::vector<float> v(segments);
+      std::vector<std::uint32_t> ix(segments);
+      segmented_min<w.value>(executor(t), "sparse", seg, val, segments, v, ix);
+      ASSERT_EQ(v, ref_v) << "W=" << w.value << " t=" << t;
+      ASSERT_EQ(ix, ref_i) << "W=" << w.value << " t=" << t;
+      segmented_min_sorted<w.value>(executor(t), "sparse_sorted", sorted_seg, val, segments, v, ix);
+      ASSERT_EQ(v, ref_sv) << "W=" << w.value << " t=" << t;
+      ASSERT_EQ(ix, ref_si) << "W=" << w.value << " t=" << t;
+    }
+  });
 }
 
 TEST(Histogram, CountsEqualSerial) {
@@ -299,15 +342,27 @@ TEST(Histogram, CountsEqualSerial) {
       for (std::size_t i = 0; i < n; ++i) bin[i] = hash32(i) % bins;
       std::vector<std::uint64_t> ref(bins, 0);
       for (auto b : bin) ++ref[b];
-      for (int t : kThreadCounts) {
-        std::vector<std::uint64_t> count(bins);
-        histogram(executor(t), "hist", bin, count);
-        ASSERT_EQ(count, ref);
-      }
+      for_each_width([&](auto w) {
+        for (int t : kThreadCounts) {
+          std::vector<std::uint64_t> count(bins);
+          histogram<w.value>(executor(t), "hist", bin, count);
+          ASSERT_EQ(count, ref) << n << " bins=" << bins << " W=" << w.value << " t=" << t;
+        }
+      });
     }
   std::vector<std::uint32_t> bad = {3};
   std::vector<std::uint64_t> count(3);
   EXPECT_THROW(histogram(executor(1), "h", bad, count), std::invalid_argument);
+  for (std::size_t at : {0u, 5u, 8u, 16u, 18u}) {
+    std::vector<std::uint32_t> ids(19, 2);
+    ids[at] = 0xffffffffu;  // the largest id: out of range for any count table
+    std::vector<std::uint64_t> c(3);
+    for_each_width([&](auto w) {
+      EXPECT_THROW(histogram<w.value>(executor(2), "h", ids, c), std::invalid_argument) << "W=" << w.value << " at " << at;
+    });
+  }
+  std::vector<std::uint64_t> none;
+  EXPECT_THROW(histogram(executor(1), "h", bad, none), std::invalid_argument);  // ids but no bins
 }
 
 }  // namespace
