@@ -150,38 +150,52 @@ std::vector<std::uint8_t> half_flags(std::size_t n) {
   return f;
 }
 
+// Args: n, threads, lane width W (compact_scatter<W>; 8 = the native width of this build,
+// 1 = the scalar reference).
 void BM_CompactScatter(benchmark::State& state) {
   const std::size_t n = state.range(0);
   const int threads = int(state.range(1));
   const auto keep = half_flags(n);
   std::vector<std::uint32_t> out(n);
-  std::size_t kept = compact_scatter(executor(threads), "compact", keep, out);  // warm-up
-  for (auto _ : state) benchmark::DoNotOptimize(kept = compact_scatter(executor(threads), "compact", keep, out));
+  std::size_t kept = 0;
+  dispatch_lanes(int(state.range(2)), [&](auto w) {
+    kept = compact_scatter<w.value>(executor(threads), "compact", keep, out);  // warm-up
+    for (auto _ : state)
+      benchmark::DoNotOptimize(kept = compact_scatter<w.value>(executor(threads), "compact", keep, out));
+  });
   report(state, n + kept * 4, threads);
 }
 
+// Args: n, threads, block size s, lane width W.
 void BM_CompactHierarchical(benchmark::State& state) {
   const std::size_t n = state.range(0);
   const int threads = int(state.range(1));
   const std::size_t s = state.range(2);
   const auto keep = half_flags(n);
   std::vector<std::uint32_t> out(n), scratch;
-  std::size_t kept = compact_hierarchical(executor(threads), "compact_h", keep, out, s, &scratch);  // warm-up: first touch of out and scratch
-  for (auto _ : state)
-    benchmark::DoNotOptimize(kept = compact_hierarchical(executor(threads), "compact_h", keep, out, s, &scratch));
+  std::size_t kept = 0;
+  dispatch_lanes(int(state.range(3)), [&](auto w) {
+    // Warm-up: first touch of out and scratch.
+    kept = compact_hierarchical<w.value>(executor(threads), "compact_h", keep, out, s, &scratch);
+    for (auto _ : state)
+      benchmark::DoNotOptimize(kept = compact_hierarchical<w.value>(executor(threads), "compact_h", keep, out, s, &scratch));
+  });
   report(state, n + kept * 4, threads);
 }
 
+// Args: n, threads, lane width W.
 void BM_Partition(benchmark::State& state) {
   const std::size_t n = state.range(0);
   const int threads = int(state.range(1));
   const std::uint32_t p = 16;
   std::vector<std::uint32_t> bucket(n), out(n), begin(p + 1);
   for (std::size_t i = 0; i < n; ++i) bucket[i] = hash32(i) % p;
-  for (auto _ : state) {
-    partition_stable(executor(threads), "partition", bucket, p, out, begin);
-    benchmark::DoNotOptimize(out.data());
-  }
+  dispatch_lanes(int(state.range(2)), [&](auto w) {
+    for (auto _ : state) {
+      partition_stable<w.value>(executor(threads), "partition", bucket, p, out, begin);
+      benchmark::DoNotOptimize(out.data());
+    }
+  });
   report(state, n * 8, threads);
 }
 
@@ -244,15 +258,24 @@ void scan_args(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_ExclusiveScan)->Apply(scan_args);
 BENCHMARK(BM_InclusiveScan)->Apply(scan_args);
 BENCHMARK(BM_Reduce)->Apply(sizes_threads);
-BENCHMARK(BM_CompactScatter)->Apply(sizes_threads);
+// Compaction and partition at W = 8, plus W = 1 (the scalar reference), 4 and 16 at 16M on
+// one thread.
+void lanes_args(benchmark::internal::Benchmark* b) {
+  for (long n : {1L << 20, 16L << 20})
+    for (long t : {1, 2}) b->Args({n, t, 8});
+  for (long w : {1, 4, 16}) b->Args({16L << 20, 1, w});
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+BENCHMARK(BM_CompactScatter)->Apply(lanes_args);
 BENCHMARK(BM_CompactHierarchical)->Apply([](benchmark::internal::Benchmark* b) {
   for (long n : {1L << 20, 16L << 20})
-    for (long t : {1, 2}) b->Args({n, t, 64});
+    for (long t : {1, 2}) b->Args({n, t, 64, 8});
+  for (long w : {1, 4, 16}) b->Args({16L << 20, 1, 64, w});
   // ROGER ch.4 block-size sweep s = 8 ... 1024 at 16M, 2 threads.
-  for (long s = 8; s <= 1024; s *= 2) b->Args({16L << 20, 2, s});
+  for (long s = 8; s <= 1024; s *= 2) b->Args({16L << 20, 2, s, 8});
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 });
-BENCHMARK(BM_Partition)->Apply(sizes_threads);
+BENCHMARK(BM_Partition)->Apply(lanes_args);
 BENCHMARK(BM_RadixSort32)->Apply(scan_args);
 BENCHMARK(BM_RadixSort32Keys)->Apply(sizes_threads);
 
