@@ -195,10 +195,22 @@ template <int W>
         _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(lanes_detail::kLeftPack<8>.lanes[bits & 0xff])));
     return lanes_detail::from_native(_mm256_add_epi32(pos, _mm256_set1_epi32(int(first))));
   }
+  if constexpr (W == 16) {  // two 8-lane packs, the second stored right after the first's kept lanes
+    alignas(64) std::uint32_t packed[24];
+    left_pack<8>(bits & 0xff, first).copy_to(packed, stdx::element_aligned);
+    left_pack<8>(bits >> 8 & 0xff, first + 8).copy_to(packed + std::popcount(bits & 0xffu), stdx::element_aligned);
+    return LaneU32<W>(packed, stdx::element_aligned);
+  }
 #endif
+  if constexpr (W == 1) return LaneU32<W>(first);  // lane 0 matters only when bit 0 is set
   if constexpr (W == 4) {
     const std::uint64_t packed = lanes_detail::kLeftPack<4>.lanes[bits & 0xf];
+#if defined(__AVX2__)
+    const __m128i pos = _mm_cvtepu8_epi32(_mm_cvtsi32_si128(int(packed)));
+    return lanes_detail::from_native(_mm_add_epi32(pos, _mm_set1_epi32(int(first))));
+#else
     return LaneU32<W>([&](auto i) { return first + std::uint32_t(packed >> (8 * int(i)) & 0xff); });
+#endif
   }
   std::uint32_t pos[W] = {};
   int k = 0;

@@ -69,15 +69,24 @@ TEST(LanesStream, EveryOpAtEveryWidthMatchesItsScalarDefinition) {
   check_ops<16>(rng);
 }
 
-TEST(LanesStream, LeftPackCoversEveryMaskOfEightLanes) {
-  for (unsigned m = 0; m < 256; ++m) {
-    const auto packed = left_pack<8>(m, 100);
+template <int W>
+void check_every_left_pack_mask() {
+  for (unsigned m = 0; m < (1u << W); ++m) {
+    const auto packed = left_pack<W>(m, 100);
     int k = 0;
-    for (unsigned b = 0; b < 8; ++b)
+    for (unsigned b = 0; b < unsigned(W); ++b) {
       if (m >> b & 1) {
-        ASSERT_EQ(std::uint32_t(packed[k++]), 100 + b) << "mask " << m;
+        ASSERT_EQ(std::uint32_t(packed[k++]), 100 + b) << "W=" << W << " mask " << m;
       }
+    }
   }
+}
+
+TEST(LanesStream, LeftPackCoversEveryMask) {
+  check_every_left_pack_mask<1>();
+  check_every_left_pack_mask<4>();
+  check_every_left_pack_mask<8>();
+  check_every_left_pack_mask<16>();
 }
 
 }  // namespace
