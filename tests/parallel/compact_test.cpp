@@ -141,8 +141,6 @@ TEST(Compact, LaneWidthsAndThreadsGiveIdenticalResults) {
 // Every kernel width W = 1, 4, 8, 16 (instantiated here, not taken from --lanes) at 1, 2 and 8
 // threads gives the serial filter's indices: every size class and ratio, both forms, and the
 // same search_steps for every W (probes per output slot do not depend on W).
-constexpr int kKernelWidths[] = {1, 4, 8, 16};
-
 TEST(Compact, EveryKernelWidthAndThreadCountEqualsSerial) {
   for (std::size_t n : sizes()) {
     for (int percent : {0, 3, 50, 97, 100}) {
@@ -150,7 +148,7 @@ TEST(Compact, EveryKernelWidthAndThreadCountEqualsSerial) {
       const auto ref = serial_filter(keep);
       for (std::size_t s : {1u, 16u, 64u}) {
         std::uint64_t ref_steps = 0;
-        for (int w : kKernelWidths)
+        for (int w : kLaneWidths)
           for (int t : kThreadCounts) {
             std::vector<std::uint32_t> out(n, 0xdeadbeefu);
             HierarchicalCompactStats stats;
@@ -163,7 +161,7 @@ TEST(Compact, EveryKernelWidthAndThreadCountEqualsSerial) {
             ASSERT_EQ(stats.search_steps, ref_steps) << n << " " << percent << "% s=" << s << " W=" << w << " t=" << t;
           }
       }
-      for (int w : kKernelWidths)
+      for (int w : kLaneWidths)
         for (int t : kThreadCounts) {
           std::vector<std::uint32_t> out(n, 0xdeadbeefu);
           out.resize(dispatch_lanes(w, [&](auto lw) { return compact_scatter<lw.value>(executor(t), "compact_w", keep, out); }));
@@ -182,7 +180,7 @@ TEST(Compact, EveryRatioAtEveryKernelWidth) {
   for (int percent = 0; percent <= 100; ++percent) {
     const auto keep = flags(n, percent, 1000 + percent);
     const auto ref = serial_filter(keep);
-    for (int w : kKernelWidths)
+    for (int w : kLaneWidths)
       for (int t : kThreadCounts) {
         std::vector<std::uint32_t> out(n);
         out.resize(dispatch_lanes(w, [&](auto lw) { return compact_scatter<lw.value>(executor(t), "ratio_w", keep, out); }));
@@ -205,7 +203,7 @@ TEST(Compact, RogerFig48BlockStepAtEveryKernelWidth) {
   for (char c : blocks) keep.push_back(c != 'X');
   const char* psums[] = {"0011112334455566", "0001122344555677", "1112333345667889", "0123334455666667"};
   const char* reduced[] = {"4319276585", "431267985", "8723561", "145768329"};
-  for (int w : kKernelWidths)
+  for (int w : kLaneWidths)
     for (int b = 0; b < 4; ++b) {
       std::vector<std::uint32_t> psum(16), out(16);
       std::uint64_t steps = 0;

@@ -21,9 +21,10 @@ inline constexpr int kThreadCounts[] = {1, 2, 8};
 
 // f(std::integral_constant<int, W>) for every lane width W ∈ {1, 4, 8, 16}: the kernels are
 // instantiated at each width in the test binary.
+inline constexpr int kLaneWidths[] = {1, 4, 8, 16};
 template <class F>
 void for_each_lane_width(F&& f) {
-  for (int w : {1, 4, 8, 16}) dispatch_lanes(w, f);
+  for (int w : kLaneWidths) dispatch_lanes(w, f);
 }
 
 // 0, 1, odd, just over a stream chunk, just over a scatter chunk (16M cases are separate).

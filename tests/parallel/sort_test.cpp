@@ -17,14 +17,6 @@ namespace speculum::par {
 namespace {
 using namespace test;
 
-// The kernel widths every W-templated primitive is instantiated at here (W = 1 is the scalar
-// reference); each must give the serial reference's bits at 1, 2 and 8 threads.
-constexpr int kKernelWidths[] = {1, 4, 8, 16};
-template <class F>
-void for_each_width(F&& f) {
-  for (int w : kKernelWidths) dispatch_lanes(w, f);
-}
-
 TEST(Partition, StableBucketsEqualSerial) {
   for (std::size_t n : sizes())
     for (std::uint32_t p : {1u, 2u, 7u, 300u}) {
@@ -37,7 +29,7 @@ TEST(Partition, StableBucketsEqualSerial) {
           if (bucket[i] == d) ref.push_back(std::uint32_t(i));
       }
       ref_begin.push_back(std::uint32_t(n));
-      for_each_width([&](auto w) {
+      for_each_lane_width([&](auto w) {
         for (int t : kThreadCounts) {
           std::vector<std::uint32_t> out(n), begin(p + 1);
           partition_stable<w.value>(executor(t), "partition", bucket, p, out, begin);
@@ -52,7 +44,7 @@ TEST(Partition, StableBucketsEqualSerial) {
   for (std::size_t at : {0u, 3u, 8u, 16u, 18u}) {
     std::vector<std::uint32_t> ids(19, 1), o(19), bb(5);
     ids[at] = 4;
-    for_each_width([&](auto w) {
+    for_each_lane_width([&](auto w) {
       EXPECT_THROW(partition_stable<w.value>(executor(2), "p", ids, 4, o, bb), std::invalid_argument)
           << "W=" << w.value << " at " << at;
     });
@@ -201,7 +193,7 @@ TEST(SegmentedMin, ClosestHitPerRayEqualsSerial) {
     auto sorted_seg = seg;
     std::sort(sorted_seg.begin(), sorted_seg.end());
     serial_segmented_min(sorted_seg, t, segments, ref_sv, ref_si);
-    for_each_width([&](auto w) {
+    for_each_lane_width([&](auto w) {
       for (int th : kThreadCounts) {
         std::vector<float> v(segments);
         std::vector<std::uint32_t> ix(segments);
@@ -224,7 +216,7 @@ TEST(SegmentedMin, ClosestHitPerRayEqualsSerial) {
     for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = std::uint32_t(i / 2);
     std::vector<float> vals(19, 1.f), mv(10);
     std::vector<std::uint32_t> mi(10);
-    for_each_width([&](auto w) {
+    for_each_lane_width([&](auto w) {
       auto down = ids;
       down[at] = down[at - 1] - 1;
       EXPECT_THROW(segmented_min_sorted<w.value>(executor(2), "down", down, vals, 10, mv, mi), std::invalid_argument)
@@ -260,7 +252,7 @@ TEST(SegmentedMin, NaNNeverWinsAndEmptySegmentsGetInfinityAndNoIndex) {
     for (float x : v) b.push_back(std::bit_cast<std::uint32_t>(x));
     return b;
   };
-  for_each_width([&](auto w) {
+  for_each_lane_width([&](auto w) {
     for (int t : kThreadCounts) {
       std::vector<float> v(segments, 42.f);
       std::vector<std::uint32_t> ix(segments, 42);
@@ -321,7 +313,7 @@ TEST(SegmentedMin, SparseSegmentsAcrossChunksEqualSerial) {
   auto sorted_seg = seg;
   std::sort(sorted_seg.begin(), sorted_seg.end());
   serial_segmented_min(sorted_seg, val, segments, ref_sv, ref_si);
-  for_each_width([&](auto w) {
+  for_each_lane_width([&](auto w) {
     for (int t : kThreadCounts) {
       std::vector<float> v(segments);
       std::vector<std::uint32_t> ix(segments);
@@ -342,7 +334,7 @@ TEST(Histogram, CountsEqualSerial) {
       for (std::size_t i = 0; i < n; ++i) bin[i] = hash32(i) % bins;
       std::vector<std::uint64_t> ref(bins, 0);
       for (auto b : bin) ++ref[b];
-      for_each_width([&](auto w) {
+      for_each_lane_width([&](auto w) {
         for (int t : kThreadCounts) {
           std::vector<std::uint64_t> count(bins);
           histogram<w.value>(executor(t), "hist", bin, count);
@@ -357,7 +349,7 @@ TEST(Histogram, CountsEqualSerial) {
     std::vector<std::uint32_t> ids(19, 2);
     ids[at] = 0xffffffffu;  // the largest id: out of range for any count table
     std::vector<std::uint64_t> c(3);
-    for_each_width([&](auto w) {
+    for_each_lane_width([&](auto w) {
       EXPECT_THROW(histogram<w.value>(executor(2), "h", ids, c), std::invalid_argument) << "W=" << w.value << " at " << at;
     });
   }
