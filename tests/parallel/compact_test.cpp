@@ -89,23 +89,25 @@ TEST(Compact, EveryRatioFromZeroToHundredPercent) {
   }
 }
 
-// 16M flags at a middle ratio and at the ends, both forms, 1/2/8 threads (the serial filter
-// is the reference, so every thread count gives the same indices).
+// 16M flags at a middle ratio and at the ends, both forms, 1/2/8 threads × W = 1, 4, 8, 16
+// (the serial filter is the reference, so every thread count and width gives the same indices).
 TEST(Compact, SixteenMillion) {
   const std::size_t n = (std::size_t(16) << 20) + 5;
   for (int percent : {37, 0, 100}) {
     const auto keep = flags(n, percent, 5);
     const auto ref = serial_filter(keep);
     std::vector<std::uint32_t> out, scratch;
-    for (int t : kThreadCounts) {
-      out.assign(n, 0xdeadbeefu);
-      ASSERT_EQ(compact_scatter(executor(t), "s16M", keep, out), ref.size()) << percent << "% t=" << t;
-      ASSERT_TRUE(std::equal(ref.begin(), ref.end(), out.begin())) << percent << "% t=" << t;
-      out.assign(n, 0xdeadbeefu);
-      ASSERT_EQ(compact_hierarchical(executor(t), "h16M", keep, out, 64, &scratch), ref.size())
-          << percent << "% t=" << t;
-      ASSERT_TRUE(std::equal(ref.begin(), ref.end(), out.begin())) << percent << "% t=" << t;
-    }
+    for (int t : kThreadCounts)
+      for_each_lane_width([&](auto w) {
+        constexpr int W = w.value;
+        out.assign(n, 0xdeadbeefu);
+        ASSERT_EQ(compact_scatter<W>(executor(t), "s16M", keep, out), ref.size()) << percent << "% t=" << t << " W=" << W;
+        ASSERT_TRUE(std::equal(ref.begin(), ref.end(), out.begin())) << percent << "% t=" << t << " W=" << W;
+        out.assign(n, 0xdeadbeefu);
+        ASSERT_EQ(compact_hierarchical<W>(executor(t), "h16M", keep, out, 64, &scratch), ref.size())
+            << percent << "% t=" << t << " W=" << W;
+        ASSERT_TRUE(std::equal(ref.begin(), ref.end(), out.begin())) << percent << "% t=" << t << " W=" << W;
+      });
   }
 }
 

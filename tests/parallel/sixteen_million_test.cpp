@@ -1,7 +1,8 @@
 // The 16M-element size class (issue 3: "sizes 0, 1, odd, just-over-a-chunk and 16M") for
 // map, map_lanes, gather, reduce, float scan, stable partition, 64-bit radix sort with
 // payload, segmented min/argmin and histogram: each against a serial loop written here,
-// and identical (exact equality, floats bit for bit) for 1, 2 and 8 threads.
+// and identical (exact equality, floats bit for bit) for 1, 2 and 8 threads and, for the
+// width-generic primitives, for every lane width W = 1, 4, 8, 16.
 #include "parallel/partition.h"
 #include "parallel/scan.h"
 #include "parallel/segmented.h"
@@ -167,12 +168,13 @@ TEST(SixteenMillion, PartitionEqualsSerialCountingScatter) {
     std::vector<std::uint32_t> cursor(ref_begin.begin(), ref_begin.end() - 1);
     for (std::size_t i = 0; i < n; ++i) ref[cursor[bucket[i]]++] = std::uint32_t(i);
     std::vector<std::uint32_t> out(n), begin(p + 1);
-    for (int t : kThreadCounts) {
-      std::fill(out.begin(), out.end(), 0xdeadbeefu);
-      partition_stable(executor(t), "partition16M", bucket, p, out, begin);
-      ASSERT_TRUE(out == ref) << "p=" << p << " t=" << t;
-      ASSERT_TRUE(begin == ref_begin) << "p=" << p << " t=" << t;
-    }
+    for (int t : kThreadCounts)
+      for_each_lane_width([&](auto w) {
+        std::fill(out.begin(), out.end(), 0xdeadbeefu);
+        partition_stable<w.value>(executor(t), "partition16M", bucket, p, out, begin);
+        ASSERT_TRUE(out == ref) << "p=" << p << " t=" << t << " W=" << w.value;
+        ASSERT_TRUE(begin == ref_begin) << "p=" << p << " t=" << t << " W=" << w.value;
+      });
   }
 }
 
@@ -203,13 +205,14 @@ TEST(SixteenMillion, RadixSort64WithPayloadEqualsSerialStableSort) {
   std::vector<std::uint64_t> sorted(n);
   std::vector<std::uint32_t> payload(n);
   RadixSortScratch<std::uint64_t> scratch;
-  for (int t : kThreadCounts) {
-    sorted = keys;
-    std::iota(payload.begin(), payload.end(), 0u);
-    radix_sort(executor(t), "radix64_16M", std::span(sorted), std::span(payload), &scratch);
-    ASSERT_TRUE(payload == ref) << "t=" << t;
-    ASSERT_TRUE(sorted == ref_keys) << "t=" << t;
-  }
+  for (int t : kThreadCounts)
+    for_each_lane_width([&](auto w) {
+      sorted = keys;
+      std::iota(payload.begin(), payload.end(), 0u);
+      radix_sort<w.value>(executor(t), "radix64_16M", std::span(sorted), std::span(payload), &scratch);
+      ASSERT_TRUE(payload == ref) << "t=" << t << " W=" << w.value;
+      ASSERT_TRUE(sorted == ref_keys) << "t=" << t << " W=" << w.value;
+    });
 }
 
 // Closest hit per ray at 16M candidates over 4M rays (some rays with no candidate), values
@@ -250,14 +253,16 @@ TEST(SixteenMillion, SegmentedMinEqualsSerialLoop) {
   serial_segmented_min(sorted_seg, value, segments, ref_sv, ref_si);
   std::vector<float> v(segments);
   std::vector<std::uint32_t> ix(segments);
-  for (int t : kThreadCounts) {
-    segmented_min(executor(t), "closest16M", seg, value, segments, v, ix);
-    ASSERT_TRUE(same_bytes(v, ref_v)) << "t=" << t;
-    ASSERT_TRUE(ix == ref_i) << "t=" << t;
-    segmented_min_sorted(executor(t), "closest16M_sorted", sorted_seg, value, segments, v, ix);
-    ASSERT_TRUE(same_bytes(v, ref_sv)) << "t=" << t;
-    ASSERT_TRUE(ix == ref_si) << "t=" << t;
-  }
+  for (int t : kThreadCounts)
+    for_each_lane_width([&](auto w) {
+      constexpr int W = w.value;
+      segmented_min<W>(executor(t), "closest16M", seg, value, segments, v, ix);
+      ASSERT_TRUE(same_bytes(v, ref_v)) << "t=" << t << " W=" << W;
+      ASSERT_TRUE(ix == ref_i) << "t=" << t << " W=" << W;
+      segmented_min_sorted<W>(executor(t), "closest16M_sorted", sorted_seg, value, segments, v, ix);
+      ASSERT_TRUE(same_bytes(v, ref_sv)) << "t=" << t << " W=" << W;
+      ASSERT_TRUE(ix == ref_si) << "t=" << t << " W=" << W;
+    });
 }
 
 TEST(SixteenMillion, HistogramEqualsSerialCounts) {
@@ -271,11 +276,12 @@ TEST(SixteenMillion, HistogramEqualsSerialCounts) {
     }
     std::vector<std::uint64_t> ref(bins, 0);
     for (std::size_t i = 0; i < n; ++i) ++ref[bin[i]];
-    for (int t : kThreadCounts) {
-      std::vector<std::uint64_t> count(bins, 12345);
-      histogram(executor(t), "hist16M", bin, count);
-      ASSERT_TRUE(count == ref) << "bins=" << bins << " t=" << t;
-    }
+    for (int t : kThreadCounts)
+      for_each_lane_width([&](auto w) {
+        std::vector<std::uint64_t> count(bins, 12345);
+        histogram<w.value>(executor(t), "hist16M", bin, count);
+        ASSERT_TRUE(count == ref) << "bins=" << bins << " t=" << t << " W=" << w.value;
+      });
   }
 }
 
