@@ -25,13 +25,17 @@
 //   }
 //   dispatch_lanes(default_lanes(), [&](auto w) { scale<decltype(w)::value>(x, y, n, 2.f); });
 //
-// Which kernels take W (what `--lanes` changes): map_lanes (stream.h) and the tile
-// rasterizer's coverage and depth test (raster/tile_rasterizer.cpp). The bandwidth-bound
-// primitives (scan_kernels.h, compact.cpp, radix_sort.cpp), the G-buffer resolve and the
-// BVH traversal kernels are written with fixed 8-wide AVX2 intrinsics instead (measured
-// faster than fixed_size_simd, whose min/max were out-of-line calls); they do integer work or
-// the same IEEE operations per element as their scalar tests, so their bits do not depend on
-// W either — but they are not instantiated per W.
+// Which kernels take W (what `--lanes` changes): map_lanes (stream.h); the 32-bit sum scans
+// (scan_kernels.h); both compactions, stable partition, histogram, segmented min and the
+// radix sort (compact.cpp, partition.cpp, chunk_counts.cpp, segmented.cpp, radix_sort.cpp),
+// each `template <int W>` instantiated for 1, 4, 8 and 16 beside a plain overload that uses
+// default_lanes(); and the tile rasterizer's coverage and depth test. Their extra lane ops
+// (prefix sums, streaming stores, left-packing, ...) are in lanes_stream.h and lanes_pack.h,
+// with intrinsic paths where a width is one register. Scans and reductions with an
+// arbitrary operator fold element by element (their association must not depend on W).
+// Not width-generic: the G-buffer resolve and the BVH traversal kernels, written with fixed
+// 8-wide AVX2 for the 8-child BVH node layout; they do the same IEEE operations per element
+// as their scalar tests, so their bits do not depend on W either.
 #pragma once
 
 #include <experimental/simd>
