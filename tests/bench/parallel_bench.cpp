@@ -248,24 +248,17 @@ void sizes_threads(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_Memcpy)->Apply(sizes_threads);
 BENCHMARK(BM_StreamCopy)->Apply(sizes_threads);
-// W = 8, plus W = 1 (the scalar reference), 4 and 16 at 16M on one thread.
-void scan_args(benchmark::internal::Benchmark* b) {
-  for (long n : {1L << 20, 16L << 20})
-    for (long t : {1, 2}) b->Args({n, t, 8});
-  for (long w : {1, 4, 16}) b->Args({16L << 20, 1, w});
-  b->Unit(benchmark::kMillisecond)->UseRealTime();
-}
-BENCHMARK(BM_ExclusiveScan)->Apply(scan_args);
-BENCHMARK(BM_InclusiveScan)->Apply(scan_args);
-BENCHMARK(BM_Reduce)->Apply(sizes_threads);
-// Compaction and partition at W = 8, plus W = 1 (the scalar reference), 4 and 16 at 16M on
-// one thread.
+// Primitives that take a lane width: W = 8, plus W = 1 (the scalar reference), 4 and 16 at
+// 16M on one thread.
 void lanes_args(benchmark::internal::Benchmark* b) {
   for (long n : {1L << 20, 16L << 20})
     for (long t : {1, 2}) b->Args({n, t, 8});
   for (long w : {1, 4, 16}) b->Args({16L << 20, 1, w});
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
+BENCHMARK(BM_ExclusiveScan)->Apply(lanes_args);
+BENCHMARK(BM_InclusiveScan)->Apply(lanes_args);
+BENCHMARK(BM_Reduce)->Apply(sizes_threads);
 BENCHMARK(BM_CompactScatter)->Apply(lanes_args);
 BENCHMARK(BM_CompactHierarchical)->Apply([](benchmark::internal::Benchmark* b) {
   for (long n : {1L << 20, 16L << 20})
@@ -276,7 +269,7 @@ BENCHMARK(BM_CompactHierarchical)->Apply([](benchmark::internal::Benchmark* b) {
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 });
 BENCHMARK(BM_Partition)->Apply(lanes_args);
-BENCHMARK(BM_RadixSort32)->Apply(scan_args);
+BENCHMARK(BM_RadixSort32)->Apply(lanes_args);
 BENCHMARK(BM_RadixSort32Keys)->Apply(sizes_threads);
 
 }  // namespace

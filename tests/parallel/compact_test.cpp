@@ -32,36 +32,40 @@ std::vector<std::uint32_t> run_hier(Executor& ex, const std::vector<std::uint8_t
   return out;
 }
 
+// ROGER Fig.4.8 (s = 16), exactly, at every kernel width W: the within-block step's prefix
+// sums and reduced blocks, then the whole compaction with its block displacements.
 TEST(Compact, RogerFig48GoldenVector) {
   const std::string blocks = "43X192XX7X6X58X5" "431X2X6XX7X98XX5" "X87XX235XXX6XX1X" "1XXX45X7X6X8329X";
   std::vector<std::uint8_t> keep;
   for (char c : blocks) keep.push_back(c != 'X');
-  // Within-block step: the figure's prefix sums and reduced blocks.
   const char* psums[] = {"0011112334455566", "0001122344555677", "1112333345667889", "0123334455666667"};
   const char* reduced[] = {"4319276585", "431267985", "8723561", "145768329"};
-  for (int b = 0; b < 4; ++b) {
-    std::vector<std::uint32_t> psum(16), out(16);
-    std::uint64_t steps = 0;
-    const auto c = compact_block_gather(std::span(keep).subspan(b * 16, 16), psum, out, steps);
-    std::string p, r;
-    for (auto v : psum) p += char('0' + v);
-    for (std::size_t k = 0; k < c; ++k) r += blocks[b * 16 + out[k]];
-    EXPECT_EQ(p, psums[b]);
-    EXPECT_EQ(r, reduced[b]);
-  }
-  for (int t : kThreadCounts) {
-    std::vector<std::uint32_t> out(64);
-    HierarchicalCompactStats stats;
-    const auto n = compact_hierarchical(executor(t), "fig48", keep, out, 16, nullptr, &stats);
-    std::string joined;
-    for (std::size_t k = 0; k < n; ++k) {
-      // Block displacements in output order: 0, 10, 19, 26.
-      if (k == 10 || k == 19 || k == 26) joined += '|';
-      joined += blocks[out[k]];
+  for_each_lane_width([&](auto w) {
+    constexpr int W = w.value;
+    for (int b = 0; b < 4; ++b) {
+      std::vector<std::uint32_t> psum(16), out(16);
+      std::uint64_t steps = 0;
+      const auto c = compact_block_gather<W>(std::span(keep).subspan(b * 16, 16), psum, out, steps);
+      std::string p, r;
+      for (auto v : psum) p += char('0' + v);
+      for (std::size_t k = 0; k < c; ++k) r += blocks[b * 16 + out[k]];
+      EXPECT_EQ(p, psums[b]) << "W=" << W;
+      EXPECT_EQ(r, reduced[b]) << "W=" << W;
     }
-    EXPECT_EQ(joined, "4319276585|431267985|8723561|145768329");
-    EXPECT_EQ(stats.blocks, 4u);
-  }
+    for (int t : kThreadCounts) {
+      std::vector<std::uint32_t> out(64);
+      HierarchicalCompactStats stats;
+      const auto n = compact_hierarchical<W>(executor(t), "fig48", keep, out, 16, nullptr, &stats);
+      std::string joined;
+      for (std::size_t k = 0; k < n; ++k) {
+        // Block displacements in output order: 0, 10, 19, 26.
+        if (k == 10 || k == 19 || k == 26) joined += '|';
+        joined += blocks[out[k]];
+      }
+      EXPECT_EQ(joined, "4319276585|431267985|8723561|145768329") << "W=" << W << " t=" << t;
+      EXPECT_EQ(stats.blocks, 4u);
+    }
+  });
 }
 
 TEST(Compact, BothFormsEqualSequentialFilterForEverySize) {
@@ -196,28 +200,6 @@ TEST(Compact, EveryRatioAtEveryKernelWidth) {
         }
       }
   }
-}
-
-// The within-block step of ROGER Fig.4.8 at every W: the same prefix sums and reduced block.
-TEST(Compact, RogerFig48BlockStepAtEveryKernelWidth) {
-  const std::string blocks = "43X192XX7X6X58X5" "431X2X6XX7X98XX5" "X87XX235XXX6XX1X" "1XXX45X7X6X8329X";
-  std::vector<std::uint8_t> keep;
-  for (char c : blocks) keep.push_back(c != 'X');
-  const char* psums[] = {"0011112334455566", "0001122344555677", "1112333345667889", "0123334455666667"};
-  const char* reduced[] = {"4319276585", "431267985", "8723561", "145768329"};
-  for (int w : kLaneWidths)
-    for (int b = 0; b < 4; ++b) {
-      std::vector<std::uint32_t> psum(16), out(16);
-      std::uint64_t steps = 0;
-      const auto c = dispatch_lanes(w, [&](auto lw) {
-        return compact_block_gather<lw.value>(std::span(keep).subspan(b * 16, 16), psum, out, steps);
-      });
-      std::string p, r;
-      for (auto v : psum) p += char('0' + v);
-      for (std::size_t k = 0; k < c; ++k) r += blocks[b * 16 + out[k]];
-      EXPECT_EQ(p, psums[b]) << "W=" << w;
-      EXPECT_EQ(r, reduced[b]) << "W=" << w;
-    }
 }
 
 TEST(Compact, RejectsBadArguments) {
