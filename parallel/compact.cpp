@@ -8,6 +8,7 @@
 #include <bit>
 #include <stdexcept>
 
+#include "parallel/chained_pass.h"
 #include "parallel/lanes_pack.h"
 
 namespace speculum::par {
@@ -66,9 +67,26 @@ std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const
   const std::size_t n = keep.size();
   if (chunk == 0) chunk = 1;
   const std::size_t chunks = Executor::chunk_count(n, chunk);
+  auto count_of = [&](std::size_t c) {
+    const std::size_t b = c * chunk;
+    return count_kept<W>(keep.data() + b, std::min(n, b + chunk) - b);
+  };
+  if (out.size() >= n) {
+    // Room for any count: one chained pass (chained_pass.h) — each chunk counts its kept
+    // flags, takes its output offset by look-back, and scatters while its flags are cached.
+    std::plus<std::uint32_t> plus;
+    return chained_pass(ex, name, "chained_scatter", chunks, std::uint32_t(0), plus, count_of, true,
+                        [&](std::size_t c, std::uint32_t offset, std::uint32_t count, std::size_t) {
+                          const std::size_t b = c * chunk;
+                          scatter_kept<W>(keep.data(), b, std::min(n, b + chunk), out.data() + offset,
+                                          out.data() + offset + count);
+                        });
+  }
+  // A short output may be too small: count everything first, so that nothing is written
+  // before the size check throws.
   std::vector<std::uint32_t> offset(chunks + 1);
-  ex.parallel_for(launch_name(name, "count"), n, chunk, [&](std::size_t b, std::size_t e) {
-    offset[b / chunk] = count_kept<W>(keep.data() + b, e - b);
+  ex.parallel_for(launch_name(name, "count"), n, chunk, [&](std::size_t b, std::size_t) {
+    offset[b / chunk] = count_of(b / chunk);
   });
   std::size_t total = 0;
   for (auto& o : offset) {

@@ -202,6 +202,25 @@ TEST(Compact, EveryRatioAtEveryKernelWidth) {
   }
 }
 
+// An output span shorter than the input takes the count-first path: exactly the kept count
+// fits, one slot less throws before anything is written (the span keeps its contents).
+TEST(Compact, ScatterIntoExactlySizedOrShortOutput) {
+  for (std::size_t n : {std::size_t(100), 3 * kStreamChunk + 11})
+    for (int percent : {1, 50, 99}) {
+      const auto keep = flags(n, percent, n + std::size_t(percent));
+      const auto ref = serial_filter(keep);
+      for (int t : kThreadCounts)
+        for_each_lane_width([&](auto w) {
+          std::vector<std::uint32_t> exact(ref.size(), 0xdeadbeefu);
+          ASSERT_EQ(compact_scatter<w.value>(executor(t), "exact", keep, exact), ref.size());
+          ASSERT_EQ(exact, ref) << n << " " << percent << "% W=" << w.value << " t=" << t;
+          std::vector<std::uint32_t> short_by_one(ref.size() - 1, 7u);
+          EXPECT_THROW(compact_scatter<w.value>(executor(t), "short", keep, short_by_one), std::invalid_argument);
+          EXPECT_TRUE(std::all_of(short_by_one.begin(), short_by_one.end(), [](auto v) { return v == 7u; }));
+        });
+    }
+}
+
 TEST(Compact, RejectsBadArguments) {
   std::vector<std::uint8_t> keep = {1, 1, 1};
   std::vector<std::uint32_t> small(2);
