@@ -141,7 +141,9 @@ int expect_matches_oracle(const Mesh& m, const Bvh& bvh, const std::vector<Ray>&
     for (int k = 0; k < n; ++k) {
       const Hit o = closest_hit_oracle(m.positions, m.indices, rays[i + k]);
       EXPECT_EQ(o.triangle, h[k].triangle) << "packet, ray " << i + k;
-      if (o.hit()) EXPECT_EQ(bits(o.t), bits(h[k].t)) << "packet, ray " << i + k;
+      if (o.hit()) {
+        EXPECT_EQ(bits(o.t), bits(h[k].t)) << "packet, ray " << i + k;
+      }
     }
   }
   EXPECT_EQ(c.stack_overflows, 0u);
@@ -170,7 +172,9 @@ int expect_packets_match_oracle(const Mesh& m, const Bvh& bvh, int packets) {
     for (int k = 0; k < kPacketSize; ++k) {
       const Hit o = closest_hit_oracle(m.positions, m.indices, rays[k]);
       EXPECT_EQ(o.triangle, h[k].triangle) << "packet " << p << " ray " << k;
-      if (o.hit()) EXPECT_EQ(bits(o.t), bits(h[k].t)) << "packet " << p << " ray " << k;
+      if (o.hit()) {
+        EXPECT_EQ(bits(o.t), bits(h[k].t)) << "packet " << p << " ray " << k;
+      }
     }
   }
   return taken;
@@ -333,7 +337,9 @@ TEST(RealMeshWatertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
     const Mesh m = load(rel);
     if (m.indices.empty()) continue;
     const Welded w = weld(m);
-    if (std::string(rel) == "OFF/Cube.off") EXPECT_EQ(w.non_manifold_edges, 0u) << "Cube.off is closed";
+    if (std::string(rel) == "OFF/Cube.off") {
+      EXPECT_EQ(w.non_manifold_edges, 0u) << "Cube.off is closed";
+    }
     EXPECT_LT(w.non_manifold_edges, w.directed.size() / 10) << rel << ": mostly manifold";
     ++meshes;
     par::Executor ex(2);
