@@ -124,8 +124,8 @@ TEST(SixteenMillion, FloatScansMatchChunkAssociationForEveryThreadCount) {
   const float init = -2.5f;
   std::vector<float> ex_ref(n), in_ref(n);
   float running = init;
-  for (std::size_t b = 0; b < n; b += kStreamChunk) {
-    const std::size_t e = std::min(n, b + kStreamChunk);
+  for (std::size_t b = 0; b < n; b += kScanChunk) {
+    const std::size_t e = std::min(n, b + kScanChunk);
     float sum = in[b];
     for (std::size_t i = b + 1; i < e; ++i) sum = sum + in[i];
     float acc = running;

@@ -93,8 +93,8 @@ TEST(Stream, FloatScanAcrossTilesMatchesChunkAssociation) {
   for (std::size_t i = 0; i < n; ++i) in[i] = unit_float(i) * 10.f - 3.f;
   std::vector<float> oracle(n);
   float running = 1.5f;
-  for (std::size_t b = 0; b < n; b += kStreamChunk) {
-    const std::size_t e = std::min(n, b + kStreamChunk);
+  for (std::size_t b = 0; b < n; b += kScanChunk) {
+    const std::size_t e = std::min(n, b + kScanChunk);
     float sum = in[b];
     for (std::size_t i = b + 1; i < e; ++i) sum += in[i];
     float acc = running;
