@@ -152,7 +152,8 @@ void run_yu_fig9(const YuFig9Options& o, const GlobalOptions& global) {
     const pipeline::Technique technique{
         "yu-lod", "", [prebuilt](par::Graph& g, const Scene* sc, const pipeline::FrameSettings& fs) {
           pipeline::add_yu_lod_passes_prebuilt(g, sc, fs, prebuilt);
-        }};
+        },
+        {}};
     double static_ms = 0.0;
     for (std::size_t ai = 0; ai < alphas.size(); ++ai) {
       const float alpha = alphas[ai];

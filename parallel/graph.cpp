@@ -38,7 +38,7 @@ NodeBuilder Graph::add_node(std::string name, std::unique_ptr<Node> node) {
   if (name.empty()) throw GraphError("a graph node needs a name");
   for (const auto& e : nodes_)
     if (e.name == name) throw GraphError("two graph nodes are named " + quote(name));
-  NodeEntry entry{std::move(name), std::move(node), {}, {}};
+  NodeEntry entry{std::move(name), std::move(node), {}, {}, {}};
   Ports ports;
   entry.node->declare(ports);
   entry.ports = std::move(ports.decls());

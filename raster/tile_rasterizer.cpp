@@ -297,7 +297,7 @@ bool raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int 
   constexpr std::int64_t kLimit = std::int64_t(1) << 30;
   bool narrow = true;
   for (int i = 0; i < 3 && narrow && !e.small; ++i)
-    for (const auto [px, py] : {std::pair{x0, y0}, {xw, y0}, {x0, y1}, {xw, y1}}) {
+    for (const auto& [px, py] : {std::pair{x0, y0}, {xw, y0}, {x0, y1}, {xw, y1}}) {
       const std::int64_t v = edge_at(e, i, px, py);
       narrow &= v < kLimit && v > -kLimit;
     }

@@ -100,7 +100,7 @@ struct Tracer {
     };
     if (s.is_refractor()) {
       const float nu = entering ? s.ior : 1.0f / s.ior;
-      glm::vec3 tdir;
+      glm::vec3 tdir(0.0f);  // written by refract() when it returns true
       const bool ok = refract(dir, n, nu, tdir);
       const float F = ok ? fresnel_dielectric(cos_nv, nu) : 1.0f;
       glm::vec3 Ls = F * trace_dir(above, reflect(dir, n));

@@ -59,7 +59,9 @@ void expect_complete_manifest(const fs::path& dir, const std::string& technique)
     EXPECT_FALSE(n["outputs"].empty());
     for (const auto& out : n["outputs"]) {
       EXPECT_FALSE(out["type"].get<std::string>().empty());
-      if (out["drawable"].get<bool>()) EXPECT_FALSE(out["images"].empty()) << out["resource"];
+      if (out["drawable"].get<bool>()) {
+        EXPECT_FALSE(out["images"].empty()) << out["resource"];
+      }
       for (const auto& im : out["images"]) {
         EXPECT_TRUE(files.count(im["png"].get<std::string>())) << im["png"];
         EXPECT_TRUE(files.count(im["exr"].get<std::string>())) << im["exr"];

@@ -70,7 +70,7 @@ TEST(BadInput, SpecificProblemsAreNamed) {
 }
 
 TEST(BadInput, MissingFileAndUnknownName) {
-  for (const std::string name : {std::string(SPECULUM_TEST_DATA "/bad/no_such_file.glb"),
+  for (const std::string& name : {std::string(SPECULUM_TEST_DATA "/bad/no_such_file.glb"),
                                  std::string("/nonexistent/dir/scene.obj"),
                                  std::string("no-such-builtin-scene"),
                                  std::string("sphere-in-room:size=12"),

@@ -63,8 +63,9 @@ TEST(GltfRoundTrip, EveryBuiltinSceneSurvivesExport) {
         EXPECT_EQ(back.lights[l].type, src.lights[l].type);
         EXPECT_LT(glm::length(back.lights[l].position - src.lights[l].position), 1e-5f);
         EXPECT_FLOAT_EQ(back.lights[l].intensity, src.lights[l].intensity);
-        if (src.lights[l].type != LightType::Point)
+        if (src.lights[l].type != LightType::Point) {
           EXPECT_GT(glm::dot(back.lights[l].direction, src.lights[l].direction), 0.99999f);
+        }
       }
     }
   }

@@ -75,7 +75,7 @@ TEST(EnvmapReflect, ClearRefractorConservesAConstantEnvironment) {
   const Scene scene = plane_scene(m);
   par::Executor ex(1);
   const EnvironmentMap env = build_environment(ex, scene.environment, 8);
-  for (const Camera cam : {oblique_camera(), Camera{"below", {0.2f, 1.0f, -2.0f}, {0, 0, 0}}}) {
+  for (const Camera& cam : {oblique_camera(), Camera{"below", {0.2f, 1.0f, -2.0f}, {0, 0, 0}}}) {
     const auto vis = render_visibility(ex, scene, cam, 40, 30);
     const GBuffer g = resolve_gbuffer(ex, scene, vis, cam.eye);
     const ImageRGBA spec = envmap_reflect(ex, g, env);

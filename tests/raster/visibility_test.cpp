@@ -372,7 +372,9 @@ TEST(RasterInput, OverflowingCoordinatesAreDroppedNotUndefined) {
   const auto a = render_visibility(ex, scene, cam, 64, 64);
   const auto b = render_visibility(ex, with_huge, cam, 64, 64);
   for (std::size_t i = 0; i < a.triangle.size(); ++i)
-    if (b.triangle.pixels[i] != 1u) EXPECT_EQ(a.triangle.pixels[i], b.triangle.pixels[i]);
+    if (b.triangle.pixels[i] != 1u) {
+      EXPECT_EQ(a.triangle.pixels[i], b.triangle.pixels[i]);
+    }
 }
 
 }  // namespace

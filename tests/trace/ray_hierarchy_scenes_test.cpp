@@ -113,8 +113,12 @@ TEST_P(RayHierarchyScenes, EveryGenerationEqualsOracle) {
     run_and_check(scene, 24, 18, bounces, 1, c);  // 24×18 pads to 32²
     EXPECT_GT(c.rays, 20u) << GetParam();
     EXPECT_GT(c.hits, 0u) << GetParam();
-    if (bounces == 3 && GetParam() != "bumpy-sphere:n=4") EXPECT_GT(c.later_bounce_rays, 0u) << GetParam();
-    if (!scene.lights.empty()) EXPECT_GT(c.shadow_rays, 0u) << GetParam();
+    if (bounces == 3 && GetParam() != "bumpy-sphere:n=4") {
+      EXPECT_GT(c.later_bounce_rays, 0u) << GetParam();
+    }
+    if (!scene.lights.empty()) {
+      EXPECT_GT(c.shadow_rays, 0u) << GetParam();
+    }
   }
 }
 

@@ -80,10 +80,14 @@ TEST(TraversalOverflow, AnyHitAndClosestHitCountOverflowsAtFullStackSize) {
     any_overflows += ca.stack_overflows;
     closest_overflows += cc.stack_overflows;
     // Never silently wrong: a different answer only with a counted overflow.
-    if (ca.stack_overflows == 0) EXPECT_EQ(a, oa) << "any hit, probe " << i;
+    if (ca.stack_overflows == 0) {
+      EXPECT_EQ(a, oa) << "any hit, probe " << i;
+    }
     if (cc.stack_overflows == 0) {
       EXPECT_EQ(h.triangle, o.triangle) << "closest hit, probe " << i;
-      if (o.hit()) EXPECT_EQ(bits(h.t), bits(o.t)) << "probe " << i;
+      if (o.hit()) {
+        EXPECT_EQ(bits(h.t), bits(o.t)) << "probe " << i;
+      }
     }
     // The threaded layout is stackless: always exact.
     EXPECT_EQ(closest_hit_threaded(t.bvh, r).triangle, o.triangle) << "threaded, probe " << i;
