@@ -10,6 +10,8 @@
 #include <bit>
 #include <limits>
 #include <numeric>
+#include <string>
+#include <vector>
 
 #include "primitive_test_util.h"
 
@@ -178,6 +180,30 @@ TEST(RadixSort, SixteenMillion32BitKeys) {
   }
 }
 
+// Both segmented-min forms (ids as given, and sorted) at every lane width and thread count
+// equal serial_segmented_min on the same ids.
+void check_segmented_min(const std::vector<std::uint32_t>& seg, const std::vector<float>& value,
+                         std::uint32_t segments, const std::string& label) {
+  std::vector<float> ref_v, ref_sv;
+  std::vector<std::uint32_t> ref_i, ref_si;
+  serial_segmented_min(seg, value, segments, ref_v, ref_i);
+  auto sorted_seg = seg;
+  std::sort(sorted_seg.begin(), sorted_seg.end());
+  serial_segmented_min(sorted_seg, value, segments, ref_sv, ref_si);
+  for_each_lane_width([&](auto w) {
+    for (int t : kThreadCounts) {
+      std::vector<float> v(segments);
+      std::vector<std::uint32_t> ix(segments);
+      segmented_min<w.value>(executor(t), "closest_hit", seg, value, segments, v, ix);
+      ASSERT_EQ(v, ref_v) << label << " W=" << w.value << " t=" << t;
+      ASSERT_EQ(ix, ref_i) << label << " W=" << w.value << " t=" << t;
+      segmented_min_sorted<w.value>(executor(t), "closest_hit_sorted", sorted_seg, value, segments, v, ix);
+      ASSERT_EQ(v, ref_sv) << label << " W=" << w.value << " t=" << t;
+      ASSERT_EQ(ix, ref_si) << label << " W=" << w.value << " t=" << t;
+    }
+  });
+}
+
 TEST(SegmentedMin, ClosestHitPerRayEqualsSerial) {
   for (std::size_t n : sizes()) {
     const std::uint32_t segments = std::uint32_t(n / 3 + 2);
@@ -187,24 +213,7 @@ TEST(SegmentedMin, ClosestHitPerRayEqualsSerial) {
       seg[i] = hash32(i) % segments;
       t[i] = float(hash32(i + 5) % 50);  // coarse values: many ties
     }
-    std::vector<float> ref_v, ref_sv;
-    std::vector<std::uint32_t> ref_i, ref_si;
-    serial_segmented_min(seg, t, segments, ref_v, ref_i);
-    auto sorted_seg = seg;
-    std::sort(sorted_seg.begin(), sorted_seg.end());
-    serial_segmented_min(sorted_seg, t, segments, ref_sv, ref_si);
-    for_each_lane_width([&](auto w) {
-      for (int th : kThreadCounts) {
-        std::vector<float> v(segments);
-        std::vector<std::uint32_t> ix(segments);
-        segmented_min<w.value>(executor(th), "closest_hit", seg, t, segments, v, ix);
-        ASSERT_EQ(v, ref_v);
-        ASSERT_EQ(ix, ref_i) << n << " W=" << w.value << " t=" << th;
-        segmented_min_sorted<w.value>(executor(th), "closest_hit_sorted", sorted_seg, t, segments, v, ix);
-        ASSERT_EQ(v, ref_sv);
-        ASSERT_EQ(ix, ref_si) << n << " W=" << w.value << " t=" << th;
-      }
-    });
+    check_segmented_min(seg, t, segments, "n=" + std::to_string(n));
   }
   std::vector<std::uint32_t> unsorted = {1, 0};
   std::vector<float> v(2), t = {1, 2};
@@ -307,24 +316,7 @@ TEST(SegmentedMin, SparseSegmentsAcrossChunksEqualSerial) {
     val[i] = hash32(i + 1) % 5 == 0 ? std::numeric_limits<float>::quiet_NaN() : float(hash32(i + 2) % 8);
   }
   seg[0] = 4095, seg[1] = 4096, seg[2] = segments - 1;  // chunk edges and the last segment
-  std::vector<float> ref_v, ref_sv;
-  std::vector<std::uint32_t> ref_i, ref_si;
-  serial_segmented_min(seg, val, segments, ref_v, ref_i);
-  auto sorted_seg = seg;
-  std::sort(sorted_seg.begin(), sorted_seg.end());
-  serial_segmented_min(sorted_seg, val, segments, ref_sv, ref_si);
-  for_each_lane_width([&](auto w) {
-    for (int t : kThreadCounts) {
-      std::vector<float> v(segments);
-      std::vector<std::uint32_t> ix(segments);
-      segmented_min<w.value>(executor(t), "sparse", seg, val, segments, v, ix);
-      ASSERT_EQ(v, ref_v) << "W=" << w.value << " t=" << t;
-      ASSERT_EQ(ix, ref_i) << "W=" << w.value << " t=" << t;
-      segmented_min_sorted<w.value>(executor(t), "sparse_sorted", sorted_seg, val, segments, v, ix);
-      ASSERT_EQ(v, ref_sv) << "W=" << w.value << " t=" << t;
-      ASSERT_EQ(ix, ref_si) << "W=" << w.value << " t=" << t;
-    }
-  });
+  check_segmented_min(seg, val, segments, "sparse");
 }
 
 TEST(Histogram, CountsEqualSerial) {
