@@ -169,6 +169,23 @@ inline void stream_fence() {
 #endif
 }
 
+// How many elements of p[0, m) come before the first 64-byte line boundary (m if none does,
+// or if p is not aligned to its element): the head a streaming kernel writes plainly.
+template <class T>
+std::size_t to_line(const T* p, std::size_t m) {
+  const std::uintptr_t a = reinterpret_cast<std::uintptr_t>(p);
+  if (a % sizeof(T) != 0) return m;
+  const std::size_t k = ((64 - a % 64) % 64) / sizeof(T);
+  return k < m ? k : m;
+}
+
+// Copies src[0, words) to dst with stream_store, W words at a time: dst aligned to 4·W
+// bytes, words a multiple of W.
+template <int W>
+[[gnu::always_inline]] inline void stream_words(const std::uint32_t* src, std::size_t words, std::uint32_t* dst) {
+  for (std::size_t k = 0; k < words; k += W) stream_store<W>(Lanes<W>::load(src + k), dst + k);
+}
+
 // Bit k set iff flags[k] != 0, for k < W.
 template <int W>
 [[gnu::always_inline]] inline unsigned nonzero_bits(const std::uint8_t* flags) {

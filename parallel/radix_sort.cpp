@@ -227,15 +227,7 @@ ThreadBuffers<E>& thread_buffers() {
 // is not read again before the whole pass is done, so caching it only evicts the sources).
 template <int W>
 void stream_line(void* dst, const void* src) {
-  const auto* from = static_cast<const std::uint32_t*>(src);
-  auto* to = static_cast<std::uint32_t*>(dst);
-  for (int k = 0; k < 16; k += W) stream_store<W>(Lanes<W>::load(from + k), to + k);
-}
-
-// Elements before dst + k is 64-byte aligned (at most m).
-inline std::size_t to_line(const std::uint32_t* dst, std::size_t m) {
-  const std::size_t k = ((64 - reinterpret_cast<std::uintptr_t>(dst) % 64) % 64) / 4;
-  return std::min(k, m);
+  stream_words<W>(static_cast<const std::uint32_t*>(src), 16, static_cast<std::uint32_t*>(dst));
 }
 
 // dst[i] = the high (Key = true) or low 32 bits of src[i], i < m; whole aligned lines of dst
@@ -257,7 +249,9 @@ template <int W>
 void stream_copy(const std::uint32_t* src, std::size_t m, std::uint32_t* dst) {
   std::size_t i = to_line(dst, m);
   std::copy_n(src, i, dst);
-  for (; i + W <= m; i += W) stream_store<W>(Lanes<W>::load(src + i), dst + i);
+  const std::size_t body = (m - i) / W * W;
+  stream_words<W>(src + i, body, dst + i);
+  i += body;
   std::copy(src + i, src + m, dst + i);
 }
 

@@ -78,15 +78,6 @@ T scan_scalar(const T* in, T* out, std::size_t m, T acc, Op& op) {
   return acc;
 }
 
-// Elements before `p + k` is 64-byte aligned (m if that is never reached within m).
-template <class T>
-std::size_t to_line(const T* p, std::size_t m) {
-  const std::uintptr_t a = reinterpret_cast<std::uintptr_t>(p);
-  if (a % sizeof(T) != 0) return m;
-  const std::size_t k = ((64 - a % 64) % 64) / sizeof(T);
-  return k < m ? k : m;
-}
-
 // Prefetch::next / end: the lines of the chunk this thread most likely scans next, fetched
 // into L2 one line per 16 elements of this chunk's scan, so its reduction reads cache while
 // this scan, bound by arithmetic and writes, would otherwise leave the memory reads idle.
@@ -160,11 +151,10 @@ T scan_streaming(const T* in, T* out, std::size_t m, T acc, Op& op) {
   std::size_t i = to_line(out, m);
   acc = scan_scalar<Inclusive>(in, out, i, acc, op);
   alignas(64) T buf[kBlock];
-  const auto* words = reinterpret_cast<const std::uint32_t*>(buf);
   for (; i + kBlock <= m; i += kBlock) {
     acc = scan_scalar<Inclusive>(in + i, buf, kBlock, acc, op);
-    auto* dst = reinterpret_cast<std::uint32_t*>(out + i);
-    for (std::size_t k = 0; k < kBlock * sizeof(T) / 4; k += W) stream_store<W>(Lanes<W>::load(words + k), dst + k);
+    stream_words<W>(reinterpret_cast<const std::uint32_t*>(buf), kBlock * sizeof(T) / 4,
+                    reinterpret_cast<std::uint32_t*>(out + i));
   }
   return scan_scalar<Inclusive>(in + i, out + i, m - i, acc, op);
 }
