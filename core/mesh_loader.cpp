@@ -43,7 +43,7 @@ void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t 
   std::getline(in, line);
   if (!line.empty() && line.back() == '\r') line.pop_back();
   if (line != "ply") throw InputError(path, "missing 'ply' magic line");
-  bool format = false, element = false, vertex = false, binary = false;
+  bool format = false, element = false, vertex = false, face = false, binary = false;
   int lines = 0;
   while (std::getline(in, line)) {
     if (++lines > 10000) throw InputError(path, "PLY header too long");
@@ -56,6 +56,9 @@ void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t 
     if (w[0] == "comment" || w[0] == "obj_info") continue;
     if (w[0] == "end_header") {
       if (w.size() != 1 || !format || !vertex) bad();
+      // Checked here because OpenMesh rejects some face-less files (e.g. point clouds with
+      // extra properties) with no reason given.
+      if (!face) throw InputError(path, "contains no faces (the header declares no face element)");
       return;
     }
     if (w[0] == "format") {
@@ -72,6 +75,7 @@ void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t 
                                    std::to_string(size) + " bytes");
       element = true;
       vertex = vertex || w[1] == "vertex";
+      face = face || w[1] == "face";
     } else if (w[0] == "property") {
       if (!element) bad();
       if (w.size() == 3) {

@@ -67,6 +67,7 @@ TEST(BadInput, SpecificProblemsAreNamed) {
   EXPECT_NE(problem("unsupported_extension.gltf").find("KHR_draco_mesh_compression"), std::string::npos);
   EXPECT_NE(problem("absurd_count.gltf").find("absurd"), std::string::npos);
   EXPECT_NE(problem("empty.glb").find("empty"), std::string::npos);
+  EXPECT_NE(problem("point_cloud.ply").find("no faces"), std::string::npos);
 }
 
 TEST(BadInput, MissingFileAndUnknownName) {

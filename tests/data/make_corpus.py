@@ -177,6 +177,10 @@ def main():
           b"property float x\nproperty float y\nproperty float z\nelement face 1\n"
           b"property list uchar int vertex_indices\nend_header\n" + struct.pack("<4f", 0, 0, 0, 1))
     write(BAD, "not_a_ply.ply", "hello\n", "w")
+    # A binary point cloud (no face element) with an extra per-vertex property.
+    write(BAD, "point_cloud.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 2\n"
+          b"property float x\nproperty float y\nproperty float z\nproperty float psz\nend_header\n"
+          + struct.pack("<8f", 0, 0, 0, 1, 1, 0, 0, 1))
     # Property before any element: crashed OpenMesh's PLY reader before our header check.
     write(BAD, "property_before_element.ply", "ply\nformat ascii 1.0\n\xa6lement vertex 4\n"
           "property float x\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n", "w")
