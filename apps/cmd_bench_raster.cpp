@@ -39,7 +39,6 @@ double median(std::vector<double> v) {
 }
 
 void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) {
-  if (global.lanes != 0) par::set_default_lanes(global.lanes);
   if (o.repeat < 1) throw InputError("--repeat", "must be at least 1");
   if (double(o.width) * o.height > double(1 << 26))  // ~110 bytes per sample
     throw InputError("--width/--height", "more than 67M samples");

@@ -15,7 +15,6 @@
 #include "apps/result_table.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
-#include "parallel/lanes.h"
 #include "raster/gbuffer.h"
 #include "raster/visibility.h"
 #include "trace/bvh.h"
@@ -118,7 +117,6 @@ void run_row(const Scene& scene, const std::string& name, const trace::Bvh& bvh,
 }
 
 void run_ray_hierarchy_experiment(const RayHierarchyExperimentOptions& o, const GlobalOptions& global) {
-  if (global.lanes != 0) par::set_default_lanes(global.lanes);
   if (o.min_width > o.max_width)
     throw InputError("--min-width", "must not exceed --max-width (" + std::to_string(o.max_width) + ")");
   par::Executor ex(global.threads);

@@ -19,7 +19,6 @@
 #include "core/error.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
-#include "parallel/lanes.h"
 
 namespace speculum::cli {
 namespace {
@@ -90,7 +89,6 @@ ImageRGBA reference_image(const Scene& scene, const std::string& scene_name,
 }
 
 void run_survey(const SurveyOptions& o, const GlobalOptions& global) {
-  if (global.lanes != 0) par::set_default_lanes(global.lanes);
   std::vector<std::string> scenes = o.scenes;
   if (scenes.empty()) scenes = {"sphere-in-room", "bowl", "living-room", "glass-sphere", "mirror-corridor"};
   const std::vector<std::string>& wanted = o.techniques.empty() ? kTechniques : o.techniques;

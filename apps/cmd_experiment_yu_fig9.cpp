@@ -19,7 +19,6 @@
 #include "core/image_metrics.h"
 #include "core/procedural_geometry.h"
 #include "core/sampling.h"
-#include "parallel/lanes.h"
 #include "parallel/executor.h"
 #include "raster/composite.h"
 #include "trace/reference_tracer.h"
@@ -118,7 +117,6 @@ double node_ms(const par::RunReport& r, const char* node) {
 }
 
 void run_yu_fig9(const YuFig9Options& o, const GlobalOptions& global) {
-  if (global.lanes != 0) par::set_default_lanes(global.lanes);
   if (o.min_res > o.max_res) throw InputError("--min-res", "larger than --max-res");
   std::vector<float> alphas;
   for (const std::string& a : o.alphas) {

@@ -16,7 +16,6 @@
 #include "apps/progress.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
-#include "parallel/lanes.h"
 
 namespace speculum::cli {
 namespace {
@@ -51,7 +50,6 @@ std::string shell_quote(const std::string& s) {
 bool have_graphviz() { return std::system("command -v dot >/dev/null 2>&1") == 0; }
 
 void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
-  if (global.lanes != 0) par::set_default_lanes(global.lanes);
   const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
   const Scene scene = load_scene(o.frame.scene.empty() ? default_scene_name() : o.frame.scene);
   const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);

@@ -19,7 +19,6 @@
 #include "apps/result_table.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
-#include "parallel/lanes.h"
 
 namespace speculum::cli {
 namespace {
@@ -54,7 +53,6 @@ std::string counters_text(const std::map<std::string, std::uint64_t>& counters) 
 }
 
 void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
-  if (global.lanes != 0) par::set_default_lanes(global.lanes);
   const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
   const Scene scene = load_scene(o.frame.scene.empty() ? default_scene_name() : o.frame.scene);
   const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);

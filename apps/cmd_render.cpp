@@ -11,7 +11,6 @@
 #include "apps/progress.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
-#include "parallel/lanes.h"
 
 namespace speculum::cli {
 namespace {
@@ -28,7 +27,6 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 void run_render(const RenderOptions& opts, const GlobalOptions& global) {
   const pipeline::FrameOptions& o = opts.frame;
-  if (global.lanes != 0) par::set_default_lanes(global.lanes);
   const pipeline::Technique& technique = pipeline::find_technique(o.technique);
   const int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
   if (k * k != o.spp && technique.name != "reference" && technique.name != "yu-lod")
