@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <initializer_list>
 #include <string>
 
 #include "primitive_test_util.h"
@@ -79,17 +80,6 @@ TEST(Compact, BothFormsEqualSequentialFilterForEverySize) {
           EXPECT_EQ(run_hier(executor(t), keep, s), ref) << n << " " << percent << "% s=" << s << " t=" << t;
       }
     }
-  }
-}
-
-TEST(Compact, EveryRatioFromZeroToHundredPercent) {
-  // Every integer percentage, for each block size of the sweep, at a size with a tail block.
-  const std::size_t n = 4099;
-  for (int percent = 0; percent <= 100; ++percent) {
-    const auto keep = flags(n, percent, 1000 + percent);
-    const auto ref = serial_filter(keep);
-    ASSERT_EQ(run_scatter(executor(2), keep), ref) << percent;
-    for (std::size_t s = 8; s <= 1024; s *= 2) ASSERT_EQ(run_hier(executor(2), keep, s), ref) << percent << "% s=" << s;
   }
 }
 
@@ -181,26 +171,38 @@ TEST(Compact, EveryKernelWidthAndThreadCountEqualsSerial) {
   }
 }
 
-TEST(Compact, EveryRatioAtEveryKernelWidth) {
-  const std::size_t n = 4099;
+// Every integer percentage 0..100 % at size n, every kernel width W × 1/2/8 threads: the
+// scatter form at its default chunk and the hierarchical form at each block size s, both
+// against the serial filter.
+void check_every_ratio(std::size_t n, std::initializer_list<std::size_t> block_sizes) {
+  std::vector<std::uint32_t> out;
   for (int percent = 0; percent <= 100; ++percent) {
-    const auto keep = flags(n, percent, 1000 + percent);
+    const auto keep = flags(n, percent, n + std::size_t(percent));
     const auto ref = serial_filter(keep);
     for (int w : kLaneWidths)
       for (int t : kThreadCounts) {
-        std::vector<std::uint32_t> out(n);
+        out.assign(n, 0xdeadbeefu);
         out.resize(dispatch_lanes(w, [&](auto lw) { return compact_scatter<lw.value>(executor(t), "ratio_w", keep, out); }));
-        ASSERT_EQ(out, ref) << percent << "% W=" << w << " t=" << t;
-        for (std::size_t s = 8; s <= 1024; s *= 8) {
-          out.assign(n, 0);
+        ASSERT_EQ(out, ref) << n << " " << percent << "% W=" << w << " t=" << t;
+        for (std::size_t s : block_sizes) {
+          out.assign(n, 0xdeadbeefu);
           out.resize(dispatch_lanes(w, [&](auto lw) {
             return compact_hierarchical<lw.value>(executor(t), "ratio_hw", keep, out, s);
           }));
-          ASSERT_EQ(out, ref) << percent << "% s=" << s << " W=" << w << " t=" << t;
+          ASSERT_EQ(out, ref) << n << " " << percent << "% s=" << s << " W=" << w << " t=" << t;
         }
       }
   }
 }
+
+// One chunk of either form (4099 < kStreamChunk), with a short tail block for every s.
+TEST(Compact, EveryRatioAtEveryKernelWidth) { check_every_ratio(4099, {8, 16, 32, 64, 128, 256, 512, 1024}); }
+
+// Three chunks of the chained scatter (the last holds 5 flags), so every ratio also runs the
+// look-back between chunks; for the hierarchical form 32 block_reduce launch chunks of
+// kStreamChunk flags (s = 64 divides it; s = 1000 makes launch chunks of 16 blocks that do
+// not line up with them) and, above ~3 % kept, several concatenate chunks.
+TEST(Compact, EveryRatioAcrossChunksAtEveryKernelWidth) { check_every_ratio(2 * kCompactChunk + 5, {64, 1000}); }
 
 // An output span shorter than the input takes the count-first path: exactly the kept count
 // fits, one slot less throws before anything is written (the span keeps its contents).
