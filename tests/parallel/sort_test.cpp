@@ -19,26 +19,33 @@ namespace speculum::par {
 namespace {
 using namespace test;
 
+// partition_stable at every lane width × 1/2/8 threads against the serial stable partition:
+// bucket by bucket in id order, each bucket's indices ascending, and the bucket boundaries.
+void check_partition(const std::vector<std::uint32_t>& bucket, std::uint32_t p, const std::string& label) {
+  const std::size_t n = bucket.size();
+  std::vector<std::uint32_t> ref, ref_begin;
+  for (std::uint32_t d = 0; d < p; ++d) {
+    ref_begin.push_back(std::uint32_t(ref.size()));
+    for (std::size_t i = 0; i < n; ++i)
+      if (bucket[i] == d) ref.push_back(std::uint32_t(i));
+  }
+  ref_begin.push_back(std::uint32_t(n));
+  for_each_lane_width([&](auto w) {
+    for (int t : kThreadCounts) {
+      std::vector<std::uint32_t> out(n, 0xdeadbeefu), begin(p + 1, 0xdeadbeefu);
+      partition_stable<w.value>(executor(t), "partition", bucket, p, out, begin);
+      ASSERT_EQ(out, ref) << label << " p=" << p << " W=" << w.value << " t=" << t;
+      ASSERT_EQ(begin, ref_begin) << label << " p=" << p << " W=" << w.value << " t=" << t;
+    }
+  });
+}
+
 TEST(Partition, StableBucketsEqualSerial) {
   for (std::size_t n : sizes())
     for (std::uint32_t p : {1u, 2u, 7u, 300u}) {
       std::vector<std::uint32_t> bucket(n);
       for (std::size_t i = 0; i < n; ++i) bucket[i] = hash32(i * 3 + p) % p;
-      std::vector<std::uint32_t> ref, ref_begin;
-      for (std::uint32_t d = 0; d < p; ++d) {
-        ref_begin.push_back(std::uint32_t(ref.size()));
-        for (std::size_t i = 0; i < n; ++i)
-          if (bucket[i] == d) ref.push_back(std::uint32_t(i));
-      }
-      ref_begin.push_back(std::uint32_t(n));
-      for_each_lane_width([&](auto w) {
-        for (int t : kThreadCounts) {
-          std::vector<std::uint32_t> out(n), begin(p + 1);
-          partition_stable<w.value>(executor(t), "partition", bucket, p, out, begin);
-          ASSERT_EQ(out, ref) << n << " p=" << p << " W=" << w.value << " t=" << t;
-          ASSERT_EQ(begin, ref_begin);
-        }
-      });
+      check_partition(bucket, p, "n=" + std::to_string(n));
     }
   std::vector<std::uint32_t> bad = {0, 5}, out(2), begin(5);
   EXPECT_THROW(partition_stable(executor(2), "p", bad, 4, out, begin), std::invalid_argument);
@@ -50,6 +57,25 @@ TEST(Partition, StableBucketsEqualSerial) {
       EXPECT_THROW(partition_stable<w.value>(executor(2), "p", ids, 4, o, bb), std::invalid_argument)
           << "W=" << w.value << " at " << at;
     });
+  }
+}
+
+// Every share 0..100 % of the elements in one bucket, at a size of four scatter chunks (the
+// last one partial), so each chunk's offsets come from uneven per-chunk counts: p = 2 (the
+// compaction split of ROGER §4.5, bucket 0 = the kept share), and p = 7 with that share in
+// bucket 3, the rest spread over the others except bucket 5, which stays empty.
+TEST(Partition, EveryBucketShareAcrossChunksEqualsSerial) {
+  const std::size_t n = 3 * kScatterChunk + 7;
+  constexpr std::uint32_t others[] = {0, 1, 2, 4, 6};
+  std::vector<std::uint32_t> two(n), seven(n);
+  for (int percent = 0; percent <= 100; ++percent) {
+    const auto in_share = flags(n, percent, n + std::size_t(percent));
+    for (std::size_t i = 0; i < n; ++i) {
+      two[i] = in_share[i] ? 0u : 1u;
+      seven[i] = in_share[i] ? 3u : others[hash32(i * 5 + std::size_t(percent)) % 5];
+    }
+    ASSERT_NO_FATAL_FAILURE(check_partition(two, 2, std::to_string(percent) + "%"));
+    ASSERT_NO_FATAL_FAILURE(check_partition(seven, 7, std::to_string(percent) + "%"));
   }
 }
 
