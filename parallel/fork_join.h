@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <type_traits>
 
+#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #if defined(__SANITIZE_THREAD__)
@@ -125,7 +126,11 @@ void fork_join_chunks(ForkJoinSync& sync, std::size_t chunks, ChunkBody& chunk_b
   sync.fork();
   // The root runs on this thread (run_and_wait does not copy or spawn it); rethrows the
   // first exception of any chunk once all spawned tasks have finished.
-  group.run_and_wait(ForkJoinTask<Splitter>(sync, split, 0, chunks));
+  // Isolated: while this thread waits for stolen chunks it runs only this launch's tasks.
+  // Otherwise it could pick up another graph node (a whole pass) in the wait, and this
+  // launch, and the node that issued it, would end only when that pass does: their
+  // recorded wall times would include its work.
+  tbb::this_task_arena::isolate([&] { group.run_and_wait(ForkJoinTask<Splitter>(sync, split, 0, chunks)); });
 }  // ~task_group acquires TBB's join counter: the edge leave()/join() cannot state (above)
 
 }  // namespace speculum::par

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdint>
 #include <chrono>
 #include <string>
 #include <thread>
@@ -108,6 +109,36 @@ TEST(Graph, IndependentNodesRunConcurrently) {
   g.run(ex);
   EXPECT_EQ(g.get<int>("a"), 2);
   EXPECT_EQ(g.get<int>("b"), 2);
+}
+
+// A thread waiting for its launch's stolen chunks must not pick up another node meanwhile:
+// that node would then run nested inside the first one's launch, and the first node's launch
+// and wall time would last until the other node finished (fork_join.h isolates the wait).
+// Many independent nodes with many small chunks on an oversubscribed executor give the
+// scheduler every chance to nest them; each node notes whether its thread was already inside
+// a node when it started.
+TEST(Graph, NodesNeverRunInsideAnotherNodesLaunch) {
+  Executor ex(8);
+  static thread_local int nodes_on_this_thread = 0;
+  std::atomic<int> nested{0};
+  Graph g;
+  constexpr int kNodes = 24;
+  for (int i = 0; i < kNodes; ++i) {
+    const std::string name = "node" + std::to_string(i);
+    g.add(name, [&nested](NodeContext& c) {
+       if (nodes_on_this_thread++ > 0) nested.fetch_add(1);
+       std::atomic<std::uint64_t> sum{0};
+       c.executor().parallel_for("work", 64, 1, [&](std::size_t b, std::size_t) {
+         std::uint64_t x = b;
+         for (int k = 0; k < 20000; ++k) x = x * 6364136223846793005ull + 1442695040888963407ull;
+         sum.fetch_add(x, std::memory_order_relaxed);
+       });
+       c.output<std::uint64_t>(c.node_name()) = sum.load();
+       --nodes_on_this_thread;
+     }).writes<std::uint64_t>(name);
+  }
+  for (int round = 0; round < 5; ++round) g.run(ex);
+  EXPECT_EQ(nested.load(), 0);
 }
 
 TEST(Graph, RejectsCycleNamingNodesAndResources) {
