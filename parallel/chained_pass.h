@@ -70,7 +70,8 @@ T look_back(const ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum
 
 }  // namespace detail
 
-// Runs the chained pass over `chunks` chunks as one launch "<name>/<phase>": for every chunk
+// Runs the chained pass over the `chunks` chunks of `n` elements as one launch
+// "<name>/<phase>" (recorded with n and chunks, whatever the thread count): for every chunk
 // c, sum_of(c) (the chunk's ⊕-sum; called again by look-back for a missing predecessor when
 // may_compute), then finish(c, offset, sum, workers) with offset = init ⊕ sums of chunks [0, c)
 // and sum = sum_of(c).
@@ -78,8 +79,8 @@ T look_back(const ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum
 // takes next (c + workers). Returns init ⊕ every sum (init when chunks == 0).
 // may_compute false (in place): a missing sum is awaited instead of computed (see look_back).
 template <class T, class Op, class SumOf, class Finish>
-T chained_pass(Executor& ex, std::string_view name, std::string_view phase, std::size_t chunks, T init,
-               Op& op, SumOf&& sum_of, bool may_compute, Finish&& finish) {
+T chained_pass(Executor& ex, std::string_view name, std::string_view phase, std::size_t n, std::size_t chunks,
+               T init, Op& op, SumOf&& sum_of, bool may_compute, Finish&& finish) {
   if (chunks == 0) return init;
   using detail::ScanLink;
   std::unique_ptr<ScanLink<T>[]> links(new ScanLink<T>[chunks]);
@@ -88,7 +89,7 @@ T chained_pass(Executor& ex, std::string_view name, std::string_view phase, std:
   // may_compute no thread ever blocks on another.
   std::atomic<std::size_t> next{0};
   const std::size_t workers = std::min<std::size_t>(std::size_t(ex.threads()), chunks);
-  ex.parallel_for(launch_name(name, phase), workers, 1, [&](std::size_t, std::size_t) {
+  ex.run_workers(launch_name(name, phase), workers, n, chunks, [&](std::size_t) {
     std::vector<T> sums;
     for (;;) {
       const std::size_t c = next.fetch_add(1, std::memory_order_relaxed);

@@ -75,7 +75,7 @@ std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const
     // Room for any count: one chained pass (chained_pass.h) — each chunk counts its kept
     // flags, takes its output offset by look-back, and scatters while its flags are cached.
     std::plus<std::uint32_t> plus;
-    return chained_pass(ex, name, "chained_scatter", chunks, std::uint32_t(0), plus, count_of, true,
+    return chained_pass(ex, name, "chained_scatter", n, chunks, std::uint32_t(0), plus, count_of, true,
                         [&](std::size_t c, std::uint32_t offset, std::uint32_t count, std::size_t) {
                           const std::size_t b = c * chunk;
                           scatter_kept<W>(keep.data(), b, std::min(n, b + chunk), out.data() + offset,

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 namespace speculum::par {
@@ -22,6 +23,9 @@ int resolve_threads(int threads) {
 
 Executor::Executor(int threads)
     : threads_(resolve_threads(threads)), epoch_(std::chrono::steady_clock::now()) {
+  if (threads_ > tbb::info::default_concurrency())
+    oversubscribe_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                           std::size_t(threads_));
   if (threads_ > 1) arena_ = std::make_unique<tbb::task_arena>(threads_);
 }
 

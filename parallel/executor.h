@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 #include "parallel/fork_join.h"
@@ -54,8 +55,8 @@ class Executor {
  public:
   // threads == 0: all hardware threads; threads == 1: synchronous, in chunk order, on the
   // calling thread (the debugging mode). threads < 0 throws std::invalid_argument. More
-  // threads than cores is allowed (the arena asks for them; TBB may grant fewer), and
-  // results never depend on it.
+  // threads than cores is allowed and really runs that many (oversubscribed: a way to shake
+  // out ordering bugs); results never depend on it.
   explicit Executor(int threads = 0);
 
   // Number of chunks parallel_for(n, chunk) uses; chunk 0 is treated as 1.
@@ -72,22 +73,21 @@ class Executor {
   void parallel_for(std::string_view name, std::size_t n, std::size_t chunk, Body&& body) {
     if (chunk == 0) chunk = 1;
     const std::size_t chunks = chunk_count(n, chunk);
-    const auto t0 = now_ns();
     auto run_chunk = [&](std::size_t c) {
       const std::size_t begin = c * chunk;
       const std::size_t end = begin + chunk < n ? begin + chunk : n;
       body(begin, end);
     };
-    if (synchronous() || chunks <= 1) {
-      for (std::size_t c = 0; c < chunks; ++c) run_chunk(c);
-    } else {
-      // A task_group fork/join, not tbb::parallel_for: see fork_join.h for why.
-      ForkJoinSync sync;  // per launch
-      sync.fork();  // after everything the tasks read is written
-      ForkJoinSync::JoinOnExit join{sync};
-      arena_->execute([&] { fork_join_chunks(sync, chunks, run_chunk); });
-    }
-    record(name, n, chunks, t0, now_ns() - t0);
+    launch(name, n, chunks, chunks, run_chunk);
+  }
+
+  // Calls body(w) for each w in [0, workers) at once, for a kernel whose workers claim the
+  // data's chunks themselves in a fixed order (chained_pass.h); the record names the data
+  // (`n` elements in `chunks` chunks), not the thread-dependent worker count.
+  template <class Body>
+  void run_workers(std::string_view name, std::size_t workers, std::size_t n, std::size_t chunks,
+                   Body&& body) {
+    launch(name, n, chunks, workers, body);
   }
 
   // Deterministic reduction: partial = chunk_fn(begin, end) per fixed chunk (in parallel),
@@ -133,10 +133,29 @@ class Executor {
   }
 
  private:
+  // Runs task(t) for t in [0, tasks) and records the launch as `n` elements in `chunks`.
+  template <class Task>
+  void launch(std::string_view name, std::size_t n, std::size_t chunks, std::size_t tasks, Task& task) {
+    const auto t0 = now_ns();
+    if (synchronous() || tasks <= 1) {
+      for (std::size_t t = 0; t < tasks; ++t) task(t);
+    } else {
+      // A task_group fork/join, not tbb::parallel_for: see fork_join.h for why.
+      ForkJoinSync sync;  // per launch
+      sync.fork();  // after everything the tasks read is written
+      ForkJoinSync::JoinOnExit join{sync};
+      arena_->execute([&] { fork_join_chunks(sync, tasks, task); });
+    }
+    record(name, n, chunks, t0, now_ns() - t0);
+  }
+
   void record(std::string_view name, std::size_t n, std::size_t chunks, std::int64_t start,
               std::int64_t duration);
 
   int threads_;
+  // Raises TBB's process-wide worker limit (default: the core count) while an executor asks
+  // for more threads than cores, so `--threads 8` on 2 cores really runs 8 threads.
+  std::unique_ptr<tbb::global_control> oversubscribe_;
   std::unique_ptr<tbb::task_arena> arena_;
   std::chrono::steady_clock::time_point epoch_;
   bool recording_ = true;

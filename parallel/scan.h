@@ -50,7 +50,7 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   };
   const auto addr = [](const T* p) { return reinterpret_cast<std::uintptr_t>(p); };
   const bool in_place = addr(src) < addr(dst + n) && addr(dst) < addr(src + n);
-  return chained_pass(ex, name, "chained_scan", chunks, init, op, sum_of, !in_place,
+  return chained_pass(ex, name, "chained_scan", n, chunks, init, op, sum_of, !in_place,
                       [&](std::size_t c, T offset, T, std::size_t workers) {
                         // This thread's next chunk is most likely c + workers: the kernel
                         // prefetches it while it scans (a prefetch reads nothing in the memory

@@ -14,6 +14,9 @@
 #include <thread>
 #include <vector>
 
+#include "parallel/compact.h"
+#include "parallel/scan.h"
+
 namespace speculum::par {
 namespace {
 
@@ -93,6 +96,47 @@ TEST(Executor, ThreadSettings) {
   EXPECT_EQ(seen, (std::vector<std::size_t>{0, 8, 16, 24, 32, 40, 48}));
   EXPECT_EQ(ex.run([] { return 42; }), 42);
   EXPECT_EQ(Executor(2).run([] { return 7; }), 7);
+}
+
+// More threads than cores really run: eight chunks that each wait (bounded) until all eight
+// have started can only all see eight if eight threads run at once. TBB caps its workers at
+// the core count unless the executor lifts the cap (executor.h).
+TEST(Executor, OversubscribedExecutorRunsThatManyThreads) {
+  constexpr int kThreads = 8;
+  Executor ex(kThreads);
+  std::atomic<int> started{0};
+  std::vector<int> saw(kThreads, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  ex.parallel_for("rendezvous", kThreads, 1, [&](std::size_t b, std::size_t) {
+    started.fetch_add(1);
+    while (started.load() < kThreads && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    saw[b] = started.load();
+  });
+  EXPECT_EQ(saw, std::vector<int>(kThreads, kThreads));
+}
+
+// The chained scan and scatter compaction run one task per worker, but their launch records
+// (what `profile` and the trace show) name the data: n elements in its fixed chunks, the same
+// for every thread count.
+TEST(Executor, ChainedPassRecordsItsDataNotItsWorkers) {
+  const std::size_t n = 3 * kScanChunk + 5;
+  std::vector<std::uint32_t> in(n, 1u), out(n);
+  std::vector<std::uint8_t> keep(n, 1);
+  for (int threads : {1, 2, 8}) {
+    SCOPED_TRACE(threads);
+    Executor ex(threads);
+    exclusive_scan(ex, "scan", std::span<const std::uint32_t>(in), std::span(out));
+    compact_scatter(ex, "compact", std::span<const std::uint8_t>(keep), std::span(out));
+    const auto launches = ex.launches();
+    ASSERT_EQ(launches.size(), 2u);
+    EXPECT_EQ(launches[0].name, "scan/chained_scan");
+    EXPECT_EQ(launches[0].elements, n);
+    EXPECT_EQ(launches[0].chunks, Executor::chunk_count(n, kScanChunk));
+    EXPECT_EQ(launches[1].name, "compact/chained_scatter");
+    EXPECT_EQ(launches[1].elements, n);
+    EXPECT_EQ(launches[1].chunks, Executor::chunk_count(n, kCompactChunk));
+  }
 }
 
 // Writes 64 KiB of this thread's stack below the caller's frame with plain stores, as any
