@@ -159,52 +159,7 @@ TEST(RadixSort, StreamingOutputUnalignedSpansEqualStableSort) {
   }
 }
 
-TEST(RadixSort, SixteenMillion32BitKeys) {
-  const std::size_t n = std::size_t(16) << 20;
-  // 20-bit keys: many duplicates, stability is visible; 32-bit keys: two in-cache passes
-  // per bucket after the top-digit scatter.
-  for (std::uint32_t mask : {0xfffffu, 0xffffffffu}) {
-    std::vector<std::uint32_t> keys(n), payload(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      keys[i] = hash32(i) & mask;
-      payload[i] = std::uint32_t(i);
-    }
-    const auto original = keys;
-    RadixSortScratch<std::uint32_t> scratch;
-    // 1 and 8 threads give exactly the 2-thread result checked below (keys and payload).
-    std::vector<std::vector<std::uint32_t>> other_keys, other_payload;
-    for (int t : {1, 8}) {
-      std::vector<std::uint32_t> k = original, p(n);
-      std::iota(p.begin(), p.end(), 0u);
-      radix_sort(executor(t), "radix16M", std::span(k), std::span(p), &scratch);
-      other_keys.push_back(std::move(k));
-      other_payload.push_back(std::move(p));
-    }
-    radix_sort(executor(2), "radix16M", std::span(keys), std::span(payload), &scratch);
-    for (std::size_t k = 0; k < other_keys.size(); ++k) {
-      ASSERT_TRUE(other_keys[k] == keys) << std::hex << mask << " t=" << (k ? 8 : 1);
-      ASSERT_TRUE(other_payload[k] == payload) << std::hex << mask << " t=" << (k ? 8 : 1);
-    }
-    // Sorted, stable, and payload is a permutation mapping back to the original keys.
-    std::vector<bool> seen(n, false);
-    for (std::size_t i = 0; i < n; ++i) {
-      ASSERT_EQ(keys[i], original[payload[i]]);
-      ASSERT_FALSE(seen[payload[i]]);
-      seen[payload[i]] = true;
-      if (i) {
-        ASSERT_LE(keys[i - 1], keys[i]);
-        if (keys[i - 1] == keys[i]) {
-          ASSERT_LT(payload[i - 1], payload[i]);
-        }
-      }
-    }
-    for (int t : kThreadCounts) {
-      auto bare = original;  // keys only: the same keys in the same order
-      radix_sort(executor(t), "radix16M_keys", std::span(bare), {}, &scratch);
-      ASSERT_TRUE(bare == keys) << std::hex << mask << " t=" << t;
-    }
-  }
-}
+// 16M 32-bit keys (every W × 1/2/8 threads, one reference): radix_sort_width_test.cpp.
 
 // Both segmented-min forms (ids as given, and sorted) at every lane width and thread count
 // equal serial_segmented_min on the same ids.
