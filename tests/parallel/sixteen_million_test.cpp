@@ -116,7 +116,8 @@ TEST(SixteenMillion, ReduceFollowsChunkOrderAssociationForEveryThreadCount) {
 
 // Float scans over 16M + a tail (1025 chunks, the last one partial: the chained scan's
 // prefetch of the following chunk reaches a short chunk): the documented association, each
-// chunk scanned from init ⊕ the preceding chunk sums folded in order, bit for bit.
+// chunk scanned from init ⊕ the preceding chunk sums folded in order, bit for bit, for every
+// kernel width W (out of place, and in place for the inclusive scan) and thread count.
 TEST(SixteenMillion, FloatScansMatchChunkAssociationForEveryThreadCount) {
   const std::size_t n = k16M + 4099;
   std::vector<float> in(n);
@@ -136,20 +137,20 @@ TEST(SixteenMillion, FloatScansMatchChunkAssociationForEveryThreadCount) {
     }
     running = running + sum;
   }
-  std::vector<float> out(n);
-  for (int t : kThreadCounts) {
-    std::fill(out.begin(), out.end(), 0.f);
-    const float ex_total = exclusive_scan(executor(t), "fex16M", std::span<const float>(in), std::span(out), init);
-    EXPECT_EQ(std::bit_cast<std::uint32_t>(ex_total), std::bit_cast<std::uint32_t>(running)) << t;
-    for (std::size_t i = 0; i < n; ++i)
-      ASSERT_EQ(std::bit_cast<std::uint32_t>(out[i]), std::bit_cast<std::uint32_t>(ex_ref[i])) << "exclusive i=" << i << " t=" << t;
-    std::vector<float> inplace(in);
-    const float in_total =
-        inclusive_scan(executor(t), "fin16M", std::span<const float>(inplace), std::span(inplace), init);
-    EXPECT_EQ(std::bit_cast<std::uint32_t>(in_total), std::bit_cast<std::uint32_t>(running)) << t;
-    for (std::size_t i = 0; i < n; ++i)
-      ASSERT_EQ(std::bit_cast<std::uint32_t>(inplace[i]), std::bit_cast<std::uint32_t>(in_ref[i])) << "inclusive i=" << i << " t=" << t;
-  }
+  std::vector<float> out(n), inplace(n);
+  for (int t : kThreadCounts)
+    for_each_lane_width([&](auto w) {
+      constexpr int W = w.value;
+      std::fill(out.begin(), out.end(), 0.f);
+      const float ex_total = exclusive_scan<W>(executor(t), "fex16M", std::span<const float>(in), std::span(out), init);
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(ex_total), std::bit_cast<std::uint32_t>(running)) << "t=" << t << " W=" << W;
+      ASSERT_TRUE(same_bytes(out, ex_ref)) << "exclusive t=" << t << " W=" << W;
+      inplace = in;
+      const float in_total =
+          inclusive_scan<W>(executor(t), "fin16M", std::span<const float>(inplace), std::span(inplace), init);
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(in_total), std::bit_cast<std::uint32_t>(running)) << "t=" << t << " W=" << W;
+      ASSERT_TRUE(same_bytes(inplace, in_ref)) << "inclusive t=" << t << " W=" << W;
+    });
 }
 
 // Stable partition: the serial counting scatter (count per bucket, offsets, then every
