@@ -10,6 +10,7 @@
 
 #include "parallel/chained_pass.h"
 #include "parallel/lanes_pack.h"
+#include "parallel/scan.h"
 
 namespace speculum::par {
 
@@ -187,14 +188,12 @@ std::size_t compact_hierarchical(Executor& ex, std::string_view name,
                     }
                     chunk_steps[b0 / blocks_per_chunk] = steps;
                   });
-  // Level 2: block displacements (exclusive scan of kept counts, in output order; ROGER
-  // §4.3.3 Fig.4.8).
+  // Level 2: block displacements, the exclusive scan of the kept counts in output order
+  // (ROGER §4.3.3 Fig.4.8), by the scan primitive (n / s counts: 1M at 16M flags, s = 16).
   std::vector<std::uint32_t> displacement(blocks + 1);
-  std::size_t total = 0;
-  for (std::size_t b = 0; b < blocks; ++b) {
-    displacement[b] = std::uint32_t(total);
-    total += count[b];
-  }
+  const std::size_t total = exclusive_scan<W>(ex, launch_name(name, "block_offsets"),
+                                              std::span<const std::uint32_t>(count),
+                                              std::span(displacement).first(blocks));
   displacement[blocks] = std::uint32_t(total);
   if (out.size() < total) throw std::invalid_argument("compact_hierarchical: output span too small");
   // Concatenation as a gather: output slot k finds its block by binary search over the
