@@ -115,7 +115,7 @@ void segmented_min(Executor& ex, std::string_view name, std::span<const std::uin
   std::vector<std::uint32_t> keys(segment.begin(), segment.end());
   std::vector<std::uint32_t> order(n);
   std::iota(order.begin(), order.end(), 0u);
-  radix_sort(ex, launch_name(name, "sort"), std::span(keys), std::span(order));
+  radix_sort<W>(ex, launch_name(name, "sort"), std::span(keys), std::span(order));
   std::vector<float> sorted_value(n);
   gather(ex, launch_name(name, "gather"), value, std::span<const std::uint32_t>(order), std::span(sorted_value));
   segmented_min_sorted<W>(ex, name, keys, sorted_value, segments, min_value, min_index);
