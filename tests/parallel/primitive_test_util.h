@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "parallel/compact.h"
 #include "parallel/executor.h"
 #include "parallel/partition.h"
 #include "parallel/scan.h"
@@ -28,9 +29,10 @@ void for_each_lane_width(F&& f) {
   for (int w : kLaneWidths) dispatch_lanes(w, f);
 }
 
-// 0, 1, odd, just over a stream, scan and scatter chunk (16M cases are separate).
+// 0, 1, odd, just over a stream, scan, scatter and compaction chunk (16M cases are separate).
 inline const std::vector<std::size_t>& sizes() {
-  static const std::vector<std::size_t> s = {0, 1, 7, 12345, kStreamChunk + 1, kScanChunk + 1, kScatterChunk + 3};
+  static const std::vector<std::size_t> s = {0, 1, 7, 12345, kStreamChunk + 1, kScanChunk + 1, kScatterChunk + 3,
+                                             kCompactChunk + 1};
   return s;
 }
 
