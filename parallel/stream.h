@@ -34,18 +34,23 @@ inline std::string launch_name(std::string_view name, std::string_view phase) {
   return s;
 }
 
-// A structure-of-arrays stream: one std::vector per field, all of the same length.
+// A structure-of-arrays stream: one array per field, all of the same length.
 //   SoaStream<float, float, std::uint32_t> hits;  // t, u, primitive
 //   hits.resize(n); hits.field<0>()[i] = t;
+// Only resize changes the length, and it resizes every field: field<I>() is a span over the
+// field's elements (their values can change, their number cannot), so the fields never
+// disagree on size(). A span is invalidated by the next resize.
 template <class... Fields>
 class SoaStream {
+  static_assert(sizeof...(Fields) > 0, "SoaStream needs at least one field");
+
  public:
   std::size_t size() const { return std::get<0>(fields_).size(); }
   void resize(std::size_t n) {
     std::apply([n](auto&... f) { (f.resize(n), ...); }, fields_);
   }
-  template <std::size_t I> auto& field() { return std::get<I>(fields_); }
-  template <std::size_t I> const auto& field() const { return std::get<I>(fields_); }
+  template <std::size_t I> auto field() { return std::span(std::get<I>(fields_)); }
+  template <std::size_t I> auto field() const { return std::span(std::get<I>(fields_)); }
   // out[k] = this[index[k]] for every field (the gather that follows a compaction or sort).
   SoaStream gather(Executor& ex, std::string_view name, std::span<const std::uint32_t> index) const;
 

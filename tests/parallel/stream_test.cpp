@@ -5,12 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cstring>
 #include <memory>
 #include <numeric>
+#include <span>
 #include <thread>
+#include <type_traits>
+#include <utility>
 
 #include "primitive_test_util.h"
 
@@ -248,6 +252,11 @@ TEST(Stream, MapLanesBitIdenticalForEveryWidthAndThreadCount) {
   }
 }
 
+template <class T>
+std::vector<T> to_vector(std::span<const T> s) {
+  return {s.begin(), s.end()};
+}
+
 TEST(Stream, SoaGather) {
   SoaStream<float, std::uint32_t> s;
   s.resize(5);
@@ -258,8 +267,58 @@ TEST(Stream, SoaGather) {
   const std::vector<std::uint32_t> idx = {4, 0, 2};
   const auto g = s.gather(executor(2), "soa_gather", idx);
   ASSERT_EQ(g.size(), 3u);
-  EXPECT_EQ(g.field<0>(), (std::vector<float>{6.f, 0.f, 3.f}));
-  EXPECT_EQ(g.field<1>(), (std::vector<std::uint32_t>{104, 100, 102}));
+  EXPECT_EQ(to_vector(g.field<0>()), (std::vector<float>{6.f, 0.f, 3.f}));
+  EXPECT_EQ(to_vector(g.field<1>()), (std::vector<std::uint32_t>{104, 100, 102}));
+}
+
+// SoaStream::gather at every size class and 1/2/8 threads against a serial gather of each
+// field: fields of three element sizes, an index stream half again as long as the source
+// (repeated indices; several gather chunks past kStreamChunk), every field of the result
+// of the index stream's length. resize keeps the fields the same length when growing and
+// shrinking, and keeps the values below the new length.
+TEST(Stream, SoaGatherEverySizeAndThreadCountEqualsSerial) {
+  for (std::size_t n : sizes()) {
+    SoaStream<float, std::uint64_t, std::uint8_t> s;
+    // A field is a fixed-length view: only resize, which resizes every field, changes lengths.
+    static_assert(std::is_same_v<decltype(s.field<1>()), std::span<std::uint64_t>>);
+    static_assert(std::is_same_v<decltype(std::as_const(s).field<1>()), std::span<const std::uint64_t>>);
+    s.resize(n + 3);
+    s.resize(n);
+    ASSERT_EQ(s.size(), n);
+    ASSERT_EQ(s.field<1>().size(), n);
+    ASSERT_EQ(s.field<2>().size(), n);
+    std::vector<float> a(n);
+    std::vector<std::uint64_t> b(n);
+    std::vector<std::uint8_t> c(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      a[i] = s.field<0>()[i] = unit_float(i);
+      b[i] = s.field<1>()[i] = std::uint64_t(hash32(i + 1)) << 32 | hash32(i + 2);
+      c[i] = s.field<2>()[i] = std::uint8_t(hash32(i + 3));
+    }
+    const std::size_t m = n ? n + n / 2 : 0;
+    std::vector<std::uint32_t> idx(m);
+    for (std::size_t k = 0; k < m; ++k) idx[k] = hash32(k * 7 + 5) % std::uint32_t(n);
+    std::vector<float> ga(m);
+    std::vector<std::uint64_t> gb(m);
+    std::vector<std::uint8_t> gc(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      ga[k] = a[idx[k]];
+      gb[k] = b[idx[k]];
+      gc[k] = c[idx[k]];
+    }
+    for (int t : kThreadCounts) {
+      const auto g = s.gather(executor(t), "soa_gather", idx);
+      ASSERT_EQ(g.size(), m) << n << " t=" << t;
+      EXPECT_EQ(to_vector(g.field<0>()), ga) << n << " t=" << t;
+      EXPECT_EQ(to_vector(g.field<1>()), gb) << n << " t=" << t;
+      EXPECT_EQ(to_vector(g.field<2>()), gc) << n << " t=" << t;
+    }
+    // Shrinking keeps the leading elements of every field.
+    s.resize(n / 2);
+    ASSERT_EQ(s.field<2>().size(), n / 2);
+    EXPECT_TRUE(std::equal(c.begin(), c.begin() + std::ptrdiff_t(n / 2), s.field<2>().begin())) << n;
+    EXPECT_TRUE(std::equal(b.begin(), b.begin() + std::ptrdiff_t(n / 2), s.field<1>().begin())) << n;
+  }
 }
 
 }  // namespace
