@@ -175,7 +175,8 @@ TEST(Stream, ScansOffTheSimdPathEqualSerial) {
 }
 
 // The look-back gives the serial left fold's bits whatever the predecessors have published:
-// nothing (the sum is computed here), a sum, or a prefix (where the walk stops).
+// nothing yet (the sum is computed here), a sum, or a prefix (where the walk stops); a
+// predecessor no thread has taken is taken and done whole (take), never summed twice.
 TEST(Stream, ScanLookBackFoldsInChunkOrder) {
   using Link = detail::ScanLink<float>;
   constexpr std::size_t kChunks = 9;
@@ -188,33 +189,46 @@ TEST(Stream, ScanLookBackFoldsInChunkOrder) {
   }
   std::plus<float> op;
   std::vector<float> scratch;
-  // state[c] per pattern: 0 none, 1 sum, 2 prefix.
-  const std::uint32_t patterns[][kChunks] = {{0, 0, 0, 0, 0, 0, 0, 0, 0},
-                                              {1, 1, 1, 1, 1, 1, 1, 1, 1},
-                                              {2, 0, 1, 0, 2, 1, 0, 1, 0},
-                                              {2, 2, 2, 2, 2, 2, 2, 2, 2}};
+  constexpr std::uint32_t F = Link::kFree, C = Link::kClaimed, S = Link::kSum, P = Link::kPrefix;
+  const std::uint32_t patterns[][kChunks] = {{C, C, C, C, C, C, C, C, C},
+                                              {S, S, S, S, S, S, S, S, S},
+                                              {P, C, S, C, P, S, C, S, C},
+                                              {P, P, P, P, P, P, P, P, P},
+                                              {F, S, F, C, P, F, S, C, F}};
   for (const auto& pattern : patterns) {
-    std::unique_ptr<Link[]> links(new Link[kChunks]);
     for (std::size_t c = 0; c < kChunks; ++c) {
-      links[c].sum = sum[c];
-      links[c].prefix = prefix[c];
-      links[c].state.store(pattern[c]);
-    }
-    std::size_t computed = 0;
-    auto sum_of = [&](std::size_t c) {
-      ++computed;
-      return sum[c];
-    };
-    for (std::size_t c = 0; c < kChunks; ++c) {
-      const float offset = detail::look_back(links.get(), c, 0.25f, op, sum_of, true, scratch);
+      std::unique_ptr<Link[]> links(new Link[kChunks]);
+      for (std::size_t k = 0; k < kChunks; ++k) {
+        links[k].sum = sum[k];
+        links[k].prefix = prefix[k];
+        links[k].state.store(pattern[k]);
+      }
+      std::vector<std::size_t> computed, taken;
+      auto sum_of = [&](std::size_t k) {
+        computed.push_back(k);
+        return sum[k];
+      };
+      auto take = [&](std::size_t k) {  // what chained_pass does: the whole chunk, prefix published
+        EXPECT_EQ(links[k].state.load(), Link::kClaimed);
+        taken.push_back(k);
+        links[k].state.store(Link::kPrefix);
+      };
+      const float offset = detail::look_back(links.get(), c, 0.25f, op, sum_of, true, scratch, take);
       const float expected = c == 0 ? 0.25f : prefix[c - 1];
       EXPECT_EQ(std::bit_cast<std::uint32_t>(offset), std::bit_cast<std::uint32_t>(expected)) << c;
-    }
-    if (pattern[0] == 0) {
-      EXPECT_GT(computed, 0u);  // the missing sums were computed, not awaited
-    }
-    if (pattern[0] == 2 && pattern[1] == 2) {
-      EXPECT_EQ(computed, 0u);
+      // Walking back from c-1: claimed links are summed here, free ones taken, and the walk
+      // ends at the first prefix (a taken link publishes one).
+      std::vector<std::size_t> want_computed, want_taken;
+      for (std::size_t k = c; k-- > 0;) {
+        if (pattern[k] == F) {
+          want_taken.push_back(k);
+          break;
+        }
+        if (pattern[k] == P) break;
+        if (pattern[k] == C) want_computed.push_back(k);
+      }
+      EXPECT_EQ(computed, want_computed) << c;
+      EXPECT_EQ(taken, want_taken) << c;
     }
   }
   // In place a missing sum is awaited, never computed (its owner may already be overwriting
@@ -222,7 +236,7 @@ TEST(Stream, ScanLookBackFoldsInChunkOrder) {
   std::unique_ptr<Link[]> links(new Link[kChunks]);
   for (std::size_t c = 0; c < kChunks; ++c) {
     links[c].sum = sum[c];
-    links[c].state.store(c == 3 ? 0u : 1u);
+    links[c].state.store(c == 3 ? C : S);
   }
   std::size_t computed = 0;
   auto sum_of = [&](std::size_t c) {
@@ -231,9 +245,10 @@ TEST(Stream, ScanLookBackFoldsInChunkOrder) {
   };
   std::thread owner([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    links[3].state.store(1u, std::memory_order_release);
+    links[3].state.store(S, std::memory_order_release);
   });
-  const float offset = detail::look_back(links.get(), 6, 0.25f, op, sum_of, false, scratch);
+  const float offset = detail::look_back(links.get(), 6, 0.25f, op, sum_of, false, scratch,
+                                         [](std::size_t) { ADD_FAILURE() << "no link is free"; });
   owner.join();
   EXPECT_EQ(std::bit_cast<std::uint32_t>(offset), std::bit_cast<std::uint32_t>(prefix[5]));
   EXPECT_EQ(computed, 0u);
