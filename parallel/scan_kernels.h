@@ -163,7 +163,7 @@ T scan_streaming(const T* in, T* out, std::size_t m, T acc, Op& op) {
 
 // Scans in[0, m) from `offset` into out[0, m) (out may equal in) with lane width W.
 // Streaming: full output lines bypass the caches (followed by a store fence, so the join
-// publishes them), and the `next_count` elements at `next` (the thread's likely next chunk,
+// publishes them). The `next_count` elements at `next` (the thread's likely next chunk,
 // none when null) are prefetched into L2 during the scan.
 template <int W, bool Inclusive, class T, class Op>
 void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool streaming,
@@ -172,7 +172,7 @@ void chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool strea
     const auto* i32 = reinterpret_cast<const std::uint32_t*>(in);
     auto* o32 = reinterpret_cast<std::uint32_t*>(out);
     detail::Prefetch prefetch;
-    if (streaming && next != nullptr) {
+    if (next != nullptr) {
       prefetch.next = reinterpret_cast<const char*>(next);
       prefetch.end = reinterpret_cast<const char*>(next + next_count);
     }
