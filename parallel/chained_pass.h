@@ -69,7 +69,7 @@ T look_back(ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum_of, b
       s = links[j].state.load(std::memory_order_acquire);  // kPrefix
     }
     bool compute = false;
-    for (unsigned spin = 0; s < Link::kSum && !compute; ++spin) {
+    for (unsigned spin = 0; s < Link::kSum; ++spin) {
       if (spin < kScanPatience) {
         scan_kernels::cpu_relax();
       } else if (may_compute) {
@@ -112,22 +112,27 @@ T chained_pass(Executor& ex, std::string_view name, std::string_view phase, std:
   std::unique_ptr<Link[]> links(new Link[chunks]);
   const std::size_t workers = std::min<std::size_t>(std::size_t(ex.threads()), chunks);
   // Does chunk c, which this thread has claimed; look-back may do a predecessor first.
-  auto process = [&](auto& self, std::size_t c) -> void {
+  // `sums` is look-back scratch: one per worker, reused for every chunk it does; a
+  // predecessor taken inside a look-back (rare: its worker is behind) gets its own, since the
+  // outer look-back still holds its sums.
+  auto process = [&](auto& self, std::size_t c, std::vector<T>& sums) -> void {
     Link& link = links[c];
     link.sum = sum_of(c);
     link.state.store(Link::kSum, std::memory_order_release);
-    std::vector<T> sums;
-    const T offset = detail::look_back(links.get(), c, init, op, sum_of, may_compute, sums,
-                                       [&](std::size_t j) { self(self, j); });
+    const T offset = detail::look_back(links.get(), c, init, op, sum_of, may_compute, sums, [&](std::size_t j) {
+      std::vector<T> inner;
+      self(self, j, inner);
+    });
     link.prefix = op(offset, link.sum);
     link.state.store(Link::kPrefix, std::memory_order_release);
     finish(c, offset, link.sum, workers);
   };
   ex.run_workers(launch_name(name, phase), workers, n, chunks, [&](std::size_t w) {
+    std::vector<T> sums;
     for (std::size_t c = w; c < chunks; c += workers)
-      if (links[c].claim()) process(process, c);
+      if (links[c].claim()) process(process, c, sums);
     for (std::size_t c = 0; c < chunks; ++c)  // chunks of workers that are behind
-      if (links[c].claim()) process(process, c);
+      if (links[c].claim()) process(process, c, sums);
   });
   return links[chunks - 1].prefix;
 }

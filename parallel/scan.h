@@ -36,7 +36,7 @@ namespace detail {
 // read, already cached: plain stores cost no extra read there, and streaming stores, which
 // must first evict those lines, measured slower (16M u32 in-place inclusive, interleaved
 // runs: 1T 3.2-4.0 ms and 2T 3.1-3.4 ms streaming against 2.55-2.72 and 2.16-2.43 plain).
-inline constexpr std::size_t kScanStreamingBytes = std::size_t(8) << 20;
+inline constexpr std::size_t kScanUncachedBytes = std::size_t(8) << 20;
 
 template <int W, bool Inclusive, class T, class Op>
 T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out, T init, Op op,
@@ -46,7 +46,7 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   if (chunk == 0) chunk = 1;
   const std::size_t chunks = Executor::chunk_count(n, chunk);
   if (chunks == 0) return init;
-  const bool big = n * sizeof(T) >= kScanStreamingBytes;
+  const bool big = n * sizeof(T) >= kScanUncachedBytes;
   const T* const src = in.data();
   T* const dst = out.data();
   auto sum_of = [&](std::size_t c) {
@@ -58,9 +58,10 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   const bool streaming = big && !in_place;
   return chained_pass(ex, name, "chained_scan", n, chunks, init, op, sum_of, !in_place,
                       [&](std::size_t c, T offset, T, std::size_t workers) {
-                        // This thread's next chunk is most likely c + workers: the kernel
-                        // prefetches it while it scans (a prefetch reads nothing in the memory
-                        // model, so a wrong guess only wastes bandwidth).
+                        // This thread's next chunk is c + workers (chained_pass.h's order)
+                        // unless another thread takes it first: the kernel prefetches it while
+                        // it scans (a prefetch reads nothing in the memory model, so a chunk
+                        // taken by another thread only costs bandwidth).
                         const std::size_t b = c * chunk, guess = std::min(n, (c + workers) * chunk);
                         scan_kernels::chunk_scan<W, Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b,
                                                                offset, op, streaming, big ? src + guess : nullptr,
