@@ -55,7 +55,8 @@ inline constexpr unsigned kScanPatience = 1024;
 // awaited for kScanPatience polls and then summed here too (`may_compute`); in place
 // (`may_compute` false) it is awaited however long it takes: its owner may publish the sum
 // and start overwriting the chunk's input while this thread would still be reading it.
-// Waits end: a taken chunk's owner publishes its sum before it waits on anyone.
+// Waits end: the owner of a claimed chunk is summing it or doing a lower chunk, and waits
+// only on chunks below that (chained_pass).
 template <class T, class Op, class SumOf, class Take>
 T look_back(ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum_of, bool may_compute,
             std::vector<T>& sums, Take&& take) {
@@ -76,7 +77,7 @@ T look_back(ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum_of, b
         compute = true;
         break;
       } else {
-        std::this_thread::yield();  // the owner sums without waiting on anyone: it will publish
+        std::this_thread::yield();  // the owner waits only on lower chunks: it will publish
       }
       s = links[j].state.load(std::memory_order_acquire);
     }
@@ -92,18 +93,25 @@ T look_back(ScanLink<T>* links, std::size_t c, T init, Op& op, SumOf&& sum_of, b
 
 }  // namespace detail
 
+// finish's `next` when the calling thread has no next chunk to sum.
+inline constexpr std::size_t kNoChunk = ~std::size_t(0);
+
 // Runs the chained pass over the `chunks` chunks of `n` elements as one launch
 // "<name>/<phase>" (recorded with n and chunks, whatever the thread count): for every chunk
-// c, sum_of(c) (the chunk's ⊕-sum; called again by look-back for a slow predecessor when
-// may_compute), then finish(c, offset, sum, workers) with offset = init ⊕ sums of chunks [0, c)
-// and sum = sum_of(c). Returns init ⊕ every sum (init when chunks == 0).
-// Worker w takes chunks w, w + workers, w + 2·workers, ... in order, so finish knows the chunk
-// its thread does next (c + workers) and can prefetch it; a chunk whose worker has not
-// reached it is taken by whoever needs it first (look-back) or runs out of its own chunks.
-// A shared next-chunk counter instead made that guess wrong for 4-5 % of the chunks at 2
-// threads (16M u32 scan): each miss reads a chunk from memory and wastes a prefetched one.
+// c its ⊕-sum, then finish(c, offset, sum, next) with offset = init ⊕ sums of chunks [0, c)
+// and sum = the chunk's sum. Returns init ⊕ every sum (init when chunks == 0).
+// Worker w does chunks w, w + workers, w + 2·workers, ... in order. Before finishing chunk c
+// it claims its next one, c + workers, and finish returns that chunk's sum (`next`;
+// kNoChunk when there is none, and then finish returns anything): a scan reduces its next
+// chunk while it writes this one, so the next chunk's read from memory overlaps this one's
+// writes, as a copy's do. The pass publishes that sum at once, a round before the next
+// chunk's own look-back needs it. The first chunk of each worker, and any chunk whose worker
+// has not reached it (taken by a look-back that needs it, or by a worker that has run out of
+// chunks), gets its sum from sum_of(c), which look-back also calls for a slow predecessor
+// when may_compute. Both ways must give the same bits.
 // may_compute false (in place): a slow predecessor's sum is awaited, never computed (see
-// look_back).
+// look_back). Waits end: a thread waits only on chunks below the one it is doing, and the
+// chunk it has claimed ahead gets its sum as soon as that one is done.
 template <class T, class Op, class SumOf, class Finish>
 T chained_pass(Executor& ex, std::string_view name, std::string_view phase, std::size_t n, std::size_t chunks,
                T init, Op& op, SumOf&& sum_of, bool may_compute, Finish&& finish) {
@@ -111,28 +119,39 @@ T chained_pass(Executor& ex, std::string_view name, std::string_view phase, std:
   using Link = detail::ScanLink<T>;
   std::unique_ptr<Link[]> links(new Link[chunks]);
   const std::size_t workers = std::min<std::size_t>(std::size_t(ex.threads()), chunks);
-  // Does chunk c, which this thread has claimed; look-back may do a predecessor first.
+  // Does chunk c, which this thread has claimed (its sum already published when `summed`);
+  // with `chain`, claims c + workers too and publishes its sum, and returns whether it did.
   // `sums` is look-back scratch: one per worker, reused for every chunk it does; a
   // predecessor taken inside a look-back (rare: its worker is behind) gets its own, since the
   // outer look-back still holds its sums.
-  auto process = [&](auto& self, std::size_t c, std::vector<T>& sums) -> void {
+  auto process = [&](auto& self, std::size_t c, bool summed, bool chain, std::vector<T>& sums) -> bool {
     Link& link = links[c];
-    link.sum = sum_of(c);
-    link.state.store(Link::kSum, std::memory_order_release);
+    if (!summed) {
+      link.sum = sum_of(c);
+      link.state.store(Link::kSum, std::memory_order_release);
+    }
     const T offset = detail::look_back(links.get(), c, init, op, sum_of, may_compute, sums, [&](std::size_t j) {
       std::vector<T> inner;
-      self(self, j, inner);
+      self(self, j, false, false, inner);
     });
     link.prefix = op(offset, link.sum);
     link.state.store(Link::kPrefix, std::memory_order_release);
-    finish(c, offset, link.sum, workers);
+    const std::size_t next = c + workers;
+    const bool chained = chain && next < chunks && links[next].claim();
+    const T next_sum = finish(c, offset, link.sum, chained ? next : kNoChunk);
+    if (chained) {
+      links[next].sum = next_sum;
+      links[next].state.store(Link::kSum, std::memory_order_release);
+    }
+    return chained;
   };
   ex.run_workers(launch_name(name, phase), workers, n, chunks, [&](std::size_t w) {
     std::vector<T> sums;
+    bool summed = false;  // this worker has claimed chunk c and published its sum
     for (std::size_t c = w; c < chunks; c += workers)
-      if (links[c].claim()) process(process, c, sums);
+      summed = (summed || links[c].claim()) && process(process, c, summed, true, sums);
     for (std::size_t c = 0; c < chunks; ++c)  // chunks of workers that are behind
-      if (links[c].claim()) process(process, c, sums);
+      if (links[c].claim()) process(process, c, false, false, sums);
   });
   return links[chunks - 1].prefix;
 }

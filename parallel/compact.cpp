@@ -77,10 +77,11 @@ std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const
     // flags, takes its output offset by look-back, and scatters while its flags are cached.
     std::plus<std::uint32_t> plus;
     return chained_pass(ex, name, "chained_scatter", n, chunks, std::uint32_t(0), plus, count_of, true,
-                        [&](std::size_t c, std::uint32_t offset, std::uint32_t count, std::size_t) {
+                        [&](std::size_t c, std::uint32_t offset, std::uint32_t count, std::size_t next) {
                           const std::size_t b = c * chunk;
                           scatter_kept<W>(keep.data(), b, std::min(n, b + chunk), out.data() + offset,
                                           out.data() + offset + count);
+                          return next == kNoChunk ? 0u : count_of(next);
                         });
   }
   // A short output may be too small: count everything first, so that nothing is written

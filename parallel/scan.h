@@ -1,7 +1,8 @@
 // Exclusive and inclusive scan over the Executor in one pass over memory (single-pass
 // chained scan with decoupled look-back, DESIGN.md "Stream constraints"): each fixed chunk
-// is reduced, gets its offset from the prefixes its predecessors publish, and is scanned
-// again from cache; big outputs other than the input go out with streaming stores. The
+// is reduced (during its thread's previous chunk's scan), gets its offset from the prefixes
+// its predecessors publish, and is scanned again from cache; big outputs other than the
+// input go out with streaming stores. The
 // association (chunk sums folded in chunk order from init) is fixed, so results are the
 // same for any thread count, lane width and timing, floats included.
 #pragma once
@@ -28,11 +29,10 @@ inline constexpr std::size_t kScanChunk = std::size_t(1) << 15;
 
 namespace detail {
 
-// Scans at least this large do not fit the caches: each chunk prefetches the thread's next
-// one while it scans, and an output that is not the input bypasses the caches (streaming
-// stores): it cannot stay cached for the next kernel anyway, and a cached store would first
-// read every output line from memory (read-for-ownership), a third memory stream beside
-// the input read and the write. In place the output lines are the ones the chunk has just
+// Scans at least this large do not fit the caches: an output that is not the input bypasses
+// them (streaming stores). It cannot stay cached for the next kernel anyway, and a cached
+// store would first read every output line from memory (read-for-ownership), a third memory
+// stream beside the input read and the write. In place the output lines are the ones the chunk has just
 // read, already cached: plain stores cost no extra read there, and streaming stores, which
 // must first evict those lines, measured slower (16M u32 in-place inclusive, interleaved
 // runs: 1T 3.2-4.0 ms and 2T 3.1-3.4 ms streaming against 2.55-2.72 and 2.16-2.43 plain).
@@ -57,15 +57,11 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   const bool in_place = addr(src) < addr(dst + n) && addr(dst) < addr(src + n);
   const bool streaming = big && !in_place;
   return chained_pass(ex, name, "chained_scan", n, chunks, init, op, sum_of, !in_place,
-                      [&](std::size_t c, T offset, T, std::size_t workers) {
-                        // This thread's next chunk is c + workers (chained_pass.h's order)
-                        // unless another thread takes it first: the kernel prefetches it while
-                        // it scans (a prefetch reads nothing in the memory model, so a chunk
-                        // taken by another thread only costs bandwidth).
-                        const std::size_t b = c * chunk, guess = std::min(n, (c + workers) * chunk);
-                        scan_kernels::chunk_scan<W, Inclusive>(src + b, dst + b, std::min(n, b + chunk) - b,
-                                                               offset, op, streaming, big ? src + guess : nullptr,
-                                                               std::min(n, guess + chunk) - guess);
+                      [&](std::size_t c, T offset, T, std::size_t next) {
+                        const std::size_t b = c * chunk, nb = next == kNoChunk ? 0 : next * chunk;
+                        return scan_kernels::chunk_scan<W, Inclusive>(
+                            src + b, dst + b, std::min(n, b + chunk) - b, offset, op, streaming,
+                            next == kNoChunk ? nullptr : src + nb, next == kNoChunk ? 0 : std::min(n, nb + chunk) - nb);
                       });
 }
 

@@ -174,6 +174,52 @@ TEST(Stream, ScansOffTheSimdPathEqualSerial) {
   }
 }
 
+// The chunk kernel scans its chunk and returns the sum of the thread's next chunk, which it
+// reads during the scan (scan_kernels.h): both checked against serial references at every
+// width, for chunks shorter and longer than a step, an output off its 64-byte line (the
+// streaming head), a shorter next chunk (the last one) and none, with and without streaming.
+TEST(Stream, ChunkScanSumsTheNextChunkAtEveryWidth) {
+  constexpr std::size_t kMax = 5000;
+  std::vector<std::uint32_t> in(kMax), next(kMax);
+  for (std::size_t i = 0; i < kMax; ++i) {
+    in[i] = hash32(i);
+    next[i] = hash32(i + kMax);
+  }
+  alignas(64) static std::uint32_t out[kMax + 16];
+  std::vector<std::uint32_t> ref(kMax);
+  std::plus<std::uint32_t> op;
+  for_each_lane_width([&](auto w) {
+    constexpr int W = decltype(w)::value;
+    for (std::size_t m : {std::size_t(1), std::size_t(15), std::size_t(33), std::size_t(4096), std::size_t(4999)})
+      for (std::size_t next_m : {std::size_t(0), std::size_t(1), m / 3 + 1, m})
+        for (std::size_t shift : {std::size_t(0), std::size_t(5)})
+          for (bool streaming : {false, true})
+            for (bool inclusive : {false, true}) {
+              std::uint32_t* o = out + shift;
+              const std::uint32_t* nx = next_m == 0 ? nullptr : next.data();
+              const std::uint32_t sum = inclusive
+                  ? scan_kernels::chunk_scan<W, true>(in.data(), o, m, 9u, op, streaming, nx, next_m)
+                  : scan_kernels::chunk_scan<W, false>(in.data(), o, m, 9u, op, streaming, nx, next_m);
+              if (inclusive) std::inclusive_scan(in.begin(), in.begin() + m, ref.begin(), op, 9u);
+              else std::exclusive_scan(in.begin(), in.begin() + m, ref.begin(), 9u);
+              const auto where = ::testing::Message() << "W=" << W << " m=" << m << " next_m=" << next_m
+                                                      << " shift=" << shift << " streaming=" << streaming
+                                                      << " inclusive=" << inclusive;
+              ASSERT_TRUE(std::equal(ref.begin(), ref.begin() + m, o)) << where;
+              ASSERT_EQ(sum, std::accumulate(next.begin(), next.begin() + next_m, 0u)) << where;
+            }
+  });
+  // Off the lane path (a float sum) the next chunk's sum is the serial left fold.
+  std::vector<float> fin(100), fnext(37), fout(100);
+  for (std::size_t i = 0; i < fin.size(); ++i) fin[i] = unit_float(i);
+  for (std::size_t i = 0; i < fnext.size(); ++i) fnext[i] = unit_float(i + 500);
+  std::plus<float> fop;
+  const float fsum = scan_kernels::chunk_scan<8, true>(fin.data(), fout.data(), fin.size(), 0.5f, fop, false,
+                                                       fnext.data(), fnext.size());
+  EXPECT_EQ(std::bit_cast<std::uint32_t>(fsum),
+            std::bit_cast<std::uint32_t>(std::accumulate(fnext.begin() + 1, fnext.end(), fnext[0])));
+}
+
 // The look-back gives the serial left fold's bits whatever the predecessors have published:
 // nothing yet (the sum is computed here), a sum, or a prefix (where the walk stops); a
 // predecessor no thread has taken is taken and done whole (take), never summed twice.
