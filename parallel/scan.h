@@ -2,9 +2,9 @@
 // chained scan with decoupled look-back, DESIGN.md "Stream constraints"): each fixed chunk
 // is reduced (during its thread's previous chunk's scan), gets its offset from the prefixes
 // its predecessors publish, and is scanned again from cache; big outputs other than the
-// input go out with streaming stores. The
-// association (chunk sums folded in chunk order from init) is fixed, so results are the
-// same for any thread count, lane width and timing, floats included.
+// input go out with streaming stores. The association (chunk sums folded in chunk order
+// from init) is fixed, so results are the same for any thread count, lane width and timing,
+// floats included.
 #pragma once
 
 #include <algorithm>
@@ -32,10 +32,11 @@ namespace detail {
 // Scans at least this large do not fit the caches: an output that is not the input bypasses
 // them (streaming stores). It cannot stay cached for the next kernel anyway, and a cached
 // store would first read every output line from memory (read-for-ownership), a third memory
-// stream beside the input read and the write. In place the output lines are the ones the chunk has just
-// read, already cached: plain stores cost no extra read there, and streaming stores, which
-// must first evict those lines, measured slower (16M u32 in-place inclusive, interleaved
-// runs: 1T 3.2-4.0 ms and 2T 3.1-3.4 ms streaming against 2.55-2.72 and 2.16-2.43 plain).
+// stream beside the input read and the write. In place the output lines are the ones the
+// chunk has just read, already cached: plain stores cost no extra read there, and streaming
+// stores, which must first evict those lines, measured slower (16M u32 in-place inclusive,
+// interleaved runs: 1T 3.2-4.0 ms and 2T 3.1-3.4 ms streaming against 2.55-2.72 and
+// 2.16-2.43 plain).
 inline constexpr std::size_t kScanUncachedBytes = std::size_t(8) << 20;
 
 template <int W, bool Inclusive, class T, class Op>
