@@ -82,8 +82,9 @@ T scan_scalar(const T* in, T* out, std::size_t m, T acc, Op& op) {
 // Bytes a scan reading its next chunk prefetches ahead of its loads. The reads of the next
 // chunk are demand loads spread over this chunk's scan; without prefetching, only the few
 // dozen lines the out-of-order window holds are in flight and one thread reads at 2/3 of a
-// copy's rate. Interleaved runs, 16M u32 exclusive, 1T: 2048 B 3.70 ms, 4096 B 3.02,
-// 8192 B 2.58-2.64, 16384 B 3.08, 32768 B 2.83 (same-run copy 2.6-2.9).
+// copy's rate. 16M u32 exclusive, about 400 interleaved samples per distance, mean of the
+// sample medians: 4, 8, 16 and 32 KiB gave 1T 3.10, 2.77, 2.80 and 3.12 ms, and 2T (in the
+// host's high-bandwidth state) 1.74, 1.59, 1.65 and 1.78 ms.
 inline constexpr std::size_t kNextPrefetchBytes = 8192;
 
 // One step of the 32-bit sum scan: out[k, k + 2W) from in[k, k + 2W) and the running carry
