@@ -121,15 +121,15 @@ template <int W, bool Inclusive, bool Streaming>
 // `next`, null for none) at the same indices: the loads of the next chunk and the stores of
 // this one are then one read stream and one write stream, as in a copy, where reducing the
 // next chunk separately, its lines prefetched during this scan, left the memory idle while
-// it ran (16M u32 exclusive, alternating runs, 1T 2.88-2.94 ms before, 2.47-2.54 after).
+// it ran (16M u32 exclusive, 1T, alternating runs: 2.62-2.71 ms before, 2.37-2.63 after).
 // Streaming: the output is written from its first 64-byte line boundary with stream_store
 // (aligned for every W). Returns the next chunk's sum.
 // Flattened: in a translation unit with many kernels GCC stopped inlining the W = 16 lane
 // split (stdx::split, eight calls per step). 16M u32 exclusive, 1T, W = 16 in the benchmark
 // binary: 11.5 ms without, 2.50 with (W = 8: 2.37).
 template <int W, bool Inclusive, bool Streaming>
-[[gnu::flatten]] std::uint32_t scan_sum32(const std::uint32_t* in, std::uint32_t* out, std::size_t m, std::uint32_t acc,
-                         const std::uint32_t* next, std::size_t next_m) {
+[[gnu::flatten]] std::uint32_t scan_sum32(const std::uint32_t* in, std::uint32_t* out, std::size_t m,
+                                          std::uint32_t acc, const std::uint32_t* next, std::size_t next_m) {
   using L = Lanes<W>;
   using V = LaneU32<W>;
   constexpr std::size_t kStep = 2 * W;
@@ -162,7 +162,7 @@ template <int W, bool Inclusive, bool Streaming>
   for (; i + kStep <= m; i += kStep) scan_step32<W, Inclusive, Streaming>(in, out, i, carry);
   scan_scalar<Inclusive>(in + i, out + i, m - i, std::uint32_t(carry[0]), plus);
   // Through an array: L::hadd takes a reference, and GCC then keeps next_lanes in memory
-  // through the loop (a store and a reload per step: the kernel took 30 % longer).
+  // through the loop (a store and a reload per step: the kernel took a third longer).
   alignas(64) std::uint32_t next_lane_sums[W];
   next_lanes.copy_to(next_lane_sums, stdx::vector_aligned);
   std::uint32_t next_sum = 0;
@@ -192,8 +192,8 @@ T scan_streaming(const T* in, T* out, std::size_t m, T acc, Op& op) {
 
 // Scans in[0, m) from `offset` into out[0, m) (out may equal in) with lane width W, and
 // returns the sum of the `next_m` elements at `next` (the chunk the thread does next; T{}
-// when null), the same bits as chunk_sum<W>(next, next_m). Streaming: full output lines
-// bypass the caches (followed by a store fence, so the join publishes them).
+// when null or empty), the same bits as chunk_sum<W>(next, next_m). Streaming: full output
+// lines bypass the caches (followed by a store fence, so the join publishes them).
 template <int W, bool Inclusive, class T, class Op>
 T chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool streaming, const T* next = nullptr,
              std::size_t next_m = 0) {
@@ -217,7 +217,7 @@ T chunk_scan(const T* in, T* out, std::size_t m, T offset, Op& op, bool streamin
       }
     }
     if (!streamed) detail::scan_scalar<Inclusive>(in, out, m, offset, op);
-    return next != nullptr ? chunk_sum<W>(next, next_m, op) : T{};
+    return next != nullptr && next_m > 0 ? chunk_sum<W>(next, next_m, op) : T{};
   }
 }
 
