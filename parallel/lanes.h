@@ -199,10 +199,16 @@ struct Lanes {
   }
   // Sum of the lanes in lane order ((v0 + v1) + v2) + ...: ORDER-SENSITIVE for floats — see
   // the header comment; use accumulate() to sum a stream identically for every W.
+  // Through an array: reading the lanes one by one made GCC keep the caller's accumulator
+  // in memory through its whole loop (a store and a reload per step: the fused scan kernel
+  // took a third longer).
   template <class T>
   static T hadd(const stdx::fixed_size_simd<T, W>& v) {
-    T r = v[0];
-    for (int i = 1; i < W; ++i) r = r + T(v[i]);
+    using V = stdx::fixed_size_simd<T, W>;
+    alignas(stdx::memory_alignment_v<V>) T lanes[W];
+    v.copy_to(lanes, stdx::vector_aligned);
+    T r = lanes[0];
+    for (int i = 1; i < W; ++i) r = r + lanes[i];
     return r;
   }
   // acc + v[0] + v[1] + ... over active lanes, in lane order: a serial element-order fold,

@@ -47,22 +47,19 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
   if (chunk == 0) chunk = 1;
   const std::size_t chunks = Executor::chunk_count(n, chunk);
   if (chunks == 0) return init;
-  const bool big = n * sizeof(T) >= kScanUncachedBytes;
   const T* const src = in.data();
   T* const dst = out.data();
-  auto sum_of = [&](std::size_t c) {
-    const std::size_t b = c * chunk;
-    return scan_kernels::chunk_sum<W>(src + b, std::min(n, b + chunk) - b, op);
-  };
+  const auto length = [&](std::size_t c) { return std::min(n, (c + 1) * chunk) - c * chunk; };
+  auto sum_of = [&](std::size_t c) { return scan_kernels::chunk_sum<W>(src + c * chunk, length(c), op); };
   const auto addr = [](const T* p) { return reinterpret_cast<std::uintptr_t>(p); };
   const bool in_place = addr(src) < addr(dst + n) && addr(dst) < addr(src + n);
-  const bool streaming = big && !in_place;
+  const bool streaming = n * sizeof(T) >= kScanUncachedBytes && !in_place;
   return chained_pass(ex, name, "chained_scan", n, chunks, init, op, sum_of, !in_place,
                       [&](std::size_t c, T offset, T, std::size_t next) {
-                        const std::size_t b = c * chunk, nb = next == kNoChunk ? 0 : next * chunk;
+                        const bool has_next = next != kNoChunk;
                         return scan_kernels::chunk_scan<W, Inclusive>(
-                            src + b, dst + b, std::min(n, b + chunk) - b, offset, op, streaming,
-                            next == kNoChunk ? nullptr : src + nb, next == kNoChunk ? 0 : std::min(n, nb + chunk) - nb);
+                            src + c * chunk, dst + c * chunk, length(c), offset, op, streaming,
+                            has_next ? src + next * chunk : nullptr, has_next ? length(next) : 0);
                       });
 }
 

@@ -161,12 +161,7 @@ template <int W, bool Inclusive, bool Streaming>
   const std::size_t summed_end = i;  // next[head, summed_end) is in next_lanes
   for (; i + kStep <= m; i += kStep) scan_step32<W, Inclusive, Streaming>(in, out, i, carry);
   scan_scalar<Inclusive>(in + i, out + i, m - i, std::uint32_t(carry[0]), plus);
-  // Through an array: L::hadd takes a reference, and GCC then keeps next_lanes in memory
-  // through the loop (a store and a reload per step: the kernel took a third longer).
-  alignas(64) std::uint32_t next_lane_sums[W];
-  next_lanes.copy_to(next_lane_sums, stdx::vector_aligned);
-  std::uint32_t next_sum = 0;
-  for (std::uint32_t s : next_lane_sums) next_sum += s;
+  std::uint32_t next_sum = L::hadd(next_lanes);
   for (std::size_t k = 0; k < std::min(head, next_m); ++k) next_sum += next[k];
   for (std::size_t k = std::max(head, summed_end); k < next_m; ++k) next_sum += next[k];
   return next_sum;
