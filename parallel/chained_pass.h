@@ -1,9 +1,9 @@
-// The single-pass chained form shared by the scan and the scatter compaction (DESIGN.md
-// "Stream constraints"): each chunk computes its sum and publishes it, finds its offset by
-// decoupled look-back over what its predecessors published, publishes its inclusive prefix,
-// and then does its own output work from that offset — one launch, each input chunk read
-// from memory once. The offset is the serial left fold of the chunk sums in chunk order, so
-// it has the same bits for any thread count, schedule and timing.
+// The single-pass chained form shared by the scan and the scatter compaction: each chunk
+// computes its sum and publishes it, finds its offset by decoupled look-back over what its
+// predecessors published, publishes its inclusive prefix, and then does its own output work
+// from that offset — one launch, each input chunk read from memory once. The offset is the
+// serial left fold of the chunk sums in chunk order, so it has the same bits for any thread
+// count, schedule and timing.
 #pragma once
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // Stream compaction: scan + scatter, and ROGER ch.4 hierarchical gather-only compaction
-// (TECHNIQUES.md §4.3; ROGER Fig.4.7 search, Fig.4.8 block displacements). Every kernel is
+// (ROGER §4.3.2 Fig.4.7 search, §4.3.3 Fig.4.8 block displacements). Every kernel is
 // written once over Lanes<W> (lanes.h, lanes_stream.h) and instantiated for W = 1, 4, 8, 16;
 // all of them are integer work, so every W gives the same indices.
 #include "parallel/compact.h"

@@ -1,5 +1,5 @@
 // Stream compaction in two forms: scan + scatter, and the gather-only hierarchical block
-// algorithm of ROGER ch.4 (TECHNIQUES.md §4.3; ROGER §4.3.2 Fig.4.7, §4.3.3 Fig.4.8).
+// algorithm of ROGER ch.4 (ROGER §4.3.2 Fig.4.7, §4.3.3 Fig.4.8).
 // Both are stable (order-preserving) and return the indices of the kept elements; gather
 // the payload streams with those indices (SoaStream::gather / par::gather).
 #pragma once
@@ -13,7 +13,7 @@
 
 namespace speculum::par {
 
-// Counters of one hierarchical compaction (bounded-loop accounting, DESIGN.md).
+// Counters of one hierarchical compaction (every bounded loop's work is counted).
 struct HierarchicalCompactStats {
   std::uint64_t blocks = 0;
   std::uint64_t search_steps = 0;  // psum probes of the Fig.4.7 search, summed over outputs

@@ -1,6 +1,7 @@
 // The executor: named, timed data-parallel launches on oneTBB over fixed-size chunks.
 // Chunk boundaries never depend on the thread count, so any kernel whose chunks write
-// disjoint outputs is deterministic for every thread count (DESIGN.md "Determinism").
+// disjoint outputs is deterministic for every thread count (docs/architecture.md,
+// "Determinism").
 #pragma once
 
 #include <chrono>

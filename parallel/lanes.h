@@ -1,5 +1,6 @@
 // Lanes<W>: fixed-width SIMD lanes over std::experimental::simd, W ∈ {1, 4, 8, 16}, and the
-// run-time lane-width dispatcher behind `--lanes W` (DESIGN.md "Stream constraints").
+// run-time lane-width dispatcher behind `--lanes W` (docs/architecture.md, "Stream
+// constraints").
 //
 // Kernels are written once as templates on W and must give the same bits for every W.
 // Element-wise IEEE operations (+ - * /, sqrt, compares, min/max/abs/select as defined

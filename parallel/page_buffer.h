@@ -1,5 +1,5 @@
 // A cache-line-aligned scratch area backed by transparent huge pages where the kernel
-// allows them (madvise), for scatter targets (DESIGN.md "Stream constraints": scatter cost).
+// allows them (madvise), for the scatter targets of the stream primitives.
 // A radix scatter writes to thousands of places at once; on 4 KiB pages nearly every line
 // flush goes to a page the TLB does not hold, on 2 MiB pages it does.
 #pragma once

@@ -1,5 +1,5 @@
 // Exclusive and inclusive scan over the Executor in one pass over memory (single-pass
-// chained scan with decoupled look-back, DESIGN.md "Stream constraints"): each fixed chunk
+// chained scan with decoupled look-back, see chained_pass.h): each fixed chunk
 // is reduced (during its thread's previous chunk's scan), gets its offset from the prefixes
 // its predecessors publish, and is scanned again from cache; big outputs other than the
 // input go out with streaming stores. The association (chunk sums folded in chunk order

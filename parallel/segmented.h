@@ -1,6 +1,6 @@
-// Segmented min/argmin (the closest hit per ray) and histogram (DESIGN.md "Stream
-// constraints": scatter only through primitives). Ties go to the lowest element index, so
-// results equal a serial loop for any thread count.
+// Segmented min/argmin (the closest hit per ray) and histogram: two of the primitives
+// through which alone kernels scatter (docs/architecture.md, "Stream constraints"). Ties go
+// to the lowest element index, so results equal a serial loop for any thread count.
 #pragma once
 
 #include <cstdint>

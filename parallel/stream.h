@@ -1,5 +1,6 @@
 // Streams and the element-wise primitives over them: SoA streams, map (scalar and over
-// Lanes<W>), gather and chunk-order reduce (DESIGN.md "Stream constraints", "Determinism").
+// Lanes<W>), gather and chunk-order reduce (docs/architecture.md, "Stream constraints" and
+// "Determinism").
 // Every primitive runs on the Executor over chunks of a fixed size (kStreamChunk by
 // default) that never depends on the thread count, so results are bit-identical for any
 // thread count; launch names are "<name>/<phase>".
