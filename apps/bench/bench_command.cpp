@@ -1,8 +1,8 @@
 // `speculum bench`: the parent of the benchmark subcommands (`bench trace`, and `bench
 // raster` from the raster helper). Each child registers itself from its own cmd_bench_*.cpp
-// through an add_bench_*_subcommand(bench, global) declared in apps/cli.h: to add one,
+// through an add_bench_*_subcommand(bench, global) declared in apps/cli/commands.h: to add one,
 // declare it there and call it below.
-#include "apps/cli.h"
+#include "apps/cli/commands.h"
 
 namespace speculum::cli {
 

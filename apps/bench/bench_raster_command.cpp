@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "apps/cli.h"
-#include "apps/pipeline_bench_workloads.h"
-#include "apps/pipeline_camera_options.h"
+#include "apps/cli/commands.h"
+#include "apps/bench/bench_workloads.h"
+#include "apps/cli/camera_options.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
 #include "parallel/lanes.h"

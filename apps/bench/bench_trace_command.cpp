@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "apps/cli.h"
-#include "apps/pipeline_camera_options.h"
+#include "apps/cli/commands.h"
+#include "apps/cli/camera_options.h"
 #include "core/error.h"
 #include "core/sampling.h"
 #include "core/scene_loader.h"

@@ -1,5 +1,5 @@
-// Yardstick workloads for `bench raster`: see pipeline_bench_workloads.h.
-#include "apps/pipeline_bench_workloads.h"
+// Yardstick workloads for `bench raster`: see bench_workloads.h.
+#include "apps/bench/bench_workloads.h"
 
 #include <cstdint>
 #include <cstdio>

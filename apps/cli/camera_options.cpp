@@ -1,5 +1,5 @@
-// Camera selection options: see pipeline_camera_options.h.
-#include "apps/pipeline_camera_options.h"
+// Camera selection options: see camera_options.h.
+#include "apps/cli/camera_options.h"
 
 #include <cmath>
 #include <sstream>

@@ -1,5 +1,6 @@
 // The speculum command line: global options and the subcommand registration hooks.
-// Each subcommand lives in its own apps/cmd_*.cpp and is added by main.cpp.
+// Each subcommand lives in its own *_command.cpp (apps/cli, inspect, bench, experiments) and
+// is added by main.cpp.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,7 +18,7 @@ void add_scenes_command(CLI::App& app, GlobalOptions& global);
 void add_info_command(CLI::App& app, GlobalOptions& global);
 void add_render_command(CLI::App& app, GlobalOptions& global);
 void add_techniques_command(CLI::App& app, GlobalOptions& global);
-// inspect / profile / compare (issue 9): apps/cmd_inspect.cpp, cmd_profile.cpp, cmd_compare.cpp.
+// inspect / profile / compare (issue 9): apps/inspect/inspect_command.cpp, profile_command.cpp, compare_command.cpp.
 void add_inspect_command(CLI::App& app, GlobalOptions& global);
 void add_profile_command(CLI::App& app, GlobalOptions& global);
 void add_compare_command(CLI::App& app, GlobalOptions& global);
@@ -27,12 +28,12 @@ struct ExitStatus {
   int code = 1;
 };
 
-// `bench` parent (apps/cmd_bench.cpp) and its children, one per cmd_bench_*.cpp.
+// `bench` parent (apps/bench/bench_command.cpp) and its children, one per bench_*_command.cpp.
 void add_bench_command(CLI::App& app, GlobalOptions& global);
 void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global);
 void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global);
 
-// `experiment` parent (apps/cmd_experiment.cpp) and its children, one per cmd_experiment_*.cpp.
+// `experiment` parent (apps/experiments/experiment_command.cpp) and its children, one per experiments/*.cpp.
 void add_experiment_command(CLI::App& app, GlobalOptions& global);
 void add_experiment_yu_fig9_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_survey_subcommand(CLI::App& experiment, GlobalOptions& global);

@@ -9,7 +9,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "apps/cli.h"
+#include "apps/cli/commands.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/image_flip.h"

@@ -1,5 +1,5 @@
-// Frame options of `render`, `inspect` and `profile`: see pipeline_frame_options.h.
-#include "apps/pipeline_frame_options.h"
+// Frame options of `render`, `inspect` and `profile`: see frame_options.h.
+#include "apps/cli/frame_options.h"
 
 #include <cmath>
 #include <cstdlib>

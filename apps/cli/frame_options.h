@@ -7,8 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "apps/pipeline_camera_options.h"
-#include "apps/pipeline_techniques.h"
+#include "apps/cli/camera_options.h"
+#include "apps/techniques/technique_table.h"
 #include "core/scene.h"
 
 namespace speculum::pipeline {

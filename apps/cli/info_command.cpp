@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "apps/cli.h"
+#include "apps/cli/commands.h"
 #include "core/scene_loader.h"
 
 namespace speculum::cli {

@@ -3,7 +3,7 @@
 #include <exception>
 #include <string>
 
-#include "apps/cli.h"
+#include "apps/cli/commands.h"
 #include "core/error.h"
 #include "parallel/lanes.h"
 

@@ -1,5 +1,5 @@
 // The stderr progress bar: see progress.h.
-#include "apps/progress.h"
+#include "apps/cli/progress.h"
 
 #include <unistd.h>
 

@@ -1,14 +1,14 @@
 // `speculum render [SCENE] --technique T -o out.png|exr`: loads a scene, runs the
-// technique's graph (apps/pipeline_techniques.h) and writes the image (issue 4).
+// technique's graph (apps/techniques/technique_table.h) and writes the image (issue 4).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 
-#include "apps/cli.h"
-#include "apps/pipeline_frame_options.h"
-#include "apps/pipeline_techniques.h"
-#include "apps/progress.h"
+#include "apps/cli/commands.h"
+#include "apps/cli/frame_options.h"
+#include "apps/techniques/technique_table.h"
+#include "apps/cli/progress.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
 

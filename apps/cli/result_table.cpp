@@ -1,10 +1,10 @@
 // Experiment result rows: see result_table.h.
-#include "apps/result_table.h"
+#include "apps/cli/result_table.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "apps/progress.h"
+#include "apps/cli/progress.h"
 
 namespace speculum::cli {
 

@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "apps/cli.h"
+#include "apps/cli/commands.h"
 #include "core/gltf_writer.h"
 #include "core/procedural_scenes.h"
 #include "core/scene_loader.h"

@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "apps/cli.h"
-#include "apps/pipeline_techniques.h"
+#include "apps/cli/commands.h"
+#include "apps/techniques/technique_table.h"
 
 namespace speculum::cli {
 

@@ -1,6 +1,6 @@
 // `speculum experiment NAME`: the paper-reproduction sweeps (issues 6–8). Each experiment
 // is a child subcommand in its own apps/cmd_experiment_*.cpp, registered here.
-#include "apps/cli.h"
+#include "apps/cli/commands.h"
 
 namespace speculum::cli {
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "apps/cli.h"
-#include "apps/progress.h"
-#include "apps/result_table.h"
+#include "apps/cli/commands.h"
+#include "apps/cli/progress.h"
+#include "apps/cli/result_table.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
 #include "raster/gbuffer.h"

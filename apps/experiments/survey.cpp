@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "apps/cli.h"
-#include "apps/pipeline_distance_map.h"
-#include "apps/pipeline_frame.h"
-#include "apps/progress.h"
-#include "apps/result_table.h"
+#include "apps/cli/commands.h"
+#include "apps/techniques/distance_map.h"
+#include "apps/techniques/render_frame.h"
+#include "apps/cli/progress.h"
+#include "apps/cli/result_table.h"
 #include "core/error.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"

@@ -8,12 +8,12 @@
 #include <memory>
 #include <string>
 
-#include "apps/cli.h"
-#include "apps/pipeline_frame_options.h"
-#include "apps/inspect_images.h"
-#include "apps/inspect_report.h"
-#include "apps/pipeline_frame.h"
-#include "apps/progress.h"
+#include "apps/cli/commands.h"
+#include "apps/cli/frame_options.h"
+#include "apps/inspect/inspect_images.h"
+#include "apps/inspect/inspect_report.h"
+#include "apps/techniques/render_frame.h"
+#include "apps/cli/progress.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
 

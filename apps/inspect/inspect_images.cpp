@@ -1,13 +1,13 @@
 // Drawing captured node outputs for `inspect`: see inspect_images.h.
-#include "apps/inspect_images.h"
+#include "apps/inspect/inspect_images.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include "apps/inspect_trace_images.h"
-#include "apps/pipeline_envmap.h"
+#include "apps/inspect/inspect_trace_images.h"
+#include "apps/techniques/envmap.h"
 #include "core/shading.h"
 #include "raster/composite.h"
 #include "raster/cube_map.h"

@@ -41,7 +41,7 @@ glm::vec3 id_colour(std::uint32_t id);
 // faces and the unused cells are black. All faces must have the same size.
 ImageRGBA cube_cross(const std::array<ImageRGBA, 6>& faces);
 
-// Helpers shared with the trace-side drawers (apps/inspect_trace_images.cpp).
+// Helpers shared with the trace-side drawers (apps/inspect/inspect_trace_images.cpp).
 namespace draw {
 std::string dims(int w, int h);
 std::string fmt(double v);

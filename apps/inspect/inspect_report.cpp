@@ -1,5 +1,5 @@
 // manifest.json and index.html of `inspect`: see inspect_report.h.
-#include "apps/inspect_report.h"
+#include "apps/inspect/inspect_report.h"
 
 #include <cstdio>
 #include <sstream>

@@ -1,7 +1,7 @@
 // Drawing the trace-side node outputs for `inspect`: see inspect_trace_images.h. Rays map to
 // pixels as their kernels lay them out: SecondaryRays slot i = pixel i (trace/secondary_rays.h),
 // GlossyRays slots [k N, k N + N) = pixel pixel[k] (trace/glossy_rays.h).
-#include "apps/inspect_trace_images.h"
+#include "apps/inspect/inspect_trace_images.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // §3.4) and layered distance maps (SURVEY §4.5) as per-pixel pictures, see inspect_images.h.
 #pragma once
 
-#include "apps/inspect_images.h"
+#include "apps/inspect/inspect_images.h"
 
 namespace speculum::inspect {
 

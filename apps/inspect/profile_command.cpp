@@ -12,11 +12,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "apps/cli.h"
-#include "apps/pipeline_frame_options.h"
-#include "apps/pipeline_frame.h"
-#include "apps/progress.h"
-#include "apps/result_table.h"
+#include "apps/cli/commands.h"
+#include "apps/cli/frame_options.h"
+#include "apps/techniques/render_frame.h"
+#include "apps/cli/progress.h"
+#include "apps/cli/result_table.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
 

@@ -1,10 +1,10 @@
 // The distance-map technique's recipe and the frame passes it shares with envmap (the same
-// nodes as apps/pipeline_envmap.cpp): see pipeline_distance_map.h.
-#include "apps/pipeline_distance_map.h"
+// nodes as apps/techniques/envmap.cpp): see distance_map.h.
+#include "apps/techniques/distance_map.h"
 
 #include <vector>
 
-#include "apps/pipeline_frame_passes.h"
+#include "apps/techniques/frame_passes.h"
 #include "raster/composite.h"
 #include "raster/direct_light.h"
 #include "raster/distance_map_reflect.h"

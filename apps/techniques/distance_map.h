@@ -1,9 +1,9 @@
 // Recipes of the sampled-geometry techniques of SURVEY §4 (TECHNIQUES.md §2.2, 2.3, 2.5):
 // distance-map, multi-reflection and layered-distance-map, and the passes they share with
-// envmap (apps/pipeline_envmap.cpp).
+// envmap (apps/techniques/envmap.cpp).
 #pragma once
 
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 #include "raster/distance_map_search.h"
 
 namespace speculum::pipeline {

@@ -1,7 +1,7 @@
-// The envmap technique's recipe: see pipeline_envmap.h.
-#include "apps/pipeline_envmap.h"
+// The envmap technique's recipe: see envmap.h.
+#include "apps/techniques/envmap.h"
 
-#include "apps/pipeline_frame_passes.h"
+#include "apps/techniques/frame_passes.h"
 #include "raster/envmap_reflect.h"
 #include "raster/reflector_maps.h"
 

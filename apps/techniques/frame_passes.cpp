@@ -1,5 +1,5 @@
-// The passes shared by every feed-forward technique's frame: see pipeline_frame_passes.h.
-#include "apps/pipeline_frame_passes.h"
+// The passes shared by every feed-forward technique's frame: see frame_passes.h.
+#include "apps/techniques/frame_passes.h"
 
 #include <vector>
 

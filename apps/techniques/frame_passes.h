@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 
 namespace speculum::pipeline {
 

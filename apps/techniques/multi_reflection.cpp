@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "apps/pipeline_distance_map.h"
+#include "apps/techniques/distance_map.h"
 #include "raster/distance_map_reflect.h"
 #include "raster/multi_reflection.h"
 

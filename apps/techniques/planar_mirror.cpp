@@ -1,6 +1,6 @@
-// The planar-mirror technique's recipe: see pipeline_planar_mirror.h.
-#include "apps/pipeline_frame_passes.h"
-#include "apps/pipeline_planar_mirror.h"
+// The planar-mirror technique's recipe: see planar_mirror.h.
+#include "apps/techniques/frame_passes.h"
+#include "apps/techniques/planar_mirror.h"
 
 #include <algorithm>
 #include <vector>

@@ -2,7 +2,7 @@
 // rendered by geometry transformation (raster/planar_mirror.h), recursively to depth k.
 #pragma once
 
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 
 namespace speculum::pipeline {
 

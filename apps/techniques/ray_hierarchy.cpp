@@ -1,6 +1,6 @@
-// The ray-hierarchy technique's recipe: see pipeline_ray_hierarchy.h (ROGER ch.3).
-#include "apps/pipeline_frame_passes.h"
-#include "apps/pipeline_ray_hierarchy.h"
+// The ray-hierarchy technique's recipe: see ray_hierarchy.h (ROGER ch.3).
+#include "apps/techniques/frame_passes.h"
+#include "apps/techniques/ray_hierarchy.h"
 
 #include <algorithm>
 #include <string>

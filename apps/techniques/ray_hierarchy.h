@@ -2,7 +2,7 @@
 // G-buffer traced through a screen-space cone-sphere hierarchy over stream compaction.
 #pragma once
 
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 
 namespace speculum::pipeline {
 

@@ -1,6 +1,6 @@
 // The reference technique's recipe: the path-sampled reference tracer as one node, then the
 // same tonemap as every other technique (so images compare like for like).
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 #include "raster/composite.h"
 #include "trace/reference_tracer.h"
 

@@ -1,7 +1,7 @@
-// The refraction technique's recipe: see pipeline_refraction.h. It wires raster/ passes
+// The refraction technique's recipe: see refraction.h. It wires raster/ passes
 // with one trace/ kernel (the per-vertex thickness ray cast of the two-face method).
-#include "apps/pipeline_frame_passes.h"
-#include "apps/pipeline_refraction.h"
+#include "apps/techniques/frame_passes.h"
+#include "apps/techniques/refraction.h"
 
 #include "core/error.h"
 #include "raster/composite.h"

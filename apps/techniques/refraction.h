@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 
 namespace speculum::pipeline {
 

@@ -1,5 +1,5 @@
-// One frame of a technique: see pipeline_frame.h.
-#include "apps/pipeline_frame.h"
+// One frame of a technique: see render_frame.h.
+#include "apps/techniques/render_frame.h"
 
 namespace speculum::pipeline {
 

@@ -3,7 +3,7 @@
 // they all measure and show exactly what `render` produces.
 #pragma once
 
-#include "apps/pipeline_techniques.h"
+#include "apps/techniques/technique_table.h"
 
 namespace speculum::pipeline {
 

@@ -1,13 +1,13 @@
-// The technique table: see pipeline_techniques.h.
-#include "apps/pipeline_techniques.h"
+// The technique table: see technique_table.h.
+#include "apps/techniques/technique_table.h"
 
 #include <algorithm>
 
-#include "apps/pipeline_distance_map.h"
-#include "apps/pipeline_planar_mirror.h"
-#include "apps/pipeline_ray_hierarchy.h"
-#include "apps/pipeline_refraction.h"
-#include "apps/pipeline_yu_lod.h"
+#include "apps/techniques/distance_map.h"
+#include "apps/techniques/planar_mirror.h"
+#include "apps/techniques/ray_hierarchy.h"
+#include "apps/techniques/refraction.h"
+#include "apps/techniques/yu_lod.h"
 #include "core/error.h"
 
 namespace speculum::pipeline {

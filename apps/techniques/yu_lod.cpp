@@ -1,11 +1,11 @@
-// The yu-lod technique's recipe (see pipeline_yu_lod.h): raster passes of the envmap
+// The yu-lod technique's recipe (see yu_lod.h): raster passes of the envmap
 // recipe for primary visibility and direct light, trace/ nodes for the glossy layer.
-#include "apps/pipeline_yu_lod.h"
+#include "apps/techniques/yu_lod.h"
 
 #include <memory>
 #include <vector>
 
-#include "apps/pipeline_frame_passes.h"
+#include "apps/techniques/frame_passes.h"
 #include "raster/composite.h"
 #include "raster/direct_light.h"
 #include "raster/environment.h"

@@ -4,7 +4,7 @@
 
 #include <memory>
 
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 #include "trace/bvh.h"
 #include "trace/hit_radiance.h"
 #include "trace/lod_bvh.h"

@@ -1,8 +1,8 @@
-// --eye/--target/--up/--fov (apps/pipeline_camera_options.h): a moved camera gets near/far
+// --eye/--target/--up/--fov (apps/cli/camera_options.h): a moved camera gets near/far
 // planes fitted to the scene's bounds (core/scene.h fit_clip_planes) instead of keeping the
 // scene camera's, which for a mesh file are tight around the framing view; without an eye or
 // target override the scene camera is kept exactly.
-#include "apps/pipeline_camera_options.h"
+#include "apps/cli/camera_options.h"
 
 #include <algorithm>
 #include <cmath>

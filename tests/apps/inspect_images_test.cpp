@@ -1,13 +1,13 @@
-// How inspect draws captured outputs (apps/inspect_images.h): id colours, the cube cross,
+// How inspect draws captured outputs (apps/inspect/inspect_images.h): id colours, the cube cross,
 // one view per G-buffer field with the buffer's size, and unknown types not drawable.
 #include <set>
 #include <tuple>
 
 #include <gtest/gtest.h>
 
-#include "apps/inspect_images.h"
+#include "apps/inspect/inspect_images.h"
 #include "captured_output.h"
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 #include "raster/gbuffer.h"
 
 namespace speculum::inspect {

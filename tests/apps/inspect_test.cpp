@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "apps/pipeline_frame_options.h"
-#include "apps/pipeline_techniques.h"
+#include "apps/cli/frame_options.h"
+#include "apps/techniques/technique_table.h"
 #include "core/image.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
@@ -74,7 +74,7 @@ void expect_complete_manifest(const fs::path& dir, const std::string& technique)
   EXPECT_TRUE(display_drawn);
 }
 
-// The trace-side outputs (apps/inspect_trace_images.h) a technique must draw: each is
+// The trace-side outputs (apps/inspect/inspect_trace_images.h) a technique must draw: each is
 // drawable, lists PNGs, and every PNG loads with the output's content.
 const std::map<std::string, std::vector<std::string>> kTraceOutputs = {
     {"ray-hierarchy", {"rays_1", "hierarchy_1", "hits_1", "shadow_hits_1"}},

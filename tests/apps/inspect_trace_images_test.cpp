@@ -1,10 +1,10 @@
-// How inspect draws the trace-side outputs (apps/inspect_trace_images.h): rays on their
+// How inspect draws the trace-side outputs (apps/inspect/inspect_trace_images.h): rays on their
 // pixels with d*0.5+0.5 colours and an active mask, hits on the grid of the rays drawn before
 // them (none: not drawable), hierarchy levels' α and r, YU's Ω_s and hit/proxy fractions.
 #include <map>
 #include <gtest/gtest.h>
 
-#include "apps/inspect_trace_images.h"
+#include "apps/inspect/inspect_trace_images.h"
 #include "captured_output.h"
 #include "core/shading.h"
 #include "trace/glossy_rays.h"

@@ -1,4 +1,4 @@
-// The progress bar (apps/progress.h): silent before its delay, every step counted when many
+// The progress bar (apps/cli/progress.h): silent before its delay, every step counted when many
 // threads step at once, one final newline, and the drawn count never goes backwards.
 #include <algorithm>
 #include <mutex>
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "apps/progress.h"
+#include "apps/cli/progress.h"
 
 namespace speculum::cli {
 namespace {

@@ -211,7 +211,7 @@ void usage(FILE* to) {
       "  speculum bench raster bench:spheres-room --repeat 1 --write-ply sr.ply\n"
       "  LP_NUM_THREADS=2 speculum_llvmpipe_bench sr.ply --eye 0,4.5,7.5 --target 0,0.5,-1 --fov 60 \\\n"
       "      --near 0.05 --far 100 --repeat 7 --json\n"
-      "(the workloads' cameras are in apps/pipeline_bench_workloads.cpp)\n");
+      "(the workloads' cameras are in apps/bench/bench_workloads.cpp)\n");
 }
 
 Vec3 parse_vec3(const std::string& flag, const std::string& s) {

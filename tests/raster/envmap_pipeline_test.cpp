@@ -12,7 +12,7 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "apps/pipeline_envmap.h"
+#include "apps/techniques/envmap.h"
 #include "core/optics.h"
 #include "core/scene_loader.h"
 #include "parallel/lanes.h"

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "apps/pipeline_frame.h"
+#include "apps/techniques/render_frame.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
 

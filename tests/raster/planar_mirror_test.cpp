@@ -10,9 +10,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "apps/pipeline_planar_mirror.h"
-#include "apps/pipeline_techniques.h"
-#include "apps/pipeline_frame.h"
+#include "apps/techniques/planar_mirror.h"
+#include "apps/techniques/technique_table.h"
+#include "apps/techniques/render_frame.h"
 #include "core/camera_rays.h"
 #include "core/optics.h"
 #include "core/scene_loader.h"

@@ -10,9 +10,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "apps/pipeline_frame.h"
-#include "apps/pipeline_refraction.h"
-#include "apps/pipeline_techniques.h"
+#include "apps/techniques/render_frame.h"
+#include "apps/techniques/refraction.h"
+#include "apps/techniques/technique_table.h"
 #include "core/scene_loader.h"
 #include "raster/refraction_path.h"
 #include "raster_test_scenes.h"
