@@ -94,7 +94,7 @@ void write_float_channels(const std::string& path, int w, int h, int nc,
     OIIO::ImageSpec spec(w, h, nc, OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");
     // OpenEXR stamps the write time into `capDate`; a fixed value keeps the file bytes a
-    // function of the pixels only (DESIGN.md "Determinism": same inputs, same bytes).
+    // function of the pixels only (same inputs, same bytes: docs/architecture.md).
     spec.attribute("DateTime", "1970:01:01 00:00:00");
     ok = out->open(tmp_path.string(), spec) &&
          out->write_image(OIIO::TypeDesc::FLOAT, linear.data());

@@ -1,5 +1,5 @@
 // Geometric optics shared by every technique: mirror reflection, refraction with total
-// internal reflection, and Fresnel reflectance (TECHNIQUES.md §0, SURVEY eq.2).
+// internal reflection, and Fresnel reflectance (SURVEY §1.1, eq.1–2).
 #pragma once
 
 #include <algorithm>
@@ -17,7 +17,7 @@ inline glm::vec3 reflect(const glm::vec3& v, const glm::vec3& n) {
 
 // Refraction of the unit incident direction V at a surface with unit normal N facing the
 // incident side (N·V <= 0), relative index nu = n_transmitted / n_incident:
-// c = -N·V, T = V/nu + (c/nu - sqrt(1 - (1-c²)/nu²)) N  (TECHNIQUES.md §0).
+// c = -N·V, T = V/nu + (c/nu - sqrt(1 - (1-c²)/nu²)) N  (Snell's law in vector form).
 // Returns false (and leaves `t` untouched) on total internal reflection.
 inline bool refract(const glm::vec3& v, const glm::vec3& n, float nu, glm::vec3& t) {
   const float c = -glm::dot(n, v);

@@ -1,5 +1,5 @@
-// The built-in procedural scenes, named after the documents' set-ups (issue 2 "core/:
-// scenes"): each scales from ~1K to ~10M triangles with its size parameter.
+// The built-in procedural scenes, named after the papers' set-ups: each scales from ~1K to
+// ~10M triangles with its size parameter.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 // Deterministic sampling: a counter-based hash RNG keyed by (pixel, sample, dimension,
 // seed), the 2-D Hamersley set, and direction sampling (cosine hemisphere, uniform cone,
-// normalized Phong lobe of YU eq.4 / TECHNIQUES.md §0) with their pdfs.
+// normalized Phong lobe of YU eq.4) with their pdfs.
 #pragma once
 
 #include <cmath>
@@ -26,7 +26,7 @@ inline std::uint32_t hash_u32(std::uint32_t x) {
 }
 
 // The random number for (pixel, sample, dimension, seed): no state, so any thread may
-// compute any sample and the image never depends on the schedule (DESIGN.md
+// compute any sample and the image never depends on the schedule (docs/architecture.md,
 // "Determinism"). Each key is folded in with a hash so nearby keys decorrelate.
 inline std::uint32_t hash_key(std::uint32_t pixel, std::uint32_t sample, std::uint32_t dimension,
                               std::uint32_t seed) {
@@ -116,7 +116,8 @@ inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f
 
 // Normalized Phong lobe about +Z (the lobe axis, e.g. the mirror direction R), YU eq.4:
 // cosθ = u1^(1/(n+1)), φ = 2π u2; pdf(θ) = (n+1)/(2π) cos^n θ over the hemisphere about the
-// axis, so the mean solid angle of one of N samples is 2π/N (TECHNIQUES.md §1 note).
+// axis, so the mean solid angle of one of N samples is 2π/N: the solid angle of the pdf's
+// domain over N (YU §3.2 states 4π/N, a whole sphere's).
 inline glm::vec3 sample_phong_lobe(glm::vec2 u, float exponent) {
   // 1 - u keeps u1 in (0, 1] so pow never sees 0 (which would give cosθ = 0 exactly).
   return spherical_local(std::pow(1.0f - u.x, 1.0f / (exponent + 1.0f)), u.y);

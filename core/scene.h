@@ -26,7 +26,8 @@ struct TextureRef {
 };
 
 // How a surface reflects, derived from the metallic-roughness parameters
-// (TECHNIQUES.md §0 "Material mapping").
+// (Material::kind: transmission makes a refractor; a metallic surface is a mirror or glossy
+// by the roughness thresholds below; anything else is diffuse).
 enum class MaterialKind : std::uint8_t { Diffuse, Glossy, Mirror, Refractor };
 const char* to_string(MaterialKind kind);
 
@@ -47,7 +48,8 @@ struct Material {
   TextureRef transmission_texture;        // R: transmission
 
   MaterialKind kind() const;
-  // Phong exponent n from roughness r: alpha = r^2, n = 2/alpha^2 - 2 (TECHNIQUES.md §0),
+  // Phong exponent n from roughness r: alpha = r^2, n = 2/alpha^2 - 2 (the usual
+  // Beckmann-to-Phong correspondence),
   // clamped to [0, 1e6] so a perfect mirror stays finite.
   float phong_exponent() const;
 };

@@ -1,5 +1,5 @@
 // One entry point for every scene source: glTF 2.0 (.gltf/.glb), OBJ/PLY/OFF/STL meshes,
-// or a built-in procedural scene by name (DESIGN.md "Data and formats").
+// or a built-in procedural scene by name.
 #pragma once
 
 #include <cstdint>

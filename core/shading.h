@@ -1,5 +1,5 @@
 // The one shading model shared by the rasterizer's direct_light node and the reference
-// tracer, so techniques and the ground truth agree (TECHNIQUES.md §0 material mapping;
+// tracer, so techniques and the ground truth agree (glTF metallic-roughness materials;
 // KHR_lights_punctual units). The model, in full:
 // - F0 = mix(fresnel_f0(ior) [0.04 at ior 1.5], base_color, metallic); F = Schlick(N·V, F0).
 // - Diffuse: f_d = (1 - F) (1 - metallic) (1 - transmission) base_color / π (Lambert).

@@ -1,5 +1,5 @@
 // The last passes of a feed-forward frame: `composite` (direct light + specular layer),
-// the k×k supersample resolve and `tonemap` (issue 4 "Nodes").
+// the k×k supersample resolve and `tonemap` (SOFF §3.1's final blend and supersampling).
 #pragma once
 
 #include "core/image.h"

@@ -1,6 +1,6 @@
-// The localized ray search in a distance cube map around a reference point o (SURVEY §4.1,
-// TECHNIQUES.md §2.2): parallax correction (eq.4), linear search with the §4.1.2 spacing,
-// secant refinement (eq.5, kept as regula falsi once bracketed). Each part is switchable.
+// The localized ray search in a distance cube map around a reference point o (SURVEY §4.1):
+// parallax correction (§4.1.1 eq.4), linear search with the §4.1.2 spacing, secant
+// refinement (§4.1.3 eq.5, kept as regula falsi once bracketed). Each part is switchable.
 //
 // API (also used by the refraction impostors): coordinates are relative to o; `x` is the ray
 // origin, `r` a unit direction; `distance_towards(dir)` returns the stored |y − o| in the

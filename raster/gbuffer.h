@@ -1,6 +1,6 @@
 // The `gbuffer` node: resolves a visibility buffer into per-sample surface attributes —
 // world position, shading normal (normal maps applied), uv, material parameters and
-// reflector id (SOFF §3.1's G-buffer; issue 4 "Nodes").
+// reflector id (SOFF §3.1's G-buffer).
 #pragma once
 
 #include <cstdint>

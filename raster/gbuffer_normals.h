@@ -1,5 +1,5 @@
 // The shading-normal step of the `gbuffer` node 8 samples at a time (AVX2): normalize the
-// interpolated normal and turn opaque surfaces towards the eye (issue 4 "Nodes", gbuffer).
+// interpolated normal and turn opaque surfaces towards the eye.
 // The same IEEE operations in the same order as the scalar glm code (length = sqrt of
 // (x·x + y·y) + z·z, division per component, no FMA), so the bytes are identical; the
 // per-sample sqrt and three divisions were the resolve's bottleneck on the divider unit.

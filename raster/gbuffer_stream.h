@@ -1,7 +1,7 @@
 // Block-wise output of the `gbuffer` node: samples are resolved into a small L1-resident
 // staging buffer per plane, then copied to the G-buffer planes with whole-line 32-byte
 // non-temporal (streaming) stores when the frame is far larger than the last-level cache
-// (DESIGN.md "Stream constraints": write bandwidth). Whole-line streaming stores skip the
+// (write bandwidth is the limit there). Whole-line streaming stores skip the
 // read-for-ownership a normal store pays on every line of a 170 MB target and do not evict
 // the scene data the gathers reuse.
 #pragma once

@@ -1,6 +1,6 @@
 // The scene-static input of the `gbuffer` node: one interleaved 128-byte record per triangle
 // (corner positions, normals, uvs and the material) built once per static scene, like a
-// GPU's vertex-buffer upload (issue 4 "Nodes", gbuffer; DESIGN.md "Stream constraints").
+// GPU's vertex-buffer upload.
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,4 @@
-// Layered distance maps (SURVEY §4.5, TECHNIQUES.md §2.5, after UPSK07): the whole scene
+// Layered distance maps (SURVEY §4.5, after UPSK07): the whole scene
 // depth-peeled into L cube layers around a reference point o — per texel the k-th nearest
 // surface along the texel's direction, with its distance, normal, material and direct-lit
 // colour — and a recursive tracer that searches every layer (linear + secant, as in

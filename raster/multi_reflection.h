@@ -1,4 +1,4 @@
-// Inter-object multiple reflections (SURVEY §4.3, TECHNIQUES.md §2.3): every specular
+// Inter-object multiple reflections (SURVEY §4.3): every specular
 // object's colour + distance cube map is re-rendered with the reflectors it sees shaded by
 // a distance-map search in the *current* maps of the others, so each round adds one
 // bounce. Rounds are Jacobi-style (all maps of round k read round k−1's), which makes a

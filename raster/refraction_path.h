@@ -1,4 +1,4 @@
-// The geometric optics of one refracted camera sample (SURVEY §4.4, TECHNIQUES.md §2.4):
+// The geometric optics of one refracted camera sample (SURVEY §4.4):
 // the entry interface, Wyman's two-face thickness interpolation, and the exit interface
 // with total internal reflection. Exact dielectric Fresnel, as the reference tracer.
 #pragma once
@@ -29,7 +29,7 @@ RefractionPath enter_refractor(const glm::vec3& p1, const glm::vec3& v, const gl
 // reflection reflect(T1, −N2) with f_exit = 1 when the radicand is negative.
 void leave_refractor(RefractionPath& path, const glm::vec3& p2, const glm::vec3& n2, float ior);
 
-// Wyman's thickness along T1 (TECHNIQUES.md §2.4): d = (θt/θi) d_V + (1 − θt/θi) d_N,
+// Wyman's thickness along T1 (SURVEY §4.4): d = (θt/θi) d_V + (1 − θt/θi) d_N,
 // d_V the distance to the back face along the view ray, d_N the thickness along the
 // normal. θt/θi → 1/ν at normal incidence (its small-angle limit).
 float two_face_distance(float cos_i, float cos_t, float ior, float d_view, float d_normal);

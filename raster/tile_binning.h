@@ -1,5 +1,5 @@
-// Binning of set-up triangles into 64×64 screen tiles by count → offsets → scatter (issue 4
-// "Rasterizer": per-tile lists in submission order). Each chunk of input triangles counts
+// Binning of set-up triangles into 64×64 screen tiles by count → offsets → scatter, giving
+// per-tile lists in submission order. Each chunk of input triangles counts
 // its triangles per tile; the offsets place tile t's list, chunk by chunk in chunk order
 // (= submission order, for any thread count), in one contiguous run of `binned`; each
 // chunk then copies its triangles into its slots. A tile task streams through one run of

@@ -1,6 +1,6 @@
 // Per-tile rasterization: integer edge functions with the top-left fill rule, 8×8 block
 // rejection then pixel coverage in rows of W lanes, early depth test on 1/w with ties won
-// by the lower triangle index, perspective-correct barycentrics (issue 4 "Rasterizer").
+// by the lower triangle index, perspective-correct barycentrics.
 #pragma once
 
 #include <cstdint>

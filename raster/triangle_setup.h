@@ -1,5 +1,5 @@
 // Triangle setup for the tile rasterizer: clip-space transform, near/far and guard-band
-// clipping, fixed-point snapping (8 sub-pixel bits) and orientation (issue 4 "Rasterizer").
+// clipping, fixed-point snapping (8 sub-pixel bits) and orientation.
 #pragma once
 
 #include <cstddef>

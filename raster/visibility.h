@@ -1,7 +1,7 @@
 // The `visibility` node: rasterizes a scene's triangle soup from a camera into a
 // per-sample visibility buffer (triangle id, object id, depth, barycentrics), following the
-// setup → bin → rasterize structure of production software rasterizers (STYLE.md "Mesa
-// llvmpipe"; issue 4 "Rasterizer"). Output is bit-identical for any thread count and lanes.
+// setup → bin → rasterize structure of production software rasterizers such as Mesa's
+// llvmpipe. Output is bit-identical for any thread count and lanes.
 #pragma once
 
 #include <cstdint>

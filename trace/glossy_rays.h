@@ -1,4 +1,4 @@
-// The `glossy_rays` node of YU §3.3: for every glossy (or mirror) G-buffer sample, N
+// The `glossy_rays` node of YU §3.2: for every glossy (or mirror) G-buffer sample, N
 // reflected rays importance-sampled from the normalized Phong lobe about R (eq.4) with a
 // per-pixel rotated 2-D Hamersley set, and each ray's solid angle Ω_s = 1/(N p) (eq.5).
 #pragma once
@@ -39,7 +39,7 @@ inline bool traces_glossy(const SurfaceParams& s) {
 
 // Solid angle of one of N samples of the Phong lobe (exponent n) at polar cosine cos_theta
 // about R (YU eq.5). Its mean over the lobe's samples is 2π/N: the pdf is normalized over the
-// hemisphere about R (TECHNIQUES.md §1 correction of the paper's 4π/N).
+// hemisphere about R (YU §3.2 states 4π/N, which would need a pdf over the whole sphere).
 float sample_solid_angle(float cos_theta, float exponent, int n);
 
 // Kernel "glossy_rays". Buffers are the G-buffer's (world positions, unit shading normals,

@@ -1,7 +1,8 @@
-// The ray-hierarchy traversal of ROGER ch.3 (TECHNIQUES.md §4.2) on the hierarchical stream
-// reduction of ROGER ch.4 (§4.3, parallel/compact.h): a stream of (node, triangle) pairs
-// refined one quad-tree level per kernel, then exact watertight tests and the closest hit
-// per ray by a segmented min. No scene structure: every triangle starts at the root.
+// The ray-hierarchy traversal of ROGER §3.3.3 (with the pair buffer of §3.3.4) on the
+// hierarchical stream reduction of ROGER §4.3 (parallel/compact.h): a stream of (node,
+// triangle) pairs refined one quad-tree level per kernel, then exact watertight tests and
+// the closest hit per ray by a segmented min. No scene structure: every triangle starts at
+// the root.
 #pragma once
 
 #include <cstdint>

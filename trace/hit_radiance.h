@@ -1,12 +1,12 @@
 // Radiance at the glossy rays' hits (YU §3.4–3.5, eq.8–9) and the `radiance_bake` that feeds
-// it. Choice for general meshes (TECHNIQUES.md §1): the pre-filtered radiance is a pyramid
-// whose level-0 texels are the triangles (A_texel = the triangle's area) and whose coarser
-// levels are the BVH ancestors' area-weighted mean radiance (trace/lod_bvh.h). Lighting is
-// baked once per triangle at its centroid: shadow-ray visibility of every light and the
-// occluded environment irradiance (cosine samples), both view-independent; a hit then
-// shades exactly at level 0 (the material at the hit's uv, shared model of core/shading.h)
-// and blends towards the ancestors as the eq.9 level grows. Glossy/mirror surfaces that are
-// hit reflect the environment along R (one bounce: no further tracing).
+// it. YU filters a radiance texture; for general meshes the pre-filtered radiance is a
+// pyramid whose level-0 texels are the triangles (A_texel = the triangle's area) and whose
+// coarser levels are the BVH ancestors' area-weighted mean radiance (trace/lod_bvh.h).
+// Lighting is baked once per triangle at its centroid: shadow-ray visibility of every light
+// and the occluded environment irradiance (cosine samples), both view-independent; a hit
+// then shades exactly at level 0 (the material at the hit's uv, shared model of
+// core/shading.h) and blends towards the ancestors as the eq.9 level grows. Glossy/mirror
+// surfaces that are hit reflect the environment along R (one bounce: no further tracing).
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
-// The LOD data YU §3.2–3.4 attaches to a threaded BVH, for general triangle meshes: every
+// The LOD data YU §3.3–3.4 attaches to a threaded BVH, for general triangle meshes: every
 // node gets approximate geometry and filtered radiance, built bottom-up from the Bvh
-// (bvh.h is read, never changed). Choice for general meshes (TECHNIQUES.md §1): a node whose
-// contents are roughly planar (area-weighted mean normal of length >= kPlanarity) is
+// (bvh.h is read, never changed). YU works on geometry images; for general meshes, a node
+// whose contents are roughly planar (area-weighted mean normal of length >= kPlanarity) is
 // approximated by one quad — the plane through the contents' area centroid perpendicular to
 // that mean normal, spanning the projection of the children's proxies (leaves: of their
 // triangles); any other node has no approximate geometry (the LOD traversal descends it,

@@ -1,4 +1,4 @@
-// The `lod_trace` node of YU §3.4: stackless traversal of the threaded BVH that stops
+// The `lod_trace` node of YU §3.3: stackless traversal of the threaded BVH that stops
 // descending at an inner node whose box subtends at most α² times the ray's solid angle
 // (eq.7, Ω_box ≤ α² Ω_s with Ω_box of eq.6), intersects that node's approximate geometry
 // (trace/lod_bvh.h) and follows its miss link. LOD off is an explicit switch: then the

@@ -1,4 +1,4 @@
-// The SPRY ray file of `speculum bench trace` (issue 5): little-endian, magic "SPRY",
+// The SPRY ray file of `speculum bench trace`: little-endian, magic "SPRY",
 // uint32 version 1, uint64 count, then per ray 8 float32: origin xyz, tnear, direction
 // xyz, tfar.
 #pragma once

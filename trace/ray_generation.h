@@ -1,4 +1,4 @@
-// Benchmark ray sets for a camera over a BVH (issue 5 "Benchmark against Embree"):
+// Benchmark ray sets for a camera over a BVH (the Embree comparison of `bench trace`):
 // primary (one per pixel, scanline order), reflect-cone30 (per primary hit, the mirror
 // direction about the geometric normal perturbed uniformly within a 30° cone) and
 // hemisphere (per primary hit, cosine-weighted about the geometric normal). Secondary

@@ -1,4 +1,4 @@
-// The ray hierarchy build (see ray_hierarchy.h; ROGER §3.2, TECHNIQUES.md §4.2).
+// The ray hierarchy build (see ray_hierarchy.h; ROGER §3.3.2).
 #include "trace/ray_hierarchy.h"
 
 #include <algorithm>

@@ -1,6 +1,6 @@
-// The screen-space ray hierarchy of ROGER ch.3 (TECHNIQUES.md §4.2): a quad-tree of
-// cone-spheres over one ray per pixel, built bottom-up one level per kernel, and the
-// cone-sphere / bounding-sphere test of ROGER eq.3.1 that its traversal uses.
+// The screen-space ray hierarchy of ROGER §3.3 (build §3.3.2, traversal §3.3.3): a
+// quad-tree of cone-spheres over one ray per pixel, built bottom-up one level per kernel,
+// and the cone-sphere / bounding-sphere test of ROGER eq.3.1 that its traversal uses.
 #pragma once
 
 #include <cmath>
@@ -15,7 +15,7 @@
 
 namespace speculum::trace {
 
-// One node, 8 floats (ROGER §3.2): a sphere (c, r) bounding the ray origins and a cone
+// One node, 8 floats (ROGER §3.3.2): a sphere (c, r) bounding the ray origins and a cone
 // (d unit, half-angle alpha <= π) bounding their directions. Leaves: r = 0, alpha = 0.
 // An empty node (no ray below it) has r < 0.
 struct ConeSphere {
@@ -66,7 +66,7 @@ inline bool cone_sphere_intersects(const ConeSphere& n, const BoundingSphere& s)
   return cone_sphere_intersects(n, std::sin(n.alpha), std::cos(n.alpha), s);
 }
 
-// The parent of up to 4 children (TECHNIQUES.md §4.2; the thesis gives no formula):
+// The parent of up to 4 children (ROGER §3.3.2, Fig.3.5, shows it but gives no formula):
 // d = normalize(Σ d_i), α = min(π, max_i(∠(d, d_i) + α_i)), C = mean(C_i),
 // r = max_i(|C - C_i| + r_i), over the non-empty children only (all empty → empty). Angles
 // by atan2(|d×d_i|, d·d_i) (acos loses ~3e-4 rad near 0) and every bound widened slightly,

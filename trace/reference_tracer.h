@@ -1,12 +1,12 @@
-// The reference tracer: the ground truth every technique is compared with (issue 5,
-// DESIGN.md "Correctness strategy"). Primary visibility; direct light from every punctual
-// light with traced shadow rays; Whitted recursion for mirrors and smooth refractors
-// (exact dielectric Fresnel, total internal reflection) to a depth limit; glossy
-// reflection by importance sampling the normalized Phong lobe (YU eq.4, one lobe sample
-// per path sample); environment on miss; optionally environment light on diffuse surfaces
-// (cosine samples, occluded by geometry, no interreflection). Shading follows
-// core/shading.h. Random numbers are keyed by (pixel, sample, dimension, seed), so the
-// image is bit-identical for any thread count; the error falls like 1/sqrt(spp).
+// The reference tracer: the ground truth every technique is compared with (an error figure
+// per technique against it, on the same scene and camera). Primary visibility; direct
+// light from every punctual light with traced shadow rays; Whitted recursion for mirrors
+// and smooth refractors (exact dielectric Fresnel, total internal reflection) to a depth
+// limit; glossy reflection by importance sampling the normalized Phong lobe (YU eq.4, one
+// lobe sample per path sample); environment on miss; optionally environment light on
+// diffuse surfaces (cosine samples, occluded by geometry, no interreflection). Shading
+// follows core/shading.h. Random numbers are keyed by (pixel, sample, dimension, seed), so
+// the image is bit-identical for any thread count; the error falls like 1/sqrt(spp).
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
-// Secondary ray generations for the ray-hierarchy technique (ROGER §3.1, TECHNIQUES.md
-// §4.2): one reflected or refracted ray per specular pixel of a G-buffer, the next bounce
+// Secondary ray generations for the ray-hierarchy technique (ROGER §3.3.1 steps 2 and 5,
+// §3.3.5): one reflected or refracted ray per specular pixel of a G-buffer, the next bounce
 // from the closest hits, shadow rays reversed to start at a point light, and the shading
 // of a generation's hits with the shared model (core/shading.h). Kernels over core types
 // only (no raster/ types), so the recipe in apps/ wires them to the G-buffer.
@@ -57,7 +57,7 @@ SecondaryRays bounce_rays(par::Executor& executor, const Scene& scene, const Sec
 // Shadow rays towards `light` for the hits of `gen` the light can reach: for point and spot
 // lights reversed, starting at the light and ending just before the surface point
 // (origin = light, direction = point - light, t in [0, 1 - 1e-4]), so every ray of the
-// hierarchy shares one origin (ROGER §3.4); directional lights get forward rays from the
+// hierarchy shares one origin (ROGER §3.3.5); directional lights get forward rays from the
 // surface. Kernel "shadow_rays".
 SecondaryRays shadow_rays(par::Executor& executor, const Scene& scene, const Light& light,
                           const SecondaryRays& gen, const HitStream& hits);

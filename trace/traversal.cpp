@@ -318,6 +318,8 @@ void closest_hit_stream(const Bvh& bvh, const RayStream& rays, HitStream& hits, 
   std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
   ex.parallel_for("trace_closest", n, kRayChunk, [&](std::size_t b, std::size_t e) {
     TraversalCounters c;
+    // One ray at a time: a kernel that interleaved 8 rays per thread (to overlap their cache
+    // misses) measured 0.74-0.87x this one on incoherent reflect-cone30 rays (1M triangles).
     for (std::size_t i = b; i < e; ++i) {
       const Hit h = closest_hit(bvh, rays.get(i), &c);
       hits.t[i] = h.t;

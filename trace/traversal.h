@@ -1,8 +1,8 @@
 // Ray queries against the BVH (trace/bvh.h) and the all-pairs oracle: closest hit and any
 // hit, single rays and SoA ray streams traversed in fixed chunks. Stacks have a fixed size;
-// an overflow drops the deepest pending node and is counted (DESIGN.md "Stream
-// constraints"). Ties in t go to the lower triangle index, so every structure returns the
-// oracle's (t, triangle) bit for bit.
+// an overflow drops the deepest pending node and is counted (bounded work per element:
+// docs/architecture.md, "Stream constraints"). Ties in t go to the lower triangle index,
+// so every structure returns the oracle's (t, triangle) bit for bit.
 #pragma once
 
 #include <cstdint>
