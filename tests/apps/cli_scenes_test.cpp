@@ -1,5 +1,5 @@
 // The real speculum binary on bad input (exit 2, one stderr line naming the file, no
-// output file) and on the scenes/info commands (issue 2 "Bad input", "Done when").
+// output file) and on the scenes/info commands.
 #include <sys/wait.h>
 #include <unistd.h>
 

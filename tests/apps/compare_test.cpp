@@ -1,5 +1,5 @@
 // `speculum compare`: exit status 0 within the bound, 1 outside, 2 on bad input, and the
-// printed metrics equal the known 8-bit differences of generated PNGs (issue 9 "compare").
+// printed metrics equal the known 8-bit differences of generated PNGs.
 #include <cmath>
 #include <map>
 #include <sstream>

@@ -1,5 +1,5 @@
 // Every subcommand's --help (found by walking the help output from the top) names an
-// example, and options with defaults show them (issue 9 "Also").
+// example, and options with defaults show them.
 #include <regex>
 #include <set>
 

@@ -1,6 +1,6 @@
 // `speculum inspect`: manifest.json lists every executed node in execution order with its
 // outputs, every listed file exists, the final image equals `render`'s, and index.html loads
-// every image without console errors in headless Chromium (issue 9 "inspect").
+// every image without console errors in headless Chromium.
 #include <map>
 #include <regex>
 #include <set>

@@ -1,6 +1,6 @@
 // `speculum profile`: trace.json is valid Chrome trace-event JSON with one complete event per
 // executed node and the kernel launches on their node's track; counters.json has every node
-// in execution order with shares that sum to about the frame (issue 9 "profile").
+// in execution order with shares that sum to about the frame.
 #include <map>
 
 #include <nlohmann/json.hpp>

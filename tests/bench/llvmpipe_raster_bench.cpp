@@ -1,5 +1,6 @@
-// speculum_llvmpipe_bench: the llvmpipe side of issue 4's raster yardstick ("2x faster than
-// llvmpipe ... with a depth test and two colour outputs, with 2 threads").
+// speculum_llvmpipe_bench: the llvmpipe side of the rasterizer's yardstick (the same
+// triangles drawn with a depth test and two colour outputs, with 2 threads; the figures are
+// in docs/performance.md).
 //
 // Draws a triangle mesh (binary little-endian PLY, as `speculum bench raster ... --write-ply`
 // writes it) through OSMesa — gallium/llvmpipe in Debian's Mesa — into an offscreen FBO with

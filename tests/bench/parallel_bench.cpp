@@ -1,4 +1,4 @@
-// Stream-primitive benchmarks (issue 3): scan, both compactions, partition, radix sort and
+// Stream-primitive benchmarks: scan, both compactions, partition, radix sort and
 // reduce at 1M and 16M elements on 1 and 2 threads, each reporting its GB/s beside a memcpy
 // of the same traffic measured in the same process; plus the ROGER ch.4 block-size sweep.
 // Traffic = bytes the primitive must read + write at minimum; memcpy traffic = 2 × copy size.

@@ -1,4 +1,4 @@
-// BVH benchmarks (issue 5): build time and closest-hit throughput (single rays and 8-ray
+// BVH benchmarks: build time and closest-hit throughput (single rays and 8-ray
 // packets) for primary and reflect-cone30 rays on UV-spheres in a box room, 1 and 2
 // threads. The Embree comparison lives in `speculum bench trace` (same run, same rays);
 // these track our own trends.

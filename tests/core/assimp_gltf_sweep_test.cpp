@@ -1,5 +1,5 @@
 // Every glTF 2.0 file of Debian's assimp-testmodels either loads into a valid scene or is
-// rejected with InputError — never a crash and never another exception (issue 2 "Bad input").
+// rejected with InputError — never a crash and never another exception.
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 // Export every built-in scene as .glb and .gltf and load it back: counts, geometry,
-// materials, cameras and lights survive (issue 2 "exported scenes re-load with identical counts").
+// materials, cameras and lights survive with identical counts.
 #include <filesystem>
 #include <string>
 

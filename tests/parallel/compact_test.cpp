@@ -106,7 +106,7 @@ TEST(Compact, SixteenMillion) {
 }
 
 // Flags made by a width-generic kernel, then compacted: identical for every W and thread
-// count (DESIGN.md: every W gives the same bits).
+// count (every W gives the same bits: docs/architecture.md, "Determinism").
 template <int W>
 std::vector<std::uint32_t> cull_kernel(Executor& ex, const std::vector<float>& d) {
   using L = Lanes<W>;

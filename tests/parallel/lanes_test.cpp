@@ -1,4 +1,4 @@
-// Lanes<W>: every width agrees bit for bit with the W=1 scalar reference (DESIGN.md lanes).
+// Lanes<W>: every width agrees bit for bit with the W=1 scalar reference.
 #include "parallel/lanes.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The 16M-element size class (issue 3: "sizes 0, 1, odd, just-over-a-chunk and 16M") for
+// The 16M-element size class (beside sizes 0, 1, odd and just over a chunk) for
 // map, map_lanes, gather, reduce, float scan, stable partition, 64-bit radix sort with
 // payload, segmented min/argmin and histogram: each against a serial loop written here,
 // and identical (exact equality, floats bit for bit) for 1, 2 and 8 threads and, for the

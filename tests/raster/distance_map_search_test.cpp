@@ -1,7 +1,7 @@
-// Tests of the distance-map search (SURVEY §4.1, TECHNIQUES.md §2.2): the checks the
-// catalogue lists against exact geometry — direct lookup at the reference point, one exact
-// parallax step for a wall perpendicular to R, one exact secant step on a plane — and the
-// error growing with |x − o| in sphere-in-room against a brute-force ray oracle.
+// Tests of the distance-map search (SURVEY §4.1): checks against exact geometry — direct
+// lookup at the reference point, one exact parallax step for a wall perpendicular to R, one
+// exact secant step on a plane — and the error growing with |x − o| in sphere-in-room
+// against a brute-force ray oracle.
 #include "raster/distance_map_search.h"
 
 #include <cmath>

@@ -1,5 +1,5 @@
 // Tests of the tile rasterizer (raster/visibility.h): fill rule, watertightness, an
-// all-triangles ray oracle, perspective-correct interpolation and determinism (issue 4).
+// all-triangles ray oracle, perspective-correct interpolation and determinism.
 #include "raster/visibility.h"
 
 #include <cmath>

@@ -1,7 +1,7 @@
-// `speculum bench trace` checksums (issue 5 "Benchmark against Embree"): hits, prim_sum (sum
-// of hit triangle indices in file order) and t_sum (double, summed in file order) printed by
-// the CLI equal the all-pairs oracle's over the same rays and mesh, for both kernels
-// (packet, single) and 1 or 2 threads.
+// `speculum bench trace` checksums (the Embree comparison's correctness side): hits,
+// prim_sum (sum of hit triangle indices in file order) and t_sum (double, summed in file
+// order) printed by the CLI equal the all-pairs oracle's over the same rays and mesh, for
+// both kernels (packet, single) and 1 or 2 threads.
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -1,4 +1,4 @@
-// BVH on real meshes (issue 5 "Tests"): Debian's assimp-testmodels loaded through the
+// BVH on real meshes: Debian's assimp-testmodels loaded through the
 // project's loaders (OFF, PLY ASCII/binary, STL ASCII/binary, glTF binary); both layouts,
 // closest hit and any hit, and 8-ray packets return the all-pairs oracle's (t, triangle)
 // for random and adversarial rays; and real meshes are watertight: rays aimed exactly at

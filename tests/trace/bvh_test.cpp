@@ -1,4 +1,4 @@
-// BVH tests (issue 5): both layouts return the all-pairs oracle's (t, triangle) on random,
+// BVH tests: both layouts return the all-pairs oracle's (t, triangle) on random,
 // degenerate and real meshes; shared edges and vertices of closed meshes never leak; the
 // build is byte-identical for any thread count; refit and streams agree with the oracle.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Tests of the shared optics, sampling and shading pieces the trace helper wrote
-// (core/optics.h, core/sampling.h, core/shading.h): checks from TECHNIQUES.md §0.
+// (core/optics.h, core/sampling.h, core/shading.h) against closed-form values.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Packet traversal tests (issue 5, coherent ray streams): 8-ray packets return the
+// Packet traversal tests (coherent ray streams): 8-ray packets return the
 // oracle's (t, triangle) bit for bit on random, degenerate, closed and real meshes; the
 // packet path is really taken for coherent rays and refused for incoherent ones; rays
 // aimed at shared edges and vertices never leak; streams equal single rays for any

@@ -1,4 +1,4 @@
-// SPRY ray files and benchmark ray sets (issue 5 "Benchmark against Embree"): round trip,
+// SPRY ray files and the benchmark ray sets of `bench trace`: round trip,
 // malformed files rejected with InputError, ray-set geometry, and the bench CLI end to end.
 #include <gtest/gtest.h>
 

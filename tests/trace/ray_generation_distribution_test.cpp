@@ -1,4 +1,4 @@
-// The distributions of the benchmark ray sets (issue 5, `--emit-rays`, trace/ray_generation.h),
+// The distributions of the benchmark ray sets (`--emit-rays`, trace/ray_generation.h),
 // with fixed seeds: reflect-cone30 directions uniform in solid angle within the 30° cone
 // about the mirror direction, hemisphere directions cosine-weighted about the geometric
 // normal, both with uniform azimuth; secondary origins offset along the normal on the

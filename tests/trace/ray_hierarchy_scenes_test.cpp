@@ -1,4 +1,4 @@
-// Ray hierarchy on built-in scenes (ROGER ch.3, TECHNIQUES.md §4.2): G-buffer-like secondary
+// Ray hierarchy on built-in scenes (ROGER §3.3, §3.3.5): G-buffer-like secondary
 // rays (from primary hits), 1–3 bounces and the reversed shadow rays of every light; each
 // generation's per-pixel closest hit (t, u, v, triangle) equals the all-pairs oracle bit for
 // bit, and the whole run is byte-identical for 1 and 2 threads.

@@ -1,4 +1,4 @@
-// Ray hierarchy unit tests (ROGER ch.3, TECHNIQUES.md §4.2): the eq.3.1 cone-sphere test is
+// Ray hierarchy unit tests (ROGER §3.3.2–3.3.4): the eq.3.1 cone-sphere test is
 // conservative against a brute force (incl. α >= π/2 and spheres behind the apex), every
 // node encloses the rays below it, traversal runs exactly log2(side) level passes per batch,
 // batched = unbatched and 1 thread = 2 threads, all equal to the all-pairs oracle.

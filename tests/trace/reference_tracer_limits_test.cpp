@@ -1,4 +1,4 @@
-// Reference tracer limits (issue 5 "Reference tracer"): a ray that misses everything
+// Reference tracer limits: a ray that misses everything
 // returns the environment radiance in its direction (constant and equirect), with no light,
 // shadow or specular work; and the Whitted depth limit between two facing mirrors: each
 // extra bounce adds exactly one more reflected emission term, the specular ray count is

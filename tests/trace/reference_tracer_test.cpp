@@ -1,4 +1,4 @@
-// Reference tracer tests (issue 5): a mirror sphere against the analytic reflection of a
+// Reference tracer tests: a mirror sphere against the analytic reflection of a
 // checker plane, a glass slab's lateral shift, a prism's total internal reflection,
 // bit-identical images for 1, 2 and 8 threads, and error falling like 1/sqrt(spp).
 #include <gtest/gtest.h>

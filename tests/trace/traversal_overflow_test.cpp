@@ -1,9 +1,9 @@
-// Fixed-size traversal stacks at their real size (issue 5 "Traversal": overflow is counted,
-// never undefined) for any hit, closest hit and the 8-ray packet kernel, single and
-// streamed. No API shrinks those stacks, so the geometry overflows them: a "tunnel" of
-// clusters of slanted triangles at geometrically growing distances along -x, each cluster
-// box crossed by the probe rays (which pass beside every triangle), so the binned SAH
-// builds a deep lopsided tree whose wide nodes all have several children on the ray.
+// Fixed-size traversal stacks at their real size (overflow is counted, never undefined)
+// for any hit, closest hit and the 8-ray packet kernel, single and streamed. No API shrinks
+// those stacks, so the geometry overflows them: a "tunnel" of clusters of slanted
+// triangles at geometrically growing distances along -x, each cluster box crossed by the
+// probe rays (which pass beside every triangle), so the binned SAH builds a deep lopsided
+// tree whose wide nodes all have several children on the ray.
 // Whatever overflows, every answer is the oracle's unless an overflow was counted.
 #include <gtest/gtest.h>
 
