@@ -1,6 +1,6 @@
 // `speculum bench raster MESH|SCENE --json`: times `visibility` + `gbuffer` K times after a
-// warm-up and prints one JSON object (issue 4 "Benchmark"); per-kernel medians come from the
-// executor's launch records.
+// warm-up and prints one JSON object (the rasterizer's yardstick, beside llvmpipe's);
+// per-kernel medians come from the executor's launch records.
 #include <algorithm>
 #include <cstdio>
 #include <map>

@@ -1,7 +1,7 @@
 // `speculum bench trace`: traces a SPRY ray file against a PLY mesh with our BVH (and with
-// Embree 3 when built with it, in the same run) and prints one JSON object (issue 5
-// "Benchmark against Embree"); `--emit-rays` writes ray files for a camera and
-// `--make-mesh spheres:N` writes the test mesh (N UV-spheres in a box room).
+// Embree 3 when built with it, in the same run) and prints one JSON object; `--emit-rays`
+// writes ray files for a camera and `--make-mesh spheres:N` writes the test mesh (N
+// UV-spheres in a box room).
 #include <algorithm>
 #include <chrono>
 #include <cmath>

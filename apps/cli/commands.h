@@ -18,7 +18,8 @@ void add_scenes_command(CLI::App& app, GlobalOptions& global);
 void add_info_command(CLI::App& app, GlobalOptions& global);
 void add_render_command(CLI::App& app, GlobalOptions& global);
 void add_techniques_command(CLI::App& app, GlobalOptions& global);
-// inspect / profile / compare (issue 9): apps/inspect/inspect_command.cpp, profile_command.cpp, compare_command.cpp.
+// inspect / profile (apps/inspect/) and compare (compare_command.cpp): the tools that show
+// and judge a technique's passes.
 void add_inspect_command(CLI::App& app, GlobalOptions& global);
 void add_profile_command(CLI::App& app, GlobalOptions& global);
 void add_compare_command(CLI::App& app, GlobalOptions& global);

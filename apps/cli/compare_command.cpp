@@ -1,6 +1,6 @@
 // `speculum compare A B [--metric M] [--max X] [--diff out.png]`: image error metrics on PNG
 // 8-bit values (core/image_metrics.h), a heat-map of the difference, and an exit status for
-// golden-image tests: 0 within the bound, 1 outside, 2 bad input (issue 9 "compare").
+// golden-image tests: 0 within the bound, 1 outside, 2 bad input.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,5 @@
-// A progress bar on stderr for renders and experiments that take longer than a second
-// (issue 9 "Also"): silent when stderr is not a terminal or with --quiet; thread-safe.
+// A progress bar on stderr for renders and experiments that take longer than a second:
+// silent when stderr is not a terminal or with --quiet; thread-safe.
 //   Progress p("yu-fig9", rows, global.quiet);
 //   for (...) { ...; p.step(); }       // or p.step("row 3") to show what just finished
 #pragma once

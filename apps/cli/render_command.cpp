@@ -1,5 +1,5 @@
 // `speculum render [SCENE] --technique T -o out.png|exr`: loads a scene, runs the
-// technique's graph (apps/techniques/technique_table.h) and writes the image (issue 4).
+// technique's graph (apps/techniques/technique_table.h) and writes the image.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>

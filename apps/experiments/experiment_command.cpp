@@ -1,5 +1,6 @@
-// `speculum experiment NAME`: the paper-reproduction sweeps (issues 6–8). Each experiment
-// is a child subcommand in its own apps/cmd_experiment_*.cpp, registered here.
+// `speculum experiment NAME`: the paper-reproduction sweeps (YU Fig.9, the SURVEY
+// techniques, ROGER's ray hierarchy). Each experiment is a child subcommand in its own file
+// of apps/experiments/, registered here.
 #include "apps/cli/commands.h"
 
 namespace speculum::cli {

@@ -1,4 +1,4 @@
-// `speculum experiment ray-hierarchy`: ROGER ch.3 measurements (TECHNIQUES.md §4.2, issue 8)
+// `speculum experiment ray-hierarchy`: the measurements of ROGER §3.4
 // — the ray hierarchy over a width sweep on smooth and bumpy reflectors: ms per frame's
 // secondary rays, candidates per ray, cone-sphere tests, the stage split, and the same rays
 // traced with the BVH (trace::closest_hit_stream) for the time ratio and the identity check.

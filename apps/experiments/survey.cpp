@@ -1,4 +1,4 @@
-// `speculum experiment survey`: the SURVEY techniques (TECHNIQUES.md §2.1–2.6, issue 7) on
+// `speculum experiment survey`: the SURVEY techniques (§3.1, §4.1–4.5, §5) on
 // the scenes where each applies — ms per frame (median of --runs) and error against the
 // reference tracer (mae8, rmse, psnr on 8-bit PNG values, core/image_metrics.h), plus the
 // search steps used and the mean distance-map reads per searched ray.

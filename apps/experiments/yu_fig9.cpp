@@ -1,4 +1,4 @@
-// `speculum experiment yu-fig9`: YU Fig.9 / TECHNIQUES.md §1 — glossy-plane with its object
+// `speculum experiment yu-fig9`: YU Fig.9 (YU §4) — glossy-plane with its object
 // tessellated on res×res vertex grids, traced with LOD off and α ∈ {1, 3, 10}: per-frame glossy
 // time, nodes and triangle tests per ray, and error against the reference tracer.
 #include <algorithm>

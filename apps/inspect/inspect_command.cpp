@@ -1,5 +1,5 @@
 // `speculum inspect SCENE --technique T -o DIR`: one frame with every node output written
-// as PNG + EXR, the graph as DOT/SVG, manifest.json and index.html (issue 9 "inspect").
+// as PNG + EXR, the graph as DOT/SVG, manifest.json and index.html.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>

@@ -1,6 +1,6 @@
-// How `inspect` draws the trace-side outputs (issue 9): secondary ray generations, the ray
-// hierarchy's levels and their hits (ROGER ch.3), YU's glossy rays and LOD hits (YU §3.3,
-// §3.4) and layered distance maps (SURVEY §4.5) as per-pixel pictures, see inspect_images.h.
+// How `inspect` draws the trace-side outputs: secondary ray generations, the ray
+// hierarchy's levels and their hits (ROGER §3.3), YU's glossy rays and LOD hits (YU §3.2,
+// §3.3) and layered distance maps (SURVEY §4.5) as per-pixel pictures, see inspect_images.h.
 #pragma once
 
 #include "apps/inspect/inspect_images.h"

@@ -1,6 +1,6 @@
 // `speculum profile SCENE --technique T [--repeat K] [-o DIR]`: per-node median wall time,
 // share of the frame and counters; DIR/trace.json (Chrome trace events, one per node and per
-// named kernel launch, of the last run) and DIR/counters.json (issue 9 "profile").
+// named kernel launch, of the last run) and DIR/counters.json.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
