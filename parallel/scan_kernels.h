@@ -84,7 +84,8 @@ T scan_scalar(const T* in, T* out, std::size_t m, T acc, Op& op) {
 // dozen lines the out-of-order window holds are in flight and one thread reads at 2/3 of a
 // copy's rate. 16M u32 exclusive, about 400 interleaved samples per distance, mean of the
 // sample medians: 4, 8, 16 and 32 KiB gave 1T 3.10, 2.77, 2.80 and 3.12 ms, and 2T (in the
-// host's high-bandwidth state) 1.74, 1.59, 1.65 and 1.78 ms.
+// host's high-bandwidth state) 1.74, 1.59, 1.65 and 1.78 ms. The hint is T0: T1 measured the
+// same, NTA slower at 2T (1.65 against 1.52 ms).
 inline constexpr std::size_t kNextPrefetchBytes = 8192;
 
 // One step of the 32-bit sum scan: out[k, k + 2W) from in[k, k + 2W) and the running carry
