@@ -145,13 +145,6 @@ glm::vec2 equirect_uv(const glm::vec3& d) {
   return {u, v};
 }
 
-glm::vec3 equirect_direction(glm::vec2 uv) {
-  const float phi = (uv.x - 0.5f) * 2.0f * kPi;
-  const float theta = uv.y * kPi;
-  const float st = std::sin(theta);
-  return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
-}
-
 glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d) {
   if (!env.has_image()) return env.constant * env.intensity;
   const glm::vec2 uv = equirect_uv(glm::normalize(d));
@@ -162,5 +155,17 @@ glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d) {
   const glm::vec2 clamped{uv.x, (fy + 0.5f) / static_cast<float>(img.height)};
   return glm::vec3(sample_bilinear_repeat(img, clamped)) * env.intensity;
 }
+
+std::vector<std::uint8_t> refractor_objects(const Scene& scene) {
+  std::vector<std::uint8_t> out(scene.objects.size(), 0);
+  for (std::size_t t = 0; t < scene.mesh.triangle_count(); ++t) {
+    const std::uint32_t o = scene.mesh.triangle_object[t], mat = scene.mesh.triangle_material[t];
+    if (o < out.size() && mat < scene.materials.size() &&
+        surface_params(scene.materials[mat]).is_refractor())
+      out[o] = 1;
+  }
+  return out;
+}
+
 
 }  // namespace speculum

@@ -29,6 +29,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/scene.h"
+#include <vector>
 
 namespace speculum {
 
@@ -79,10 +80,12 @@ glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv);
 // Equirect mapping (see the header comment) and the environment radiance towards -d
 // (d: unit direction of the ray leaving the scene).
 glm::vec2 equirect_uv(const glm::vec3& d);
-glm::vec3 equirect_direction(glm::vec2 uv);
 glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d);
 
 // Bilinear lookup with repeat wrapping in u and v (texel centres at (i+0.5)/w).
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv);
+
+// Per scene object: 1 when any of its triangles has a refracting material.
+std::vector<std::uint8_t> refractor_objects(const Scene& scene);
 
 }  // namespace speculum

@@ -1,5 +1,5 @@
-// The job graph: validation, culling, topological order and concurrent execution
-// (DESIGN.md "The job graph"); see graph.h for the recipe API.
+// The job graph: validation, culling, topological order and concurrent execution; see
+// graph.h for the recipe API.
 #include "parallel/graph.h"
 
 #include <algorithm>
@@ -22,30 +22,14 @@ const NodeRecord* RunReport::find(std::string_view node) const {
   return nullptr;
 }
 
-NodeBuilder& NodeBuilder::bind(std::string_view port, std::string resource) {
-  auto& entry = graph_->nodes_[index_];
-  for (auto& d : entry.ports) {
-    if (d.port == port) {
-      d.resource = std::move(resource);
-      graph_->compiled_ = false;
-      return *this;
-    }
-  }
-  throw GraphError("node " + quote(entry.name) + " has no port " + quote(port) + " to bind");
-}
-
-NodeBuilder Graph::add_node(std::string name, std::unique_ptr<Node> node) {
+std::size_t Graph::add_node(std::string name, std::unique_ptr<Node> node,
+                            std::vector<PortDecl> ports) {
   if (name.empty()) throw GraphError("a graph node needs a name");
   for (const auto& e : nodes_)
     if (e.name == name) throw GraphError("two graph nodes are named " + quote(name));
-  NodeEntry entry{std::move(name), std::move(node), {}, {}, {}};
-  Ports ports;
-  entry.node->declare(ports);
-  entry.ports = std::move(ports.decls());
-  entry.params = entry.node->parameters();
-  nodes_.push_back(std::move(entry));
+  nodes_.push_back(NodeEntry{std::move(name), std::move(node), std::move(ports), {}, {}});
   compiled_ = false;
-  return NodeBuilder(*this, nodes_.size() - 1);
+  return nodes_.size() - 1;
 }
 
 void Graph::set_input(std::string resource, ResourceValue value) {
@@ -53,41 +37,35 @@ void Graph::set_input(std::string resource, ResourceValue value) {
   compiled_ = false;
 }
 
-void Graph::request(std::string resource) {
+void Graph::request_name(std::string resource) {
   requests_.push_back(std::move(resource));
   compiled_ = false;
 }
 
-void Graph::compile() {
-  if (compiled_) return;
-  const std::size_t n = nodes_.size();
-  struct Producer {
-    long node;  // -1: graph input
-    std::type_index type;
-    std::string type_name;
-  };
+std::map<std::string, Graph::Producer, std::less<>> Graph::find_producers() const {
   std::map<std::string, Producer, std::less<>> producers;
-  auto producer_label = [&](long p) { return p < 0 ? std::string("the graph input") : "node " + quote(nodes_[p].name); };
   for (const auto& [r, v] : inputs_) producers.emplace(r, Producer{-1, v.type, v.type_name});
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& e = nodes_[i];
-    for (std::size_t a = 0; a < e.ports.size(); ++a)
-      for (std::size_t b = a + 1; b < e.ports.size(); ++b)
-        if (e.ports[a].port == e.ports[b].port)
-          throw GraphError("node " + quote(e.name) + " declares port " + quote(e.ports[a].port) + " twice");
-    for (const auto& d : e.ports) {
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    for (const auto& d : nodes_[i].ports) {
       if (!d.output) continue;
       auto [it, fresh] = producers.emplace(d.resource, Producer{long(i), d.type, d.type_name});
       if (!fresh)
         throw GraphError("resource " + quote(d.resource) + " has two producers: " +
-                         producer_label(it->second.node) + " and node " + quote(e.name));
+                         (it->second.node < 0 ? std::string("the graph input")
+                                              : "node " + quote(nodes_[it->second.node].name)) +
+                         " and node " + quote(nodes_[i].name));
     }
   }
-  // Edges producer → consumer, within a frame.
-  struct Edge { std::size_t from, to; std::string resource; };
+  return producers;
+}
+
+// Edges producer → consumer within a frame; inputs_of[i] also lists previous-frame producers
+// (they keep their producer alive when culling).
+std::vector<Graph::Edge> Graph::connect(const std::map<std::string, Producer, std::less<>>& producers,
+                                        std::vector<std::vector<std::size_t>>& inputs_of) const {
   std::vector<Edge> edges;
-  std::vector<std::vector<std::size_t>> inputs_of(n);  // producer nodes incl. previous-frame
-  for (std::size_t i = 0; i < n; ++i) {
+  inputs_of.assign(nodes_.size(), {});
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
     const auto& e = nodes_[i];
     for (const auto& d : e.ports) {
       if (d.output) continue;
@@ -99,41 +77,50 @@ void Graph::compile() {
       }
       if (it->second.type != d.type)
         throw GraphError("node " + quote(e.name) + " reads resource " + quote(d.resource) + " as " +
-                         d.type_name + " but " + producer_label(it->second.node) + " provides " +
-                         it->second.type_name);
+                         d.type_name + " but its producer provides " + it->second.type_name);
       if (it->second.node < 0) continue;
       inputs_of[i].push_back(std::size_t(it->second.node));
       if (!d.previous_frame) edges.push_back({std::size_t(it->second.node), i, d.resource});
     }
   }
-  // Culling: keep what reaches a requested resource (all nodes without requests).
-  std::vector<bool> active(n, requests_.empty());
-  {
-    std::vector<std::size_t> work;
-    for (const auto& r : requests_) {
-      auto it = producers.find(r);
-      if (it == producers.end()) throw GraphError("requested resource " + quote(r) + " has no producer");
-      if (it->second.node >= 0) work.push_back(std::size_t(it->second.node));
-    }
-    while (!work.empty()) {
-      const std::size_t i = work.back();
-      work.pop_back();
-      if (active[i]) continue;
-      active[i] = true;
-      for (std::size_t p : inputs_of[i]) work.push_back(p);
-    }
+  return edges;
+}
+
+// Keeps what reaches a requested resource (every node when nothing is requested).
+std::vector<bool> Graph::reachable_from_requests(
+    const std::map<std::string, Producer, std::less<>>& producers,
+    const std::vector<std::vector<std::size_t>>& inputs_of) const {
+  std::vector<bool> active(nodes_.size(), requests_.empty());
+  std::vector<std::size_t> work;
+  for (const auto& r : requests_) {
+    auto it = producers.find(r);
+    if (it == producers.end()) throw GraphError("requested resource " + quote(r) + " has no producer");
+    if (it->second.node >= 0) work.push_back(std::size_t(it->second.node));
   }
-  // Topological order (Kahn, lowest insertion index first so the order is reproducible).
+  while (!work.empty()) {
+    const std::size_t i = work.back();
+    work.pop_back();
+    if (active[i]) continue;
+    active[i] = true;
+    for (std::size_t p : inputs_of[i]) work.push_back(p);
+  }
+  return active;
+}
+
+// Kahn's algorithm, lowest insertion index first so the order is reproducible. Typed handles
+// make a cycle impossible in a recipe (a pass can only read what exists when it is added), but
+// the check stays for previous-frame seeds and future APIs.
+std::vector<std::size_t> Graph::topological_order(const std::vector<Edge>& edges) const {
+  const std::size_t n = nodes_.size();
   std::vector<std::set<std::size_t>> succ(n);
   for (const auto& ed : edges) succ[ed.from].insert(ed.to);
-  std::vector<std::size_t> indegree(n, 0);
+  std::vector<std::size_t> remaining(n, 0);
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t s : succ[i]) ++indegree[s];
+    for (std::size_t s : succ[i]) ++remaining[s];
   std::priority_queue<std::size_t, std::vector<std::size_t>, std::greater<>> ready;
   for (std::size_t i = 0; i < n; ++i)
-    if (indegree[i] == 0) ready.push(i);
+    if (remaining[i] == 0) ready.push(i);
   std::vector<std::size_t> topo;
-  std::vector<std::size_t> remaining = indegree;
   while (!ready.empty()) {
     const std::size_t i = ready.top();
     ready.pop();
@@ -142,45 +129,34 @@ void Graph::compile() {
       if (--remaining[s] == 0) ready.push(s);
   }
   if (topo.size() != n) {
-    // Walk backwards along unresolved edges until a node repeats: that loop is the cycle.
-    std::vector<bool> done(n, false);
-    for (std::size_t i : topo) done[i] = true;
-    std::size_t cur = 0;
-    while (done[cur]) ++cur;
-    std::vector<std::size_t> path;
-    std::vector<const Edge*> via;
-    std::map<std::size_t, std::size_t> seen;
-    while (!seen.count(cur)) {
-      seen[cur] = path.size();
-      path.push_back(cur);
-      const Edge* back = nullptr;
-      for (const auto& ed : edges)
-        if (ed.to == cur && !done[ed.from]) { back = &ed; break; }
-      via.push_back(back);
-      cur = back->from;
-    }
-    // path[k] is fed by path[k+1] through via[k]; print the cycle in data-flow order.
-    std::string msg = "the graph has a cycle: ";
-    const std::size_t first = seen[cur];
-    msg += quote(nodes_[cur].name);
-    for (std::size_t k = path.size(); k-- > first;) {
-      msg += " -(" + via[k]->resource + ")-> " + quote(nodes_[path[k]].name);
-    }
+    std::string msg = "the graph has a cycle through:";
+    for (std::size_t i = 0; i < n; ++i)
+      if (remaining[i] != 0) msg += " " + quote(nodes_[i].name);
     throw GraphError(msg);
   }
+  return topo;
+}
+
+void Graph::compile() {
+  if (compiled_) return;
+  const auto producers = find_producers();
+  std::vector<std::vector<std::size_t>> inputs_of;
+  const std::vector<Edge> edges = connect(producers, inputs_of);
+  std::vector<bool> active = reachable_from_requests(producers, inputs_of);
+  const std::vector<std::size_t> topo = topological_order(edges);
   order_.clear();
   for (std::size_t i : topo)
     if (active[i]) order_.push_back(i);
-  successors_.assign(n, {});
-  predecessor_count_.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!active[i]) continue;
-    for (std::size_t s : succ[i])
-      if (active[s]) {
-        successors_[i].push_back(s);
-        ++predecessor_count_[s];
-      }
+  successors_.assign(nodes_.size(), {});
+  predecessor_count_.assign(nodes_.size(), 0);
+  for (const auto& ed : edges) {
+    if (!active[ed.from] || !active[ed.to]) continue;
+    auto& succ = successors_[ed.from];
+    if (std::find(succ.begin(), succ.end(), ed.to) != succ.end()) continue;
+    succ.push_back(ed.to);
+    ++predecessor_count_[ed.to];
   }
+  for (auto& succ : successors_) std::sort(succ.begin(), succ.end());
   active_ = std::move(active);
   compiled_ = true;
 }
@@ -227,8 +203,26 @@ RunReport Graph::run(Executor& executor, const CaptureHook& capture) {
   values_.clear();
   for (const auto& [r, v] : inputs_) values_[r] = v;
   std::vector<NodeRecord> records(nodes_.size());
+  // The first pass to throw (its index and exception); once set, no new pass starts.
+  std::mutex failure_mutex;
+  std::atomic<bool> failed{false};
+  std::size_t failed_node = 0;
+  std::exception_ptr failure;
+  auto run_guarded = [&](std::size_t i) {
+    if (failed.load(std::memory_order_acquire)) return false;
+    try {
+      run_node(i, executor, capture, records[i]);
+      return true;
+    } catch (...) {
+      std::lock_guard lock(failure_mutex);
+      if (!failure) failure = std::current_exception(), failed_node = i;
+      failed.store(true, std::memory_order_release);
+      return false;
+    }
+  };
   if (executor.synchronous() || order_.size() <= 1) {
-    for (std::size_t i : order_) run_node(i, executor, capture, records[i]);
+    for (std::size_t i : order_)
+      if (!run_guarded(i)) break;
   } else {
     executor.run([&] {
       tbb::task_group group;
@@ -240,10 +234,11 @@ RunReport Graph::run(Executor& executor, const CaptureHook& capture) {
       ForkJoinSync done;
       std::function<void(std::size_t)> launch;
       // Node i's task body; it runs after sync[i].enter() (ForkJoinTask), i.e. after
-      // everything its spawner did, and publishes to the final wait through `done`.
+      // everything its spawner did, and publishes to the final wait through `done`. A node
+      // that fails (or starts after a failure) launches no successor.
       auto body = [&](std::size_t i) {
         ForkJoinSync::LeaveOnExit leave{done};
-        run_node(i, executor, capture, records[i]);
+        if (!run_guarded(i)) return;
         // acq_rel: the last predecessor to finish publishes every input to the successor.
         for (std::size_t s : successors_[i])
           if (pending[s].fetch_sub(1, std::memory_order_acq_rel) == 1) launch(s);
@@ -258,6 +253,16 @@ RunReport Graph::run(Executor& executor, const CaptureHook& capture) {
       group.wait();
     });
   }
+  if (failure) {
+    std::string message = "unknown exception";
+    try {
+      std::rethrow_exception(failure);
+    } catch (const std::exception& e) {
+      message = e.what();
+    } catch (...) {
+    }
+    throw NodeError(nodes_[failed_node].name, failure, message);
+  }
   // Cross-frame edges: hand this run's values to the next run (shared, not copied).
   for (std::size_t i : order_)
     for (const auto& d : nodes_[i].ports)
@@ -271,7 +276,7 @@ RunReport Graph::run(Executor& executor, const CaptureHook& capture) {
   return report;
 }
 
-bool Graph::has(std::string_view resource) const {
+bool Graph::has_value(std::string_view resource) const {
   auto it = values_.find(resource);
   return it != values_.end() && it->second.value;
 }

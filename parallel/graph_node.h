@@ -1,6 +1,6 @@
-// A job-graph node: typed ports declared before execution, printable parameters, and the
-// context a node runs with (executor, counters, timers, typed resource access). DESIGN.md
-// "The job graph"; the graph itself is parallel/graph.h.
+// A job-graph node: its ports, printable parameters, and the context a node runs with
+// (executor, counters, timers, resource access by port). The typed recipe API that makes
+// the ports is parallel/graph.h.
 #pragma once
 
 #include <cstdint>
@@ -27,7 +27,8 @@ class GraphError : public std::logic_error {
   using std::logic_error::logic_error;
 };
 
-// One declared port. `resource` defaults to the port name; a recipe may rebind it.
+// One port of a node: the resource it reads or writes (a previous-frame read's port is
+// "<resource>@previous").
 struct PortDecl {
   std::string port;
   std::string resource;
@@ -35,29 +36,6 @@ struct PortDecl {
   std::string type_name;
   bool output = false;
   bool previous_frame = false;  // reads the value `resource` had at the end of the last run
-};
-
-// What a node declares in declare(): its typed inputs and outputs.
-class Ports {
- public:
-  template <class T> Ports& input(std::string port) { return add<T>(std::move(port), false, false); }
-  template <class T> Ports& output(std::string port) { return add<T>(std::move(port), true, false); }
-  // A cross-frame edge: reads last run's value of the resource (absent on the first run
-  // unless Graph::seed_previous provided one). It does not order nodes within a frame.
-  template <class T> Ports& previous(std::string port) { return add<T>(std::move(port), false, true); }
-
-  std::vector<PortDecl>& decls() { return decls_; }
-  const std::vector<PortDecl>& decls() const { return decls_; }
-
-  template <class T>
-  Ports& add(std::string port, bool output, bool previous) {
-    std::string resource = port;
-    decls_.push_back({std::move(port), std::move(resource), typeid(T), type_name<T>(), output, previous});
-    return *this;
-  }
-
- private:
-  std::vector<PortDecl> decls_;
 };
 
 // Printable parameters, in declaration order (shown in DOT, manifests and `inspect`).
@@ -87,16 +65,16 @@ struct ResourceValue {
 
 class NodeContext;
 
+// What the graph runs; Graph::add wraps a pass in one (graph.h).
 class Node {
  public:
   virtual ~Node() = default;
-  virtual void declare(Ports& ports) {}
-  virtual Params parameters() const { return {}; }
   virtual void execute(NodeContext& ctx) = 0;
 };
 
 // What the graph hands a running node. Counters and timers may be used from inside the
-// node's parallel_for bodies (they lock); integer sums are order-independent.
+// node's parallel_for bodies (they lock). Counters are real numbers; a sum of integral
+// deltas is exact (below 2^53) and so independent of the order the bodies add them in.
 class NodeContext {
  public:
   NodeContext(Executor& executor, std::string node, const std::vector<PortDecl>& ports,
@@ -135,7 +113,7 @@ class NodeContext {
     return output<T>(port) = std::move(value);
   }
 
-  void count(std::string_view counter, std::uint64_t delta = 1) {
+  void count(std::string_view counter, double delta = 1) {
     std::lock_guard lock(mutex_);
     counters_[std::string(counter)] += delta;
   }
@@ -144,7 +122,7 @@ class NodeContext {
    public:
     ScopedTimer(NodeContext& ctx, std::string name)
         : ctx_(ctx), name_(std::move(name) + "_ns"), start_(ctx.executor_.now_ns()) {}
-    ~ScopedTimer() { ctx_.count(name_, std::uint64_t(ctx_.executor_.now_ns() - start_)); }
+    ~ScopedTimer() { ctx_.count(name_, double(ctx_.executor_.now_ns() - start_)); }
     ScopedTimer(const ScopedTimer&) = delete;
     ScopedTimer& operator=(const ScopedTimer&) = delete;
 
@@ -155,7 +133,7 @@ class NodeContext {
   };
   ScopedTimer timer(std::string name) { return ScopedTimer(*this, std::move(name)); }
 
-  std::map<std::string, std::uint64_t> counters() const {
+  std::map<std::string, double> counters() const {
     std::lock_guard lock(mutex_);
     return counters_;
   }
@@ -180,17 +158,7 @@ class NodeContext {
   std::map<std::string, ResourceValue>& inputs_;
   std::map<std::string, ResourceValue>& outputs_;
   mutable std::mutex mutex_;
-  std::map<std::string, std::uint64_t> counters_;
-};
-
-// A node defined by a function; its ports come from the recipe (reads/writes).
-class LambdaNode final : public Node {
- public:
-  explicit LambdaNode(std::function<void(NodeContext&)> fn) : fn_(std::move(fn)) {}
-  void execute(NodeContext& ctx) override { fn_(ctx); }
-
- private:
-  std::function<void(NodeContext&)> fn_;
+  std::map<std::string, double> counters_;
 };
 
 }  // namespace speculum::par

@@ -1,39 +1,31 @@
 // Chrome trace-event JSON export of a graph run and its kernel launches (opens in Perfetto
 // and chrome://tracing; format: "Trace Event Format", complete events ph="X", times in µs).
 #include <algorithm>
-#include <cstdio>
+#include <cmath>
 #include <map>
-#include <sstream>
+#include <type_traits>
+
+#include <nlohmann/json.hpp>
 
 #include "parallel/graph.h"
 
 namespace speculum::par {
 
 namespace {
-std::string json_escape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out;
-}
+using Json = nlohmann::ordered_json;  // keys in the order written: "name" first, as viewers list them
 
-std::string micros(std::int64_t ns) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f", double(ns) / 1000.0);
-  return buf;
+// Trace times are µs; three decimals keep the nanoseconds the executor measured.
+double micros(std::int64_t ns) { return double(ns) / 1000.0; }
+
+// A counter as an event argument: integral values as integers whatever the counter type.
+template <class T>
+Json counter_value(T v) {
+  if constexpr (std::is_floating_point_v<T>) {
+    constexpr double kExactIntegers = 9007199254740992.0;  // 2^53
+    if (std::isfinite(v) && v == std::trunc(v) && std::abs(double(v)) < kExactIntegers)
+      return static_cast<std::int64_t>(v);
+  }
+  return v;
 }
 }  // namespace
 
@@ -53,32 +45,26 @@ std::string chrome_trace_json(const RunReport& report, const std::vector<LaunchR
     track_end[t] = n->start_ns + n->duration_ns;
     track_of[n->name] = int(t) + 1;
   }
-  std::ostringstream s;
-  s << "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n";
-  s << "{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":0,\"args\":{\"name\":\"launches\"}}";
+  Json events = Json::array();
+  events.push_back({{"name", "thread_name"}, {"ph", "M"}, {"pid", 1}, {"tid", 0}, {"args", {{"name", "launches"}}}});
   for (std::size_t t = 0; t < track_end.size(); ++t)
-    s << ",\n{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":" << t + 1
-      << ",\"args\":{\"name\":\"graph " << t + 1 << "\"}}";
+    events.push_back({{"name", "thread_name"}, {"ph", "M"}, {"pid", 1}, {"tid", t + 1},
+                      {"args", {{"name", "graph " + std::to_string(t + 1)}}}});
   for (const auto* n : nodes) {
-    s << ",\n{\"name\":\"" << json_escape(n->name) << "\",\"cat\":\"node\",\"ph\":\"X\",\"pid\":1,\"tid\":"
-      << track_of[n->name] << ",\"ts\":" << micros(n->start_ns) << ",\"dur\":" << micros(n->duration_ns)
-      << ",\"args\":{";
-    bool first = true;
-    for (const auto& [k, v] : n->counters) {
-      s << (first ? "" : ",") << "\"" << json_escape(k) << "\":" << v;
-      first = false;
-    }
-    s << "}}";
+    Json args = Json::object();
+    for (const auto& [k, v] : n->counters) args[k] = counter_value(v);
+    events.push_back({{"name", n->name}, {"cat", "node"}, {"ph", "X"}, {"pid", 1}, {"tid", track_of[n->name]},
+                      {"ts", micros(n->start_ns)}, {"dur", micros(n->duration_ns)}, {"args", std::move(args)}});
   }
   for (const auto& l : launches) {
     auto it = track_of.find(l.scope);
     const int tid = it == track_of.end() ? 0 : it->second;
-    s << ",\n{\"name\":\"" << json_escape(l.name) << "\",\"cat\":\"launch\",\"ph\":\"X\",\"pid\":1,\"tid\":"
-      << tid << ",\"ts\":" << micros(l.start_ns) << ",\"dur\":" << micros(l.duration_ns)
-      << ",\"args\":{\"elements\":" << l.elements << ",\"chunks\":" << l.chunks << "}}";
+    events.push_back({{"name", l.name}, {"cat", "launch"}, {"ph", "X"}, {"pid", 1}, {"tid", tid},
+                      {"ts", micros(l.start_ns)}, {"dur", micros(l.duration_ns)},
+                      {"args", {{"elements", l.elements}, {"chunks", l.chunks}}}});
   }
-  s << "\n]}\n";
-  return s.str();
+  const Json trace{{"displayTimeUnit", "ms"}, {"traceEvents", std::move(events)}};
+  return trace.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace speculum::par

@@ -4,6 +4,7 @@
 
 #include "core/image.h"
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -18,5 +19,38 @@ ImageRGBA resolve_supersamples(par::Executor& executor, const ImageRGBA& samples
 // Exposure then the Narkowicz ACES fit per channel; alpha set to 1. Output is linear in
 // [0, 1] (1 once exposure × value ≳ 7.24) — the PNG writer applies the sRGB curve.
 ImageRGBA tonemap(par::Executor& executor, const ImageRGBA& hdr, float exposure = 1.0f);
+
+// Pass "composite": direct + specular radiance per sample.
+struct CompositePass {
+  static constexpr const char* description =
+      "Adds direct and specular radiance per sample (SOFF §3.1: the lerp by specular level, as "
+      "a sum in the shared shading model).";
+  ImageRGBA operator()(par::NodeContext& c, const ImageRGBA& direct, const ImageRGBA& specular) const {
+    return composite(c.executor(), direct, specular);
+  }
+};
+
+// Pass "resolve": k×k supersamples → one linear radiance value per pixel.
+struct ResolvePass {
+  static constexpr const char* description =
+      "Box-filters the k×k supersamples of each pixel into its linear radiance (SOFF §3.1 supersampling).";
+  int k = 1;
+  void parameters(par::Params& p) const { p.set("k", k); }
+  ImageRGBA operator()(par::NodeContext& c, const ImageRGBA& samples) const {
+    return resolve_supersamples(c.executor(), samples, k);
+  }
+};
+
+// Pass "tonemap": the display image every technique ends with.
+struct TonemapPass {
+  static constexpr const char* description =
+      "Exposure, then the ACES filmic curve: the display image a PNG stores (the same for every "
+      "technique, so images compare like for like).";
+  float exposure = 1.0f;
+  void parameters(par::Params& p) const { p.set("exposure", exposure); }
+  ImageRGBA operator()(par::NodeContext& c, const ImageRGBA& radiance) const {
+    return tonemap(c.executor(), radiance, exposure);
+  }
+};
 
 }  // namespace speculum::raster

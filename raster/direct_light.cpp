@@ -38,4 +38,10 @@ ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffe
   return out;
 }
 
+ImageRGBA DirectLightPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                     const ShadowMaps& shadows,
+                                     const EnvironmentMap& environment) const {
+  return direct_light(c.executor(), *scene, gbuffer, camera, shadows, environment);
+}
+
 }  // namespace speculum::raster

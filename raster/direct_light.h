@@ -10,6 +10,7 @@
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/shadow_map.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -18,5 +19,16 @@ namespace speculum::raster {
 ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,
                        const Camera& camera, const std::vector<ShadowMap>& shadows,
                        const EnvironmentMap& env);
+
+// Pass "direct_light": the diffuse and glossy response to every light, plus ambient.
+struct DirectLightPass {
+  static constexpr const char* description =
+      "Direct light from every scene light with shadow-map visibility, plus SH ambient from the "
+      "environment, with the one shading model shared with the reference (SURVEY §3.1 diffuse part).";
+  const Scene* scene = nullptr;
+  Camera camera;
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const ShadowMaps& shadows,
+                       const EnvironmentMap& environment) const;
+};
 
 }  // namespace speculum::raster

@@ -49,4 +49,15 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
   return out;
 }
 
+ImageRGBA DistanceMapReflectPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                            const EnvironmentMap& environment,
+                                            const ReflectorMaps& maps) const {
+  DistanceReflectStats st;
+  ImageRGBA specular = distance_map_reflect(c.executor(), gbuffer, environment, maps, search, &st);
+  c.count("searches", st.searches);
+  c.count("distance_lookups", st.lookups);
+  c.count("bracketed", st.bracketed);
+  return specular;
+}
+
 }  // namespace speculum::raster

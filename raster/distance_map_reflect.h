@@ -12,6 +12,7 @@
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -28,5 +29,16 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
                                const EnvironmentMap& env, const ReflectorMaps& maps,
                                const DistanceSearchOptions& options,
                                DistanceReflectStats* stats = nullptr);
+
+// Pass "distance_map_reflect": the specular layer searched in the reflectors' distance maps.
+struct DistanceMapReflectPass {
+  static constexpr const char* description =
+      "Parallax (eq.4) / linear (§4.1.2) / secant (eq.5) search per specular sample in its "
+      "reflector's colour + distance cube map, Fresnel-weighted (SURVEY §4.1).";
+  DistanceSearchOptions search;
+  void parameters(par::Params& p) const { p.set("search", describe_search(search)); }
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const EnvironmentMap& environment,
+                       const ReflectorMaps& maps) const;
+};
 
 }  // namespace speculum::raster

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -26,6 +27,10 @@ struct DistanceSearchOptions {
   bool secant = true;      // eq.5 refinement of the bracket (or of the parallax guesses)
   int secant_steps = 4;
 };
+
+// "parallax=1 linear=16 secant=4" (a step count, or "off" for a disabled search): the
+// search as passes and experiments print it.
+std::string describe_search(const DistanceSearchOptions& options);
 
 struct DistanceSearchResult {
   float d = std::numeric_limits<float>::infinity();  // ray parameter; +inf: environment guess
@@ -74,13 +79,6 @@ inline float secant_from_ratios(float d_l, float g_l, float d_p, float g_p) {
   const float denom = g_p - g_l;
   if (denom == 0.0f || !std::isfinite(denom)) return d_l;
   return d_l + (d_p - d_l) * (1.0f - g_l) / denom;
-}
-template <class DistanceFn>
-float secant_step(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r,
-                  float d_l, float d_p) {
-  int lookups = 0;
-  return secant_from_ratios(d_l, distance_search_detail::ratio(distance_towards, x, r, d_l, lookups),
-                            d_p, distance_search_detail::ratio(distance_towards, x, r, d_p, lookups));
 }
 
 // The combined search. Order: x = o → the direct lookup along r. Linear search (when on)

@@ -170,4 +170,8 @@ glm::vec3 EnvironmentMap::irradiance(const glm::vec3& n) const {
   return glm::max(e, glm::vec3(0.0f));
 }
 
+EnvironmentMap EnvironmentPass::operator()(par::NodeContext& c) const {
+  return build_environment(c.executor(), scene->environment, size);
+}
+
 }  // namespace speculum::raster

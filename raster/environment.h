@@ -12,6 +12,7 @@
 #include "core/scene.h"
 #include "parallel/executor.h"
 #include "raster/cube_map.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -44,5 +45,16 @@ int levels_for_lobes(int size, float min_phong_exponent);
 
 // size 0: picks from the image (a quarter of the equirect width, 16..512; 8 for constants).
 EnvironmentMap build_environment(par::Executor& executor, const Environment& env, int size = 0);
+
+// Pass "environment": the scene's environment as a mip-mapped cube map (SURVEY §3.1).
+struct EnvironmentPass {
+  static constexpr const char* description =
+      "Resamples the scene environment into a mip-mapped cube map whose coarser levels are "
+      "Phong-prefiltered for glossy lookups, plus 9 SH coefficients for ambient light (SURVEY §3.1).";
+  const Scene* scene = nullptr;
+  int size = 0;  // 0: from the image
+  void parameters(par::Params& p) const { p.set("size", size); }
+  EnvironmentMap operator()(par::NodeContext& c) const;
+};
 
 }  // namespace speculum::raster

@@ -38,4 +38,10 @@ ImageRGBA envmap_reflect(par::Executor& executor, const GBuffer& g, const Enviro
   });
 }
 
+ImageRGBA EnvmapReflectPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                       const EnvironmentMap& environment,
+                                       const ReflectorMaps* maps) const {
+  return envmap_reflect(c.executor(), gbuffer, environment, maps);
+}
+
 }  // namespace speculum::raster

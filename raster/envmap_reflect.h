@@ -9,6 +9,7 @@
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -17,5 +18,15 @@ namespace speculum::raster {
 // that map, any other the environment.
 ImageRGBA envmap_reflect(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
                          const ReflectorMaps* reflectors = nullptr);
+
+// Pass "envmap_reflect": the specular layer from the reflectors' cube maps or the environment.
+struct EnvmapReflectPass {
+  static constexpr const char* description =
+      "Looks up the reflected (or refracted) direction in the reflector's own cube map, or the "
+      "environment, weighted by Schlick Fresnel; no parallax, exact only for a distant "
+      "environment (SURVEY §3.1, eq.2).";
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const EnvironmentMap& environment,
+                       const ReflectorMaps* maps) const;
+};
 
 }  // namespace speculum::raster

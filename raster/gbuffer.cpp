@@ -387,4 +387,8 @@ ImageF glossiness_image(const GBuffer& g) {
   return out;
 }
 
+GBuffer GBufferPass::operator()(par::NodeContext& c, const VisibilityBuffer& visibility) const {
+  return resolve_gbuffer(c.executor(), *scene, visibility, eye);
+}
+
 }  // namespace speculum::raster

@@ -15,6 +15,7 @@
 #include "parallel/executor.h"
 #include "raster/gbuffer_triangles.h"
 #include "raster/visibility.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -72,5 +73,15 @@ ImageF glossiness_image(const GBuffer& g);
 inline bool is_specular(const SurfaceParams& s) {
   return s.is_refractor() || s.roughness < kGlossyRoughness;
 }
+
+// Pass "gbuffer": the visibility buffer resolved into surface attributes.
+struct GBufferPass {
+  static constexpr const char* description =
+      "Resolves the visibility buffer into world position, shading normal, uv and material "
+      "parameters per sample: the G-buffer every reflection pass reads (SOFF §3.1).";
+  const Scene* scene = nullptr;
+  glm::vec3 eye{0.0f};
+  GBuffer operator()(par::NodeContext& c, const VisibilityBuffer& visibility) const;
+};
 
 }  // namespace speculum::raster

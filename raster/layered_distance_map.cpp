@@ -114,9 +114,8 @@ LayeredDistanceMap render_layered_distance_map(par::Executor& executor, const Sc
                                                const EnvironmentMap& env,
                                                const LayeredMapOptions& options) {
   const int s = options.size, layers = std::clamp(options.layers, 1, kMaxLayers);
-  const Bounds all = scene.bounds();
-  const float scene_size = all.valid() ? glm::length(all.extent()) : 1.0f;
-  const float znear = 1e-4f * scene_size;
+  const CubeDepthRange depth_range = scene_cube_depth_range(scene);
+  const float znear = depth_range.znear;
   const TriangleMesh& m = scene.mesh;
   const std::size_t tris = m.triangle_count();
   LayeredDistanceMap out;
@@ -159,7 +158,7 @@ LayeredDistanceMap render_layered_distance_map(par::Executor& executor, const Sc
         }
       }
     });
-    const Camera cam = cube_face_camera(face, centre, znear, 4.0f * scene_size);
+    const Camera cam = cube_face_camera(face, centre, znear, depth_range.zfar);
     for (int k = 0; k < layers; ++k) {
       VisibilityBuffer vis;
       vis.width = vis.height = s;
@@ -308,6 +307,22 @@ ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const Layer
       stats->misses += c.misses;
     }
   return out;
+}
+
+LayeredDistanceMap LayeredDistanceMapPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                                     const EnvironmentMap& environment) const {
+  return render_layered_distance_map(c.executor(), *scene, centre, shadows, environment, options);
+}
+
+ImageRGBA LayeredReflectPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                        const LayeredDistanceMap& map,
+                                        const EnvironmentMap& environment) const {
+  LayeredTraceStats st;
+  ImageRGBA specular = layered_reflect(c.executor(), gbuffer, map, environment, options, &st);
+  c.count("searches", st.rays);
+  c.count("distance_lookups", st.lookups);
+  c.count("misses", st.misses);
+  return specular;
 }
 
 }  // namespace speculum::raster

@@ -17,6 +17,7 @@
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/shadow_map.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -68,5 +69,32 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
 ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const LayeredDistanceMap& map,
                           const EnvironmentMap& env, const LayeredTraceOptions& options,
                           LayeredTraceStats* stats = nullptr);
+
+// Pass "layered_distance_map": the scene peeled into layers around `centre`.
+struct LayeredDistanceMapPass {
+  static constexpr const char* description =
+      "The whole scene depth-peeled into L cube layers (material, distance, normal, direct-lit "
+      "colour) around one reference point (SURVEY §4.5).";
+  const Scene* scene = nullptr;
+  glm::vec3 centre{0.0f};
+  LayeredMapOptions options;
+  void parameters(par::Params& p) const { p.set("layers", options.layers).set("size", options.size); }
+  LayeredDistanceMap operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                const EnvironmentMap& environment) const;
+};
+
+// Pass "layered_reflect": the specular layer traced through the layered map.
+struct LayeredReflectPass {
+  static constexpr const char* description =
+      "Recursive tracer: linear + secant search in every layer, nearest hit, continued at "
+      "specular hits up to the bounce limit (SURVEY §4.5).";
+  LayeredTraceOptions options;
+  void parameters(par::Params& p) const {
+    p.set("linear_steps", options.linear_steps).set("secant_steps", options.secant_steps)
+        .set("bounces", options.bounces);
+  }
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const LayeredDistanceMap& map,
+                       const EnvironmentMap& environment) const;
+};
 
 }  // namespace speculum::raster

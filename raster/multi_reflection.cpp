@@ -16,16 +16,14 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
   ReflectorMaps next;
   next.map_of_object = current.map_of_object;
   next.centres = current.centres;
-  const Bounds all = scene.bounds();
-  const float scene_size = all.valid() ? glm::length(all.extent()) : 1.0f;
+  const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   for (std::size_t o = 0; o < current.map_of_object.size(); ++o) {
     const int m = current.map_of_object[o];
     if (m < 0) continue;
     // Same cube set-up as render_reflector_maps (reflector_maps.cpp).
     CubeMapOptions opt;
     opt.size = current.cubes[m].size;
-    opt.znear = 1e-4f * scene_size;
-    opt.zfar = 4.0f * scene_size;
+    opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;
     next.cubes.push_back(render_cube_map(
@@ -51,6 +49,22 @@ ReflectorMaps render_multi_reflection_maps(par::Executor& executor, const Scene&
   ReflectorMaps maps = render_reflector_maps(executor, scene, shadows, env, size, camera_view);
   for (int k = 1; k < rounds; ++k)
     maps = rerender_reflector_maps(executor, scene, shadows, env, maps, options, stats);
+  return maps;
+}
+
+ReflectorMaps MultiReflectionMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                                  const EnvironmentMap& environment,
+                                                  const GBuffer& gbuffer,
+                                                  const ReflectorMaps* previous) const {
+  DistanceReflectStats st;
+  ReflectorMaps maps =
+      lagged && previous
+          ? rerender_reflector_maps(c.executor(), *scene, shadows, environment, *previous, search, &st)
+          : render_multi_reflection_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
+                                         lagged ? 1 : rounds, search, &st);
+  c.count("cube_maps", maps.cubes.size());
+  c.count("searches", st.searches);
+  c.count("distance_lookups", st.lookups);
   return maps;
 }
 

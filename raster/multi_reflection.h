@@ -14,6 +14,7 @@
 #include "raster/environment.h"
 #include "raster/reflector_maps.h"
 #include "raster/shadow_map.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -33,5 +34,25 @@ ReflectorMaps render_multi_reflection_maps(par::Executor& executor, const Scene&
                                            const GBuffer* camera_view, int rounds,
                                            const DistanceSearchOptions& options,
                                            DistanceReflectStats* stats = nullptr);
+
+// Pass "multi_reflection_maps": the reflector maps after `rounds` rounds (SURVEY §4.3); with
+// `lagged`, one round per frame on the previous frame's maps (the bounce depth grows by one
+// per frame), or a first round when there is no previous frame.
+struct MultiReflectionMapsPass {
+  static constexpr const char* description =
+      "Per specular object a colour + distance cube map, re-rendered in rounds with the others' "
+      "current maps, one bounce per round (SURVEY §4.3).";
+  const Scene* scene = nullptr;
+  int size = 256;
+  int rounds = 3;
+  bool lagged = false;
+  DistanceSearchOptions search;
+  void parameters(par::Params& p) const {
+    p.set("size", size).set("rounds", lagged ? 1 : rounds).set("lagged", lagged ? 1 : 0);
+  }
+  ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                           const EnvironmentMap& environment, const GBuffer& gbuffer,
+                           const ReflectorMaps* previous) const;
+};
 
 }  // namespace speculum::raster

@@ -138,4 +138,23 @@ ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
   return specular;
 }
 
+PlanarMirrors PlanarMirrorsPass::operator()(par::NodeContext& c) const {
+  PlanarMirrors mirrors = find_planar_mirrors(*scene);
+  c.count("mirrors", mirrors.size());
+  return mirrors;
+}
+
+ImageRGBA PlanarMirrorReflectPass::operator()(par::NodeContext& c, const PlanarMirrors& mirrors,
+                                             const GBuffer& gbuffer, const ShadowMaps& shadows,
+                                             const EnvironmentMap& environment) const {
+  PlanarMirrorSettings settings;
+  settings.depth = depth;
+  PlanarMirrorStats stats;
+  ImageRGBA specular = planar_mirror_reflect(c.executor(), *scene, mirrors, gbuffer, camera, shadows,
+                                             environment, settings, &stats);
+  c.count("mirrored_views", stats.mirrored_views);
+  c.count("mirror_samples", stats.mirror_samples);
+  return specular;
+}
+
 }  // namespace speculum::raster

@@ -13,6 +13,7 @@
 #include "raster/gbuffer.h"
 #include "raster/mirrored_camera.h"
 #include "raster/shadow_map.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -51,5 +52,30 @@ ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
                                 const Camera& camera, const std::vector<ShadowMap>& shadows,
                                 const EnvironmentMap& env, const PlanarMirrorSettings& settings,
                                 PlanarMirrorStats* stats = nullptr);
+
+using PlanarMirrors = std::vector<PlanarMirror>;
+
+// Pass "planar_mirrors": the scene's planar mirrors and their clipped scenes.
+struct PlanarMirrorsPass {
+  static constexpr const char* description =
+      "Planar mirror objects (coplanar within 1e-3 of their size) and the scene clipped to each "
+      "side of each mirror plane (SURVEY §5).";
+  const Scene* scene = nullptr;
+  PlanarMirrors operator()(par::NodeContext& c) const;
+};
+
+// Pass "planar_mirror_reflect": the specular layer by reflected cameras, recursively.
+struct PlanarMirrorReflectPass {
+  static constexpr const char* description =
+      "Each planar mirror's samples get F × the view of the camera reflected about the mirror "
+      "plane (scene clipped at the plane), recursively to depth k; other specular samples the "
+      "environment map (SURVEY §5).";
+  const Scene* scene = nullptr;
+  Camera camera;
+  int depth = 3;
+  void parameters(par::Params& p) const { p.set("depth", depth); }
+  ImageRGBA operator()(par::NodeContext& c, const PlanarMirrors& mirrors, const GBuffer& gbuffer,
+                       const ShadowMaps& shadows, const EnvironmentMap& environment) const;
+};
 
 }  // namespace speculum::raster

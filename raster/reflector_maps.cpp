@@ -47,8 +47,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const GBuffer* camera_view) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
-  const Bounds all = scene.bounds();
-  const float scene_size = all.valid() ? glm::length(all.extent()) : 1.0f;
+  const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   const TriangleMesh& m = scene.mesh;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
@@ -75,8 +74,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
       centre = seen + normal * (0.01f * glm::length(e));
     CubeMapOptions opt;
     opt.size = size;
-    opt.znear = 1e-4f * scene_size;
-    opt.zfar = 4.0f * scene_size;
+    opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
     CubeMap cube = render_cube_map(
@@ -90,6 +88,14 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     out.centres.push_back(centre);
   }
   return out;
+}
+
+ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                                const EnvironmentMap& environment,
+                                                const GBuffer& gbuffer) const {
+  ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer);
+  c.count("cube_maps", maps.cubes.size());
+  return maps;
 }
 
 }  // namespace speculum::raster

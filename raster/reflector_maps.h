@@ -15,6 +15,7 @@
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/shadow_map.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -36,5 +37,17 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
                                     const GBuffer* camera_view = nullptr);
+
+// Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
+struct ReflectorCubeMapsPass {
+  static constexpr const char* description =
+      "Per specular object a colour + distance cube map at its reference point, the object "
+      "itself left out (SURVEY §3.1, §4.2).";
+  const Scene* scene = nullptr;
+  int size = 256;
+  void parameters(par::Params& p) const { p.set("size", size); }
+  ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                           const EnvironmentMap& environment, const GBuffer& gbuffer) const;
+};
 
 }  // namespace speculum::raster

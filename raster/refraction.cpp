@@ -53,7 +53,82 @@ float interpolated_thickness(const TriangleMesh& m, const std::vector<float>& th
 
 struct ChunkCounts {
   std::uint64_t refracted = 0, total_internal = 0, no_exit = 0, fallbacks = 0;
+  void count(RefractionOutcome outcome) {
+    switch (outcome) {
+      case RefractionOutcome::Refracted: ++refracted; break;
+      case RefractionOutcome::TotalInternal: ++total_internal; break;
+      case RefractionOutcome::NoExit: ++no_exit; break;
+      default: break;
+    }
+  }
 };
+
+// Radiance arriving at world point p from direction d, from the refractor's environment
+// cube (localized search) or, without one, the environment map.
+struct RefractorEnvironment {
+  const RefractionInputs& in;
+  const DistanceSearchOptions& search;
+  glm::vec3 operator()(std::uint32_t object, const glm::vec3& p, const glm::vec3& d) const {
+    const int k = in.maps && object < in.maps->map_of_object.size() ? in.maps->map_of_object[object] : -1;
+    if (k < 0) return in.env ? in.env->radiance(d, 1e6f) : glm::vec3(0.0f);
+    const CubeMap& cube = in.maps->cubes[static_cast<std::size_t>(k)];
+    const DistanceSearchResult r = search_distance_map(cube, p, d, search);
+    return glm::vec3(cube.colour_towards(r.direction));
+  }
+};
+
+// The two-face exit of pixel i's refracted ray: P2 at the distance interpolated between the
+// view-ray thickness (front to back face behind P1) and the normal thickness d_N. Returns
+// whether the ray exits (distance > 0), with P2 and the exit normal N2.
+bool two_face_exit(const RefractionInputs& in, const GBuffer& g, std::size_t i, float refractor_ior,
+                   std::uint32_t object, const glm::vec3& p1, const glm::vec3& n1,
+                   const RefractionPath& path, glm::vec3& p2, glm::vec3& n2, ChunkCounts& c) {
+  const GBuffer& back = *in.back;
+  const float d_normal = interpolated_thickness(*in.mesh, *in.vertex_thickness, *in.front_vis, i);
+  const bool back_here = back.covered(i);
+  const float d_view = back_here ? glm::length(back.position.pixels[i] - p1) : d_normal;
+  const float d = two_face_distance(path.cos_i, path.cos_t, refractor_ior, d_view, d_normal);
+  p2 = p1 + path.inside * d;
+  // The exit normal is the back face's where P2 projects (Wyman); outside the
+  // back-face buffer, the one behind P1.
+  glm::vec2 px;
+  bool found = false;
+  if (project(in.camera, g.width, g.height, p2, px)) {
+    const int x = static_cast<int>(std::floor(px.x)), y = static_cast<int>(std::floor(px.y));
+    if (x >= 0 && y >= 0 && x < g.width && y < g.height) {
+      const std::size_t j = static_cast<std::size_t>(y) * g.width + x;
+      if (back.covered(j) && back.object.pixels[j] == object) {
+        n2 = back.normal.pixels[j];
+        found = true;
+      }
+    }
+  }
+  if (!found) {
+    ++c.fallbacks;
+    n2 = back_here ? back.normal.pixels[i] : -n1;
+  }
+  return d > 0.0f;
+}
+
+// The refractor's specular radiance at P1: transmission × (f_entry·L(R1) + (1 − f_entry)·
+// base colour·L_through), L_through arriving through the exit (split again by f_exit unless
+// the exit reflects totally) or, when the path has no exit, along T1 from P1.
+glm::vec3 refractor_radiance(const RefractorEnvironment& environment, const SurfaceParams& s,
+                             std::uint32_t object, const glm::vec3& p1, const RefractionPath& path,
+                             bool exits) {
+  glm::vec3 through;
+  if (exits) {
+    const glm::vec3 behind = environment(object, path.exit_point, path.exit_direction);
+    through = path.total_internal
+                  ? behind
+                  : (1.0f - path.f_exit) * s.base_color * behind +
+                        path.f_exit * environment(object, path.exit_point, path.internal);
+  } else {
+    through = environment(object, p1, path.inside);  // single interface
+  }
+  const glm::vec3 mirror = environment(object, p1, path.reflected);
+  return s.transmission * (path.f_entry * mirror + (1.0f - path.f_entry) * s.base_color * through);
+}
 
 }  // namespace
 
@@ -70,15 +145,7 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
                         in.front_vis && in.mesh;
   const bool impostor = method == RefractionMethod::DistanceImpostor && in.impostors;
 
-  // Radiance arriving at world point p from direction d, from the refractor's environment
-  // cube (localized search) or, without one, the environment map.
-  const auto environment = [&](std::uint32_t object, const glm::vec3& p, const glm::vec3& d) {
-    const int k = in.maps && object < in.maps->map_of_object.size() ? in.maps->map_of_object[object] : -1;
-    if (k < 0) return in.env ? in.env->radiance(d, 1e6f) : glm::vec3(0.0f);
-    const CubeMap& cube = in.maps->cubes[static_cast<std::size_t>(k)];
-    const DistanceSearchResult r = search_distance_map(cube, p, d, options.environment_search);
-    return glm::vec3(cube.colour_towards(r.direction));
-  };
+  const RefractorEnvironment environment{in, options.environment_search};
 
   constexpr std::size_t kChunk = 4096;
   const std::size_t chunks = (g.object.size() + kChunk - 1) / kChunk;
@@ -103,31 +170,7 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
       if (entering && path.f_entry < 1.0f) {
         glm::vec3 p2, n2;
         if (two_face) {
-          const GBuffer& back = *in.back;
-          const float d_normal = interpolated_thickness(*in.mesh, *in.vertex_thickness, *in.front_vis, i);
-          const bool back_here = back.covered(i);
-          const float d_view = back_here ? glm::length(back.position.pixels[i] - p1) : d_normal;
-          const float d = two_face_distance(path.cos_i, path.cos_t, s.ior, d_view, d_normal);
-          p2 = p1 + path.inside * d;
-          // The exit normal is the back face's where P2 projects (Wyman); outside the
-          // back-face buffer, the one behind P1.
-          glm::vec2 px;
-          bool found = false;
-          if (project(in.camera, g.width, g.height, p2, px)) {
-            const int x = static_cast<int>(std::floor(px.x)), y = static_cast<int>(std::floor(px.y));
-            if (x >= 0 && y >= 0 && x < g.width && y < g.height) {
-              const std::size_t j = static_cast<std::size_t>(y) * g.width + x;
-              if (back.covered(j) && back.object.pixels[j] == object) {
-                n2 = back.normal.pixels[j];
-                found = true;
-              }
-            }
-          }
-          if (!found) {
-            ++c.fallbacks;
-            n2 = back_here ? back.normal.pixels[i] : -n1;
-          }
-          exits = d > 0.0f;
+          exits = two_face_exit(in, g, i, s.ior, object, p1, n1, path, p2, n2, c);
         } else if (impostor) {
           const CubeMap* cube = in.impostors->for_object(object);
           exits = cube && find_impostor_exit(*cube, p1, path.inside, options.exit_search, p2, n2);
@@ -139,29 +182,12 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
           outcome = RefractionOutcome::NoExit;
         }
       }
-      glm::vec3 through;
-      if (exits) {
-        const glm::vec3 behind = environment(object, path.exit_point, path.exit_direction);
-        through = path.total_internal
-                      ? behind
-                      : (1.0f - path.f_exit) * s.base_color * behind +
-                            path.f_exit * environment(object, path.exit_point, path.internal);
-      } else {
-        through = environment(object, p1, path.inside);  // single interface
-      }
-      const glm::vec3 mirror = environment(object, p1, path.reflected);
-      const glm::vec3 radiance =
-          s.transmission * (path.f_entry * mirror + (1.0f - path.f_entry) * s.base_color * through);
+      const glm::vec3 radiance = refractor_radiance(environment, s, object, p1, path, exits);
       out.specular.pixels[i] = glm::vec4(radiance, 1.0f);
       out.outcome.pixels[i] = static_cast<std::uint8_t>(outcome);
       out.exit_point.pixels[i] = exits ? path.exit_point : p1;
       out.exit_direction.pixels[i] = exits ? path.exit_direction : path.inside;
-      switch (outcome) {
-        case RefractionOutcome::Refracted: ++c.refracted; break;
-        case RefractionOutcome::TotalInternal: ++c.total_internal; break;
-        case RefractionOutcome::NoExit: ++c.no_exit; break;
-        default: break;
-      }
+      c.count(outcome);
     }
   });
   for (const ChunkCounts& c : counts) {
@@ -171,6 +197,33 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
     out.exit_normal_fallbacks += c.fallbacks;
   }
   return out;
+}
+
+GBuffer RefractorBackFacesPass::operator()(par::NodeContext& c) const {
+  return render_refractor_back_faces(c.executor(), *scene, camera, width, height);
+}
+
+ImageRGBA RefractionPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                    const VisibilityBuffer& visibility, const ReflectorMaps& maps,
+                                    const EnvironmentMap& environment, const ImageRGBA& specular,
+                                    const GBuffer* back, const VertexThickness* thickness,
+                                    const RefractorImpostors* impostors) const {
+  RefractionInputs in;
+  in.front = &gbuffer;
+  in.front_vis = &visibility;
+  in.mesh = &scene->mesh;
+  in.camera = camera;
+  in.maps = &maps;
+  in.env = &environment;
+  in.back = back;
+  in.vertex_thickness = thickness;
+  in.impostors = impostors;
+  RefractionLayer layer = refract_layer(c.executor(), in, options, specular);
+  c.count("refracted", layer.refracted);
+  c.count("total_internal", layer.total_internal);
+  c.count("no_exit", layer.no_exit);
+  c.count("exit_normal_fallbacks", layer.exit_normal_fallbacks);
+  return std::move(layer.specular);
 }
 
 }  // namespace speculum::raster

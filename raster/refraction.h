@@ -20,6 +20,7 @@
 #include "raster/reflector_maps.h"
 #include "raster/refraction_impostor.h"
 #include "raster/visibility.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -67,5 +68,40 @@ struct RefractionLayer {
 // left at P2: one internal bounce, no further interfaces).
 RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& in,
                               const RefractionOptions& options, const ImageRGBA& specular);
+
+using VertexThickness = std::vector<float>;  // d_N per mesh vertex (two-face method)
+
+// Pass "back_faces": render_refractor_back_faces at the camera's sample grid.
+struct RefractorBackFacesPass {
+  static constexpr const char* description =
+      "Refractors alone, front faces culled: back-face position (d_V) and normal N2 per sample "
+      "(two-face method, SURVEY §4.4).";
+  const Scene* scene = nullptr;
+  Camera camera;
+  int width = 0, height = 0;
+  void parameters(par::Params& p) const { p.set("width", width).set("height", height); }
+  GBuffer operator()(par::NodeContext& c) const;
+};
+
+// Pass "refraction": the refractor samples of the specular layer replaced by refract_layer's.
+// `back` and `thickness` are bound for the two-face method, `impostors` for distance impostors.
+struct RefractionPass {
+  static constexpr const char* description =
+      "Refractor samples: T1 at the front face, exit by the chosen method, refract out or total "
+      "internal reflection, outgoing rays searched in the environment distance map; exact "
+      "Fresnel at both interfaces (SURVEY §4.4).";
+  const Scene* scene = nullptr;
+  Camera camera;
+  RefractionOptions options;
+  void parameters(par::Params& p) const {
+    p.set("method", static_cast<int>(options.method))
+        .set("linear_steps", options.environment_search.linear_steps)
+        .set("secant_steps", options.environment_search.secant_steps);
+  }
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const VisibilityBuffer& visibility,
+                       const ReflectorMaps& maps, const EnvironmentMap& environment,
+                       const ImageRGBA& specular, const GBuffer* back,
+                       const VertexThickness* thickness, const RefractorImpostors* impostors) const;
+};
 
 }  // namespace speculum::raster

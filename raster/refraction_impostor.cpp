@@ -9,17 +9,6 @@
 
 namespace speculum::raster {
 
-std::vector<std::uint8_t> refractor_objects(const Scene& scene) {
-  std::vector<std::uint8_t> out(scene.objects.size(), 0);
-  for (std::size_t t = 0; t < scene.mesh.triangle_count(); ++t) {
-    const std::uint32_t o = scene.mesh.triangle_object[t], mat = scene.mesh.triangle_material[t];
-    if (o < out.size() && mat < scene.materials.size() &&
-        surface_params(scene.materials[mat]).is_refractor())
-      out[o] = 1;
-  }
-  return out;
-}
-
 RefractorImpostors render_refractor_impostors(par::Executor& executor, const Scene& scene, int size) {
   RefractorImpostors out;
   const std::vector<std::uint8_t> refractors = refractor_objects(scene);
@@ -31,11 +20,9 @@ RefractorImpostors render_refractor_impostors(par::Executor& executor, const Sce
       if (scene.mesh.triangle_object[t] == o)
         for (int k = 0; k < 3; ++k) box.grow(scene.mesh.positions[scene.mesh.indices[3 * t + k]]);
     if (!box.valid()) continue;
-    const float extent = glm::length(box.extent());
     CubeMapOptions opt;
     opt.size = size;
-    opt.znear = 1e-4f * extent;
-    opt.zfar = 4.0f * extent;
+    opt.set_depth_range(cube_depth_range(glm::length(box.extent())));
     opt.raster.excluded_objects.assign(scene.objects.size(), 1);
     opt.raster.excluded_objects[o] = 0;  // the refractor alone
     CubeMap cube = render_cube_map(executor, scene, box.center(), opt,
@@ -64,6 +51,12 @@ bool find_impostor_exit(const CubeMap& impostor, const glm::vec3& p1, const glm:
   const float len = glm::length(n);
   n2 = len > 0.0f ? n / len : glm::normalize(p2 - impostor.centre);
   return true;
+}
+
+RefractorImpostors RefractorImpostorsPass::operator()(par::NodeContext& c) const {
+  RefractorImpostors impostors = render_refractor_impostors(c.executor(), *scene, size);
+  c.count("impostors", impostors.cubes.size());
+  return impostors;
 }
 
 }  // namespace speculum::raster

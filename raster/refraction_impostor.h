@@ -11,11 +11,11 @@
 #include "parallel/executor.h"
 #include "raster/cube_map.h"
 #include "raster/distance_map_search.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
-// Per object: 1 when its material refracts (surface_params(material).is_refractor()).
-std::vector<std::uint8_t> refractor_objects(const Scene& scene);
+
 
 struct RefractorImpostors {
   std::vector<int> impostor_of_object;  // -1: not a refractor
@@ -34,5 +34,16 @@ RefractorImpostors render_refractor_impostors(par::Executor& executor, const Sce
 // when the search finds nothing (the ray start is then kept).
 bool find_impostor_exit(const CubeMap& impostor, const glm::vec3& p1, const glm::vec3& t1,
                         const DistanceSearchOptions& options, glm::vec3& p2, glm::vec3& n2);
+
+// Pass "refractor_impostors": one normal + distance cube per refractor.
+struct RefractorImpostorsPass {
+  static constexpr const char* description =
+      "Each refractor alone from its centre: normal + distance cube map searched for the exit "
+      "point (distance impostors, SURVEY §4.4).";
+  const Scene* scene = nullptr;
+  int size = 128;
+  void parameters(par::Params& p) const { p.set("size", size); }
+  RefractorImpostors operator()(par::NodeContext& c) const;
+};
 
 }  // namespace speculum::raster

@@ -99,4 +99,8 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
   return lit / 9.0f;
 }
 
+ShadowMaps ShadowMapPass::operator()(par::NodeContext& c) const {
+  return render_shadow_maps(c.executor(), *scene, size);
+}
+
 }  // namespace speculum::raster

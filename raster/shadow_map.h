@@ -11,6 +11,7 @@
 #include "core/scene.h"
 #include "parallel/executor.h"
 #include "raster/cube_map.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -27,8 +28,21 @@ struct ShadowMap {
   float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
 };
 
+using ShadowMaps = std::vector<ShadowMap>;
+
 // One map per scene light, in light order.
 std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& scene,
                                           int size = 512);
+
+// Pass "shadow_map": one distance map per light.
+struct ShadowMapPass {
+  static constexpr const char* description =
+      "One distance map per light (a cube around point and spot lights, one far face for a "
+      "directional light), read by the 3×3 PCF shadow test of direct_light (SURVEY §4 distance maps).";
+  const Scene* scene = nullptr;
+  int size = 512;
+  void parameters(par::Params& p) const { p.set("size", size); }
+  ShadowMaps operator()(par::NodeContext& c) const;
+};
 
 }  // namespace speculum::raster

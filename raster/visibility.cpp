@@ -6,7 +6,6 @@
 
 #include "core/camera_rays.h"
 #include "core/error.h"
-#include "parallel/lanes.h"
 #include "raster/tile_binning.h"
 #include "raster/tile_rasterizer.h"
 #include "raster/triangle_setup.h"
@@ -44,7 +43,7 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
                                int height, const RasterOptions& options,
                                TileBins& bins, VisibilityBuffer& out) {
   check_target_size(width, height);
-  const int lanes = options.lanes == 0 ? par::default_lanes() : options.lanes;
+  const int lanes = options.lanes == 0 ? executor.lanes() : options.lanes;
   const Viewport vp{width, height};
   const TileGrid grid = make_tile_grid(width, height);
   const std::size_t triangles = indices.size() / 3;
@@ -132,6 +131,10 @@ VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,
   VisibilityBuffer out;
   render_visibility(executor, scene, camera, width, height, options, workspace, out);
   return out;
+}
+
+VisibilityBuffer VisibilityPass::operator()(par::NodeContext& c) const {
+  return render_visibility(c.executor(), *scene, camera, width, height);
 }
 
 }  // namespace speculum::raster

@@ -14,6 +14,7 @@
 #include "parallel/executor.h"
 #include "raster/tile_binning.h"
 #include "raster/triangle_setup.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 
@@ -25,7 +26,7 @@ struct RasterOptions {
   // Also count, per sample, how many triangles cover it (before the depth test): the
   // watertightness tests use it.
   bool count_coverage = false;
-  int lanes = 0;                // pixel lanes per coverage block row; 0: par::default_lanes()
+  int lanes = 0;                // pixel lanes per coverage block row; 0: the executor's, lanes()
   // Objects to leave out (e.g. the reflector a cube map is rendered around); indexed by
   // object id, empty: none excluded.
   std::vector<std::uint8_t> excluded_objects;
@@ -78,5 +79,18 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
                                const std::vector<std::uint32_t>& triangle_object, int width,
                                int height, const RasterOptions& options,
                                TileBins& bins, VisibilityBuffer& out);
+
+// Pass "visibility": the camera's visibility buffer at width × height samples.
+struct VisibilityPass {
+  static constexpr const char* description =
+      "Rasterizes the triangle soup from the camera at k×k samples per pixel into triangle id, "
+      "object id, view depth and barycentrics per sample (SOFF §3.1 primary visibility; setup → "
+      "bin → rasterize).";
+  const Scene* scene = nullptr;
+  Camera camera;
+  int width = 0, height = 0;
+  void parameters(par::Params& p) const { p.set("width", width).set("height", height); }
+  VisibilityBuffer operator()(par::NodeContext& c) const;
+};
 
 }  // namespace speculum::raster

@@ -13,6 +13,7 @@
 #include "core/camera_rays.h"
 #include "core/error.h"
 #include "core/optics.h"
+#include "core/ray_offset.h"
 #include "core/sampling.h"
 #include "core/shading.h"
 #include "trace/hit_surface.h"
@@ -34,13 +35,6 @@ struct Tracer {
 
   float rnd(int depth, std::uint32_t k) const {
     return random_float(pixel, sample, static_cast<std::uint32_t>(depth) * kDimsPerBounce + k, opt.seed);
-  }
-
-  // Offset along the geometric normal, scaled with the magnitude of the point so it stays
-  // above float resolution far from the origin.
-  static glm::vec3 offset(const glm::vec3& p, const glm::vec3& ng) {
-    const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    return p + ng * (1e-4f * m);
   }
 
   bool occluded(const glm::vec3& origin, const glm::vec3& dir, float distance) {
@@ -67,7 +61,7 @@ struct Tracer {
     const bool entering = hit.entering;
     const glm::vec3 v = -dir;
     const float cos_nv = std::max(glm::dot(n, v), 0.0f);
-    const glm::vec3 above = offset(p, ng);
+    const glm::vec3 above = offset_ray_origin(p, ng);
 
     glm::vec3 L = s.emissive;
     // Direct light with traced shadows.
@@ -104,7 +98,7 @@ struct Tracer {
       const bool ok = refract(dir, n, nu, tdir);
       const float F = ok ? fresnel_dielectric(cos_nv, nu) : 1.0f;
       glm::vec3 Ls = F * trace_dir(above, reflect(dir, n));
-      if (ok && F < 1.0f) Ls += (1.0f - F) * s.base_color * trace_dir(offset(p, -ng), glm::normalize(tdir));
+      if (ok && F < 1.0f) Ls += (1.0f - F) * s.base_color * trace_dir(offset_ray_origin(p, -ng), glm::normalize(tdir));
       L += s.transmission * Ls;
     } else if (s.is_mirror_lobe()) {
       L += specular_fresnel(s, cos_nv) * trace_dir(above, reflect(dir, n));
@@ -169,6 +163,15 @@ ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& cam
     }
   }
   return image;
+}
+
+ImageRGBA ReferencePass::operator()(par::NodeContext& c) const {
+  ReferenceStats stats;
+  ImageRGBA radiance = render_reference(*scene, camera, options, c.executor(), &stats);
+  c.count("camera_rays", stats.camera_rays);
+  c.count("shadow_rays", stats.shadow_rays);
+  c.count("specular_rays", stats.specular_rays);
+  return radiance;
 }
 
 }  // namespace speculum::trace

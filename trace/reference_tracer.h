@@ -15,6 +15,7 @@
 #include "core/scene.h"
 #include "parallel/executor.h"
 #include "trace/bvh.h"
+#include "parallel/graph_node.h"
 
 namespace speculum::trace {
 
@@ -45,5 +46,17 @@ ImageRGBA render_reference(const Scene& scene, const Camera& camera, const Refer
 ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& camera,
                            const ReferenceOptions& options, par::Executor& executor,
                            ReferenceStats* stats = nullptr);
+
+// Pass "reference_trace": the whole frame's linear radiance by the reference tracer.
+struct ReferencePass {
+  static constexpr const char* description =
+      "Ground truth: ray tracing in the original geometry on the BVH, with camera, shadow and "
+      "specular/glossy rays and spp jittered samples per pixel (SURVEY §2).";
+  const Scene* scene = nullptr;
+  Camera camera;
+  ReferenceOptions options;
+  void parameters(par::Params& p) const { p.set("spp", options.spp).set("seed", options.seed); }
+  ImageRGBA operator()(par::NodeContext& c) const;
+};
 
 }  // namespace speculum::trace

@@ -11,6 +11,7 @@
 #include "apps/cli/commands.h"
 #include "apps/bench/bench_workloads.h"
 #include "apps/cli/camera_options.h"
+#include "apps/cli/json_output.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
 #include "parallel/lanes.h"
@@ -89,20 +90,17 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   const double hi = *std::max_element(frame_ms.begin(), frame_ms.end());
   const std::size_t triangles = scene.mesh.triangle_count();
   if (o.json) {
-    std::printf("{\"scene\": \"%s\", \"triangles\": %zu, \"width\": %d, \"height\": %d, "
-                "\"threads\": %d, \"lanes\": %d, \"cull\": \"%s\", \"repeat\": %d, \"ms_median\": %.3f, "
-                "\"ms_min\": %.3f, \"ms_max\": %.3f, \"mtris_per_s\": %.3f, "
-                "\"covered_fraction\": %.4f, \"gbuffer_source\": \"%s\", \"gbuffer_prepare_ms\": %.3f, "
-                "\"kernels_ms_median\": {",
-                scene.name.c_str(), triangles, o.width, o.height, executor.threads(),
-                par::default_lanes(), o.cull.c_str(), o.repeat, med, lo, hi, triangles / (med * 1e-3) / 1e6,
-                double(covered) / (double(o.width) * o.height), o.gbuffer_source.c_str(), prepare_ms);
-    bool first = true;
-    for (const auto& [name, v] : kernel_ms) {
-      std::printf("%s\"%s\": %.3f", first ? "" : ", ", name.c_str(), median(v));
-      first = false;
-    }
-    std::printf("}}\n");
+    OrderedJson kernels = OrderedJson::object();
+    for (const auto& [name, v] : kernel_ms) kernels[name] = rounded(median(v), 3);
+    const OrderedJson j{{"scene", scene.name}, {"triangles", triangles}, {"width", o.width},
+                        {"height", o.height}, {"threads", executor.threads()}, {"lanes", par::default_lanes()},
+                        {"cull", o.cull}, {"repeat", o.repeat}, {"ms_median", rounded(med, 3)},
+                        {"ms_min", rounded(lo, 3)}, {"ms_max", rounded(hi, 3)},
+                        {"mtris_per_s", rounded(triangles / (med * 1e-3) / 1e6, 3)},
+                        {"covered_fraction", rounded(double(covered) / (double(o.width) * o.height), 4)},
+                        {"gbuffer_source", o.gbuffer_source}, {"gbuffer_prepare_ms", rounded(prepare_ms, 3)},
+                        {"kernels_ms_median", kernels}};
+    std::printf("%s\n", json_line(j).c_str());
   } else {
     std::printf("%s: %zu triangles at %dx%d, %d threads: median %.2f ms (min %.2f, max %.2f), "
                 "%.1f Mtris/s\n",
@@ -121,10 +119,6 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global) {
       "raster", "Time visibility + gbuffer on a mesh, scene or yardstick workload "
                 "(bench:spheres-room, bench:random-triangles)");
   cmd->footer("Example: speculum --threads 2 bench raster bench:spheres-room --width 1920 --height 1080 --repeat 5 --json");
-  // Global options (--threads, --lanes) may follow the subcommand: let them fall through
-  // `raster` and `bench` to the top-level app.
-  cmd->fallthrough();
-  bench.fallthrough();
   cmd->add_option("scene", o->scene, "PLY/OBJ/glTF file, built-in scene or bench:* workload")
       ->capture_default_str();
   cmd->add_option("--width", o->width, "Target width")->check(CLI::Range(1, 16384))->capture_default_str();

@@ -16,6 +16,7 @@
 
 #include "apps/cli/commands.h"
 #include "apps/cli/camera_options.h"
+#include "apps/cli/json_output.h"
 #include "core/error.h"
 #include "core/sampling.h"
 #include "core/scene_loader.h"
@@ -320,40 +321,40 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
   const Checksum sum = checksum(hits);
   // Guarded so an empty ray file prints 0, never inf (which is not JSON).
   const double mrays = static_cast<double>(rays.size()) / (std::max(median(trace_ms), 1e-6) * 1e3);
-  std::printf("{\"mesh\": \"%s\", \"rays_file\": \"%s\", \"triangles\": %zu, \"rays\": %zu, \"threads\": %d, "
-              "\"repeat\": %d, \"kernel\": \"%s\", \"build_ms\": %.3f, \"mrays_per_s\": %.3f, \"hits\": %llu, \"prim_sum\": %llu, "
-              "\"t_sum\": %.6f, \"nodes_per_ray\": %.2f, \"triangle_tests_per_ray\": %.2f, \"stack_overflows\": %llu",
-              o.mesh.c_str(), o.rays.c_str(), scene.mesh.triangle_count(), rays.size(), ex.threads(), repeat,
-              o.kernel.c_str(), median(build_ms), mrays, static_cast<unsigned long long>(sum.hits),
-              static_cast<unsigned long long>(sum.prim_sum), sum.t_sum,
-              static_cast<double>(counters.nodes_visited) / std::max<double>(1.0, rays.size()),
-              static_cast<double>(counters.triangle_tests) / std::max<double>(1.0, rays.size()),
-              static_cast<unsigned long long>(counters.stack_overflows));
-  std::printf(", \"build_cpu_ms\": %.3f, \"trace_cpu_ms\": %.3f", median(build_cpu), median(trace_cpu));
+  const double per_ray = 1.0 / std::max<double>(1.0, rays.size());
+  OrderedJson j{{"mesh", o.mesh}, {"rays_file", o.rays}, {"triangles", scene.mesh.triangle_count()},
+                {"rays", rays.size()}, {"threads", ex.threads()}, {"repeat", repeat}, {"kernel", o.kernel},
+                {"build_ms", rounded(median(build_ms), 3)}, {"mrays_per_s", rounded(mrays, 3)},
+                {"hits", sum.hits}, {"prim_sum", sum.prim_sum}, {"t_sum", rounded(sum.t_sum, 6)},
+                {"nodes_per_ray", rounded(static_cast<double>(counters.nodes_visited) * per_ray, 2)},
+                {"triangle_tests_per_ray", rounded(static_cast<double>(counters.triangle_tests) * per_ray, 2)},
+                {"stack_overflows", counters.stack_overflows},
+                {"build_cpu_ms", rounded(median(build_cpu), 3)}, {"trace_cpu_ms", rounded(median(trace_cpu), 3)}};
   // The last build's phases (build_ms covers all of them: refs, binary tree, both layouts).
   const trace::BvhStats& st = bvh.stats();
-  std::printf(", \"bvh\": {\"hash\": \"%016llx\", \"leaves\": %llu, \"triangle_packs\": %llu, \"wide_nodes\": %llu, \"refs_ms\": %.1f, "
-              "\"top_ms\": %.1f, \"subtrees_ms\": %.1f, \"splice_ms\": %.1f, \"layouts_ms\": %.1f}",
-              static_cast<unsigned long long>(bvh.content_hash()), static_cast<unsigned long long>(st.leaves),
-              static_cast<unsigned long long>(st.triangle_packs),
-              static_cast<unsigned long long>(st.wide_nodes), st.refs_ms, st.top_ms, st.subtrees_ms, st.splice_ms,
-              st.layouts_ms);
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(bvh.content_hash()));
+  j["bvh"] = {{"hash", hash}, {"leaves", st.leaves}, {"triangle_packs", st.triangle_packs},
+              {"wide_nodes", st.wide_nodes}, {"refs_ms", rounded(st.refs_ms, 1)}, {"top_ms", rounded(st.top_ms, 1)},
+              {"subtrees_ms", rounded(st.subtrees_ms, 1)}, {"splice_ms", rounded(st.splice_ms, 1)},
+              {"layouts_ms", rounded(st.layouts_ms, 1)}};
 #ifdef SPECULUM_HAVE_EMBREE
   if (!o.no_embree) {
     const EmbreeFigures e = run_embree(scene, rays, repeat, ex);
-    std::printf(", \"embree\": {\"version\": \"%d.%d.%d\", \"build_ms\": %.3f, \"mrays_per_s_intersect1\": %.3f, "
-                "\"mrays_per_s_intersect16\": %.3f, \"hits\": %llu, \"prim_sum\": %llu, \"t_sum\": %.6f}, "
-                "\"ratio_vs_intersect1\": %.3f, \"ratio_vs_intersect16\": %.3f, \"build_ratio\": %.3f",
-                RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, e.build_ms, e.mrays1, e.mrays16,
-                static_cast<unsigned long long>(e.sum.hits), static_cast<unsigned long long>(e.sum.prim_sum),
-                e.sum.t_sum, mrays / std::max(e.mrays1, 1e-9), mrays / std::max(e.mrays16, 1e-9),
-                median(build_ms) / std::max(e.build_ms, 1e-9));
+    j["embree"] = {{"version", std::to_string(RTC_VERSION_MAJOR) + "." + std::to_string(RTC_VERSION_MINOR) + "." +
+                                   std::to_string(RTC_VERSION_PATCH)},
+                   {"build_ms", rounded(e.build_ms, 3)}, {"mrays_per_s_intersect1", rounded(e.mrays1, 3)},
+                   {"mrays_per_s_intersect16", rounded(e.mrays16, 3)}, {"hits", e.sum.hits},
+                   {"prim_sum", e.sum.prim_sum}, {"t_sum", rounded(e.sum.t_sum, 6)}};
+    j["ratio_vs_intersect1"] = rounded(mrays / std::max(e.mrays1, 1e-9), 3);
+    j["ratio_vs_intersect16"] = rounded(mrays / std::max(e.mrays16, 1e-9), 3);
+    j["build_ratio"] = rounded(median(build_ms) / std::max(e.build_ms, 1e-9), 3);
     // CPU-time ratios (see cpu_ms): throughput ours / rtcIntersect1, build ours / Embree.
-    std::printf(", \"cpu_ratio_vs_intersect1\": %.3f, \"build_cpu_ratio\": %.3f",
-                e.trace1_cpu_ms / std::max(median(trace_cpu), 1e-9), median(build_cpu) / std::max(e.build_cpu_ms, 1e-9));
+    j["cpu_ratio_vs_intersect1"] = rounded(e.trace1_cpu_ms / std::max(median(trace_cpu), 1e-9), 3);
+    j["build_cpu_ratio"] = rounded(median(build_cpu) / std::max(e.build_cpu_ms, 1e-9), 3);
   }
 #endif
-  std::printf("}\n");
+  std::printf("%s\n", json_line(j).c_str());
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "apps/cli/commands.h"
+#include "apps/cli/json_output.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/image_flip.h"
@@ -74,13 +75,13 @@ void run_compare(const CompareOptions& o, const GlobalOptions& global) {
                        : o.metric == "rmse" ? e.rmse
                        : o.metric == "flip" ? flip.mean
                                             : e.psnr;
-  if (o.json)
-    std::printf("{\"a\": \"%s\", \"b\": \"%s\", \"width\": %d, \"height\": %d, \"mae8\": %.6f, "
-                "\"rmse\": %.8f, \"psnr\": %.4f, \"max8\": %.0f, \"differing_pixels\": %zu%s}\n",
-                o.a.c_str(), o.b.c_str(), a.width, a.height, e.mae8, e.rmse, e.psnr, e.max8,
-                e.differing_pixels,
-                o.metric == "flip" ? (", \"flip\": " + std::to_string(flip.mean)).c_str() : "");
-  else
+  if (o.json) {
+    OrderedJson j{{"a", o.a}, {"b", o.b}, {"width", a.width}, {"height", a.height},
+                  {"mae8", rounded(e.mae8, 6)}, {"rmse", rounded(e.rmse, 8)}, {"psnr", rounded(e.psnr, 4)},
+                  {"max8", static_cast<int>(e.max8)}, {"differing_pixels", e.differing_pixels}};
+    if (o.metric == "flip") j["flip"] = rounded(flip.mean, 6);
+    std::printf("%s\n", json_line(j).c_str());
+  } else
     std::printf("mae8 %.6f\nrmse %.8f\npsnr %.4f\nmax8 %.0f\ndiffering_pixels %zu of %zu\n", e.mae8,
                 e.rmse, e.psnr, e.max8, e.differing_pixels, a.size());
   if (o.metric == "flip" && !o.json) std::printf("flip %.6f\nflip_max %.6f\n", flip.mean, flip.max);
@@ -114,7 +115,6 @@ void add_compare_command(CLI::App& app, GlobalOptions& global) {
       "compare",
       "Compare two images on their 8-bit PNG values: mae8, rmse, psnr (and LDR-FLIP); exit 0 when --metric is\n"
       "within --max (for psnr: at least --max), 1 when not, 2 on bad input");
-  cmd->fallthrough();
   cmd->footer("Example: speculum compare out.png golden.png --metric psnr --max 40 --diff diff.png");
   cmd->add_option("a", opts->a, "First image (PNG, EXR, ...)")->required();
   cmd->add_option("b", opts->b, "Second image, same size")->required();

@@ -31,6 +31,11 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
   cmd.add_option("--shadow-size", o.shadow_map_size, "Side of the shadow maps")
       ->check(CLI::Range(1, 8192))->capture_default_str();
   add_camera_options(cmd, o.camera);
+  // The technique parameters, from the technique table (after the command's own footer).
+  std::string params = "\n\nTechnique parameters (--param name=value; default, [valid range]):";
+  for (const Technique& t : techniques())
+    if (!t.params.empty()) params += "\n  " + t.name + "\n" + t.describe_params("    ");
+  cmd.footer(cmd.get_footer() + params);
 }
 
 FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {

@@ -5,7 +5,7 @@
 
 #include "apps/cli/commands.h"
 #include "core/error.h"
-#include "parallel/lanes.h"
+#include "parallel/graph.h"
 
 int main(int argc, char** argv) {
   using namespace speculum;
@@ -22,9 +22,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--lanes", global.lanes, "SIMD lane width 1, 4, 8 or 16 (0: widest built)")
       ->check(CLI::IsMember({0, 1, 4, 8, 16}))
-      ->each([](const std::string& w) { par::set_default_lanes(std::stoi(w)); })
       ->capture_default_str();
   app.add_flag("--quiet,-q", global.quiet, "No progress output on stderr");
+  // The global options may also follow the subcommand (`speculum bench trace m.ply --threads 2`):
+  // a subcommand hands options it does not know to its parent, and every subcommand, nested
+  // ones included, inherits this setting when it is added below.
+  app.fallthrough();
 
   cli::add_scenes_command(app, global);
   cli::add_info_command(app, global);
@@ -48,6 +51,21 @@ int main(int argc, char** argv) {
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "speculum: out of memory (input too large?)\n");
     return 2;
+  } catch (const par::NodeError& e) {
+    // A pass failed: bad input found inside a pass (a degenerate camera, an absurd size) is
+    // still bad input, named by its own message; anything else names the pass.
+    try {
+      std::rethrow_exception(e.cause());
+    } catch (const InputError& input) {
+      std::fprintf(stderr, "speculum: %s\n", input.what());
+      return 2;
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr, "speculum: out of memory in %s (input too large?)\n", e.node().c_str());
+      return 2;
+    } catch (...) {
+    }
+    std::fprintf(stderr, "speculum: error: %s\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "speculum: error: %s\n", e.what());
     return 1;

@@ -36,11 +36,12 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
     throw InputError(opts.output, "output must end in .png or .exr");
   const Scene scene = load_scene(o.scene.empty() ? default_scene_name() : o.scene);
   const pipeline::FrameSettings f = pipeline::make_frame_settings(o, scene);
-  par::Executor executor(global.threads);
+  par::Executor executor(global.threads, global.lanes);
   par::Graph graph;
-  technique.add_passes(graph, &scene, f);
+  const pipeline::FrameOutputs outputs = technique.add_passes(graph, &scene, f);
   const bool exr = ends_with(opts.output, ".exr");
-  graph.request(exr ? pipeline::kRadiance : pipeline::kDisplay);
+  const par::Resource<ImageRGBA>& image = exr ? outputs.radiance : outputs.display;
+  graph.request(image);
   // Progress per finished node (a node's first captured output), only for long renders.
   graph.compile();
   Progress progress("render " + technique.name, graph.order().size(), global.quiet);
@@ -49,7 +50,7 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
     if (out.node != last_node) progress.step(out.node), last_node = out.node;
   });
   progress.finish();
-  write_image(opts.output, graph.get<ImageRGBA>(exr ? pipeline::kRadiance : pipeline::kDisplay));
+  write_image(opts.output, graph.get(image));
   if (!global.quiet)
     std::fprintf(stderr, "speculum: %s %s %dx%d spp %d in %.1f ms\n", technique.name.c_str(),
                  scene.name.c_str(), o.width, o.height, o.spp, report.duration_ns * 1e-6);
@@ -67,7 +68,6 @@ void add_render_command(CLI::App& app, GlobalOptions& global) {
   cmd->footer(
       "Example: speculum render glossy-plane --technique envmap --width 800 --height 600 --spp 4 -o out.png\n"
       "         speculum render sphere-in-room --technique reference --spp 64 -o ref.exr");
-  cmd->fallthrough();  // accept --threads/--lanes after the subcommand too
   opts->frame.width = 640;  // render's defaults; inspect and profile use smaller frames
   opts->frame.height = 480;
   pipeline::add_frame_options(*cmd, opts->frame);

@@ -8,63 +8,42 @@
 
 namespace speculum::cli {
 
-std::string json_quote(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
-void ResultTable::add(const std::string& key, std::string json, std::string text) {
+void ResultTable::add(const std::string& key, OrderedJson json, std::string text) {
   row_.push_back({key, std::move(json), std::move(text)});
 }
 
 ResultTable& ResultTable::cell(const std::string& key, const std::string& value) {
-  add(key, json_quote(value), value);
+  add(key, value, value);
   return *this;
 }
 
 ResultTable& ResultTable::cell(const std::string& key, double value, int digits) {
-  char text[64], json[64];
-  if (!std::isfinite(value)) {
-    add(key, "null", std::isnan(value) ? "nan" : (value > 0 ? "inf" : "-inf"));
+  if (!std::isfinite(value)) {  // JSON has no inf or nan
+    add(key, nullptr, std::isnan(value) ? "nan" : (value > 0 ? "inf" : "-inf"));
     return *this;
   }
+  char text[64];
   std::snprintf(text, sizeof text, "%.*f", digits, value);
-  std::snprintf(json, sizeof json, "%.17g", value);
-  add(key, json, text);
+  add(key, value, text);
   return *this;
 }
 
 ResultTable& ResultTable::cell(const std::string& key, std::int64_t value) {
-  const std::string s = std::to_string(value);
-  add(key, s, s);
+  add(key, value, std::to_string(value));
   return *this;
 }
 
 ResultTable& ResultTable::cell(const std::string& key, bool value) {
-  add(key, value ? "true" : "false", value ? "yes" : "no");
+  add(key, value, value ? "yes" : "no");
   return *this;
 }
 
 void ResultTable::end_row() {
   if (progress_) progress_->clear();
   if (json_) {
-    std::string line = "{";
-    for (std::size_t i = 0; i < row_.size(); ++i)
-      line += (i ? ", " : "") + json_quote(row_[i].key) + ": " + row_[i].json;
-    std::fprintf(out_, "%s}\n", line.c_str());
+    OrderedJson line = OrderedJson::object();
+    for (Cell& c : row_) line[c.key] = std::move(c.json);
+    std::fprintf(out_, "%s\n", json_line(line).c_str());
   } else {
     if (!header_printed_) {
       // Column widths are fixed by the header and the first row; wider later cells just push

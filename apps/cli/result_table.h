@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli/json_output.h"
+
 namespace speculum::cli {
 
 class Progress;
@@ -31,9 +33,11 @@ class ResultTable {
 
  private:
   struct Cell {
-    std::string key, json, text;
+    std::string key;
+    OrderedJson json;
+    std::string text;
   };
-  void add(const std::string& key, std::string json, std::string text);
+  void add(const std::string& key, OrderedJson json, std::string text);
   bool json_;
   std::FILE* out_;
   Progress* progress_ = nullptr;
@@ -41,8 +45,5 @@ class ResultTable {
   std::vector<std::size_t> widths_;
   std::vector<Cell> row_;
 };
-
-// JSON string literal with escapes.
-std::string json_quote(const std::string& s);
 
 }  // namespace speculum::cli

@@ -1,6 +1,8 @@
-// `speculum techniques`: one line per technique (name and summary).
+// `speculum techniques`: one line per technique (name and summary), then its parameters
+// with their defaults and valid ranges, from the technique table.
 #include <algorithm>
 #include <cstdio>
+#include <string>
 
 #include "apps/cli/commands.h"
 #include "apps/techniques/technique_table.h"
@@ -13,8 +15,10 @@ void add_techniques_command(CLI::App& app, GlobalOptions&) {
   cmd->callback([] {
     int width = 0;  // names in one aligned column
     for (const auto& t : pipeline::techniques()) width = std::max(width, int(t.name.size()));
-    for (const auto& t : pipeline::techniques())
+    for (const auto& t : pipeline::techniques()) {
       std::printf("%-*s  %s\n", width, t.name.c_str(), t.summary.c_str());
+      std::fputs(t.describe_params(std::string(width + 4, ' ') + "--param ").c_str(), stdout);
+    }
   });
 }
 

@@ -10,7 +10,6 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
       "experiment", "Reproduce a paper's measurements: sweeps that print a table (or --json rows)");
   cmd->require_subcommand(1);
   cmd->footer("Example: speculum experiment NAME --help   (NAME: one of the subcommands above)");
-  cmd->fallthrough();
   // One line per experiment (apps/cmd_experiment_*.cpp):
   add_experiment_survey_subcommand(*cmd, global);
   add_experiment_ray_hierarchy_subcommand(*cmd, global);

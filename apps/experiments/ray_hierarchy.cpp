@@ -146,7 +146,6 @@ void add_experiment_ray_hierarchy_subcommand(CLI::App& experiment, GlobalOptions
       "compaction / exact), the same rays with the BVH (bvh_ms) and whether the hits are "
       "identical to the BVH's (which equal the all-pairs oracle by the trace tests).\n"
       "Example: speculum experiment ray-hierarchy --scenes sphere-in-room --max-width 256 --json");
-  cmd->fallthrough();
   cmd->add_option("--scenes", o->scenes,
                   "Scenes (repeat or comma-separate; default: sphere-in-room, bumpy-sphere:n=0, "
                   "bumpy-sphere:n=4, bumpy-sphere:n=16, living-room)")

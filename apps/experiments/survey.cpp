@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "apps/cli/commands.h"
-#include "apps/techniques/distance_map.h"
+#include "apps/techniques/recipes.h"
 #include "apps/techniques/render_frame.h"
 #include "apps/cli/progress.h"
 #include "apps/cli/result_table.h"
@@ -51,11 +51,12 @@ bool applies(const std::string& technique, const std::string& scene) {
 }
 
 // The steps column: what the technique's search does with these settings.
-std::string steps_of(const std::string& technique, const pipeline::FrameSettings& f) {
-  if (technique == "distance-map") return pipeline::describe_search(pipeline::distance_search_options(f));
+std::string steps_of(const std::string& technique, const pipeline::FrameSettings& settings) {
+  const pipeline::FrameSettings f = pipeline::find_technique(technique).with_defaults(settings);
+  if (technique == "distance-map") return raster::describe_search(pipeline::distance_search_options(f));
   if (technique == "multi-reflection")
-    return pipeline::describe_search(pipeline::distance_search_options(f)) +
-           " rounds=" + std::to_string(int(f.param("rounds", 3)));
+    return raster::describe_search(pipeline::distance_search_options(f)) +
+           " rounds=" + std::to_string(int(f.param("rounds")));
   if (technique == "layered-distance-map") return pipeline::describe_layered(f);
   return "-";
 }
@@ -96,7 +97,7 @@ void run_survey(const SurveyOptions& o, const GlobalOptions& global) {
   for (const std::string& name : wanted)
     for (const pipeline::Technique& t : pipeline::techniques())
       if (t.name == name) known.push_back(&t);
-  par::Executor executor(global.threads);
+  par::Executor executor(global.threads, global.lanes);
   ResultTable table(o.json);
   std::size_t rows = 0;
   for (const std::string& scene_name : scenes)
@@ -146,7 +147,6 @@ void add_experiment_survey_subcommand(CLI::App& experiment, GlobalOptions& globa
       "survey",
       "SURVEY techniques vs the reference tracer: ms/frame, mae8, rmse, psnr, search steps.\n"
       "Example: speculum experiment survey --width 160 --reference-spp 16 --json");
-  cmd->fallthrough();
   cmd->add_option("--scene", o->scenes,
                   "Scene(s) to run (repeatable; default: sphere-in-room, bowl, living-room, "
                   "glass-sphere, mirror-corridor)");

@@ -12,7 +12,7 @@
 
 #include "apps/cli/commands.h"
 #include "apps/techniques/render_frame.h"
-#include "apps/techniques/yu_lod.h"
+#include "apps/techniques/recipes.h"
 #include "apps/cli/progress.h"
 #include "apps/cli/result_table.h"
 #include "core/error.h"
@@ -130,7 +130,7 @@ void run_yu_fig9(const YuFig9Options& o, const GlobalOptions& global) {
       throw InputError("--alpha", "expected 'off' or a positive number, got '" + a + "'");
     alphas.push_back(v);
   }
-  par::Executor ex(global.threads);
+  par::Executor ex(global.threads, global.lanes);
   ResultTable table(o.json);
   std::size_t resolutions = 0;
   for (int res = o.min_res; res <= o.max_res; res *= 2) ++resolutions;
@@ -146,12 +146,11 @@ void run_yu_fig9(const YuFig9Options& o, const GlobalOptions& global) {
     const ImageRGBA reference = reference_display(scene, res, f, o, ex);
     // BVH, bake and LOD data are built by the first frame and shared by the others (a
     // static scene: YU precomputes them); `ms` is the per-frame glossy work.
-    auto prebuilt = std::make_shared<pipeline::YuLodStatic>();
-    const pipeline::Technique technique{
-        "yu-lod", "", [prebuilt](par::Graph& g, const Scene* sc, const pipeline::FrameSettings& fs) {
-          pipeline::add_yu_lod_passes_prebuilt(g, sc, fs, prebuilt);
-        },
-        {}};
+    auto cache = std::make_shared<trace::LodStaticData>();
+    pipeline::Technique technique = pipeline::find_technique("yu-lod");
+    technique.recipe = [cache](par::Graph& g, const Scene* sc, const pipeline::FrameSettings& fs) {
+      return pipeline::add_yu_lod_passes_cached(g, sc, fs, cache);
+    };
     double static_ms = 0.0;
     for (std::size_t ai = 0; ai < alphas.size(); ++ai) {
       const float alpha = alphas[ai];
@@ -213,7 +212,6 @@ void add_experiment_yu_fig9_subcommand(CLI::App& experiment, GlobalOptions& glob
       "(0, 0.6, 3) looking at (0, -0.3, 0), 50° — low and close, so the pot's reflection fills "
       "most glossy pixels, as in YU Fig.9.\n"
       "Example: speculum experiment yu-fig9 --width 128 --samples 8 --max-res 128 --runs 1");
-  cmd->fallthrough();
   cmd->add_option("--width", o->width, "Image width and height")->check(CLI::Range(8, 4096))->capture_default_str();
   cmd->add_option("--samples", o->samples, "Glossy rays per pixel N")->check(CLI::Range(1, 4096))->capture_default_str();
   cmd->add_option("--min-res", o->min_res, "Smallest mesh resolution (vertices per side)")

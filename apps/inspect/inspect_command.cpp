@@ -10,6 +10,7 @@
 
 #include "apps/cli/commands.h"
 #include "apps/cli/frame_options.h"
+#include "apps/cli/json_output.h"
 #include "apps/inspect/inspect_images.h"
 #include "apps/inspect/inspect_report.h"
 #include "apps/techniques/render_frame.h"
@@ -61,9 +62,9 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   // The same recipe as render_frame builds, compiled but not run: names, ports,
   // parameters and descriptions in execution order.
   par::Graph meta;
-  technique.add_passes(meta, &scene, settings);
-  meta.request(pipeline::kRadiance);
-  meta.request(pipeline::kDisplay);
+  const pipeline::FrameOutputs outputs = technique.add_passes(meta, &scene, settings);
+  meta.request(outputs.radiance);
+  meta.request(outputs.display);
   meta.compile();
   const std::vector<std::string> order = meta.order();
   std::map<std::string, std::size_t> position;
@@ -83,7 +84,7 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   // Outputs as they are produced: drawn and written at once (values die with the graph).
   std::map<std::pair<std::string, std::string>, inspect::PortInfo> captured;  // (node, port)
   std::map<std::string, std::string> size_of_resource;
-  par::Executor draw_executor(1);  // tone mapping for pictures stays out of the profile
+  par::Executor draw_executor(1, global.lanes);  // tone mapping for pictures stays out of the profile
   Progress progress("inspect " + technique.name, order.size(), global.quiet);
   std::string last_node;
   auto capture = [&](const par::CapturedOutput& out) {
@@ -109,7 +110,7 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
     captured[{out.node, out.port}] = std::move(info);
   };
 
-  par::Executor executor(global.threads);
+  par::Executor executor(global.threads, global.lanes);
   executor.clear_launches();
   const pipeline::FrameResult frame = pipeline::render_frame(scene, technique, settings, executor, capture);
   progress.finish();
@@ -121,13 +122,11 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
     inspect::NodeInfo n;
     n.name = rec.name;
     n.ms = rec.duration_ns * 1e-6;
-    n.counters = rec.counters;
+    n.counters.insert(rec.counters.begin(), rec.counters.end());
     for (const auto& entry : meta.nodes()) {
       if (entry.name != rec.name) continue;
       n.description = entry.description;
       n.parameters = entry.params.items();
-      const par::Params node_params = entry.node->parameters();
-      for (const auto& extra : node_params.items()) n.parameters.push_back(extra);
       for (const auto& p : entry.ports) {
         if (p.output) {
           auto it = captured.find({rec.name, p.port});
@@ -161,7 +160,7 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   }
   report.files.push_back("manifest.json");
   report.files.push_back("index.html");
-  write_text(dir / "manifest.json", inspect::manifest_json(report).dump(2) + "\n");
+  write_text(dir / "manifest.json", json_document(inspect::manifest_json(report)));
   write_text(dir / "index.html", inspect::index_html(report));
   if (!global.quiet)
     std::fprintf(stderr, "speculum: inspect %s %s: %zu passes, %zu files in %.1f ms\n",
@@ -178,7 +177,6 @@ void add_inspect_command(CLI::App& app, GlobalOptions& global) {
       "inspect",
       "Run one frame and write every pass's outputs (PNG + EXR), the graph (DOT, SVG),\n"
       "manifest.json and an index.html that shows the passes in execution order");
-  cmd->fallthrough();
   cmd->footer(
       "Example: speculum inspect sphere-in-room --technique envmap --width 160 --height 120 -o insp\n"
       "         then open insp/index.html in a browser (no server needed)");

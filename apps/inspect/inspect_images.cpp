@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "apps/inspect/inspect_trace_images.h"
-#include "apps/techniques/envmap.h"
+#include "apps/techniques/frame_settings.h"
 #include "core/shading.h"
 #include "raster/composite.h"
 #include "raster/cube_map.h"

@@ -1,6 +1,8 @@
 // manifest.json and index.html of `inspect`: see inspect_report.h.
 #include "apps/inspect/inspect_report.h"
 
+#include "apps/cli/json_output.h"
+
 #include <cstdio>
 #include <sstream>
 
@@ -106,7 +108,7 @@ nlohmann::json manifest_json(const Report& r) {
     for (const auto& l : n.launches)
       launches.push_back({{"name", l.name}, {"elements", l.elements}, {"chunks", l.chunks}, {"ms", l.ms}});
     nodes.push_back({{"name", n.name}, {"description", n.description}, {"parameters", params},
-                     {"time_ms", n.ms}, {"counters", n.counters}, {"inputs", inputs},
+                     {"time_ms", n.ms}, {"counters", cli::counters_json(n.counters)}, {"inputs", inputs},
                      {"outputs", outputs}, {"launches", launches}});
   }
   return {{"scene", r.scene}, {"technique", r.technique}, {"settings", settings},
@@ -140,7 +142,7 @@ std::string index_html(const Report& r) {
       << (n.description.empty() ? "(no description)" : html_escape(n.description)) << "</p>\n";
     kv_table(h, n.parameters);
     std::vector<std::pair<std::string, std::string>> counters;
-    for (const auto& [k, v] : n.counters) counters.emplace_back(k, std::to_string(v));
+    for (const auto& [k, v] : n.counters) counters.emplace_back(k, cli::counter_json(v).dump());
     if (!counters.empty()) h << "<p>Counters</p>", kv_table(h, counters);
     if (!n.inputs.empty()) {
       h << "<p>Reads:";

@@ -34,7 +34,7 @@ struct NodeInfo {
   std::string name, description;
   std::vector<std::pair<std::string, std::string>> parameters;
   double ms = 0;
-  std::map<std::string, std::uint64_t> counters;
+  std::map<std::string, double> counters;  // integral values are written as JSON integers
   std::vector<PortInfo> inputs, outputs;
   std::vector<LaunchInfo> launches;
 };

@@ -10,10 +10,9 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/cli/commands.h"
 #include "apps/cli/frame_options.h"
+#include "apps/cli/json_output.h"
 #include "apps/techniques/render_frame.h"
 #include "apps/cli/progress.h"
 #include "apps/cli/result_table.h"
@@ -44,12 +43,6 @@ void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
   if (!out) throw InputError(path.string(), "cannot write");
-}
-
-std::string counters_text(const std::map<std::string, std::uint64_t>& counters) {
-  std::string s;
-  for (const auto& [k, v] : counters) s += (s.empty() ? "" : " ") + k + "=" + std::to_string(v);
-  return s;
 }
 
 void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
@@ -96,7 +89,7 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
     table.cell("node", padded(n.name)).cell("median_ms", ms, 3).cell("share_pct", 100.0 * share, 1)
         .cell("counters", counters_text(n.counters));
     table.end_row();
-    nodes.push_back({{"name", n.name}, {"median_ms", ms}, {"share", share}, {"counters", n.counters}});
+    nodes.push_back({{"name", n.name}, {"median_ms", ms}, {"share", share}, {"counters", counters_json(n.counters)}});
   }
   table.cell("node", padded("frame")).cell("median_ms", frame_median, 3).cell("share_pct", 100.0, 1)
       .cell("counters", "repeat=" + std::to_string(o.repeat));
@@ -116,7 +109,7 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
         {"height", settings.height}, {"spp", settings.spp}, {"threads", executor.threads()},
         {"repeat", o.repeat}, {"warmup", o.warmup}, {"frame_median_ms", frame_median},
         {"frame_ms", frame_ms}, {"nodes", nodes}};
-    write_text(dir / "counters.json", counters.dump(2) + "\n");
+    write_text(dir / "counters.json", json_document(counters));
     if (!global.quiet)
       std::fprintf(stderr, "speculum: wrote %s and %s (open trace.json in https://ui.perfetto.dev)\n",
                    (dir / "trace.json").c_str(), (dir / "counters.json").c_str());
@@ -130,7 +123,6 @@ void add_profile_command(CLI::App& app, GlobalOptions& global) {
   auto* cmd = app.add_subcommand(
       "profile", "Time every pass of a technique: per-node median ms, share of the frame and\n"
                  "counters; with -o a Chrome trace (trace.json) and counters.json");
-  cmd->fallthrough();
   cmd->footer("Example: speculum profile sphere-in-room --technique envmap --repeat 10 -o prof\n"
               "         (open prof/trace.json in Perfetto or chrome://tracing)");
   pipeline::add_frame_options(*cmd, opts->frame);

@@ -1,35 +1,42 @@
 // The passes every feed-forward technique's frame shares: the surface passes before its
-// specular layer (environment, shadow_map, visibility, gbuffer, direct_light), the per-reflector
-// colour + distance cube maps, and the output passes after it (composite, resolve, tonemap).
-// A recipe adds these and its own specular-layer nodes in between (STYLE.md: a recipe reads
-// like its list of passes).
+// specular layer (environment, shadow_map, visibility, gbuffer, direct_light) and the output
+// passes after it (composite, resolve, tonemap). A recipe adds these and its own
+// specular-layer passes in between.
 #pragma once
 
 #include <string>
 
-#include "apps/techniques/envmap.h"
+#include "apps/techniques/frame_settings.h"
+#include "raster/environment.h"
+#include "raster/gbuffer.h"
+#include "raster/shadow_map.h"
+#include "raster/visibility.h"
 
 namespace speculum::pipeline {
 
-// What a technique reads in the shared passes (shown by `inspect`); empty: the generic text.
+// What a technique reads in the shared passes (shown by `inspect`); empty: the pass's own text.
 struct SurfacePassNotes {
   std::string visibility;
   std::string gbuffer;
   std::string shadow_map;
 };
 
-// environment → "environment", shadow_map → "shadow_maps", visibility → "visibility" (at
-// width·k × height·k), gbuffer → "gbuffer", direct_light → "direct".
-void add_surface_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings,
-                        const SurfacePassNotes& notes = {});
+struct SurfaceResources {
+  par::Resource<raster::EnvironmentMap> environment;
+  par::Resource<raster::ShadowMaps> shadow_maps;
+  par::Resource<raster::VisibilityBuffer> visibility;  // width·k × height·k
+  par::Resource<raster::GBuffer> gbuffer;
+  par::Resource<ImageRGBA> direct;
+};
 
-// reflector_cube_maps → "reflector_maps": per specular object a colour + distance cube map
-// at its centre, the object itself left out (SURVEY §3.1, §4.2).
-void add_reflector_cube_maps_pass(par::Graph& graph, const Scene* scene,
-                                  const FrameSettings& settings, const std::string& description);
+// environment → shadow_map → visibility → gbuffer → direct_light.
+SurfaceResources add_surface_passes(par::Graph& graph, const Scene* scene,
+                                    const FrameSettings& settings,
+                                    const SurfacePassNotes& notes = {});
 
-// composite ("direct" + `specular`) → "samples", resolve (k×k) → kRadiance, tonemap → kDisplay.
-void add_output_passes(par::Graph& graph, const FrameSettings& settings,
-                       const std::string& specular = "specular");
+// composite (direct + specular) → resolve (k×k) → tonemap.
+FrameOutputs add_output_passes(par::Graph& graph, const FrameSettings& settings,
+                               const par::Resource<ImageRGBA>& direct,
+                               const par::Resource<ImageRGBA>& specular);
 
 }  // namespace speculum::pipeline

@@ -7,13 +7,13 @@ FrameResult render_frame(const Scene& scene, const Technique& technique,
                          const FrameSettings& settings, par::Executor& executor,
                          const par::CaptureHook& capture) {
   par::Graph graph;
-  technique.add_passes(graph, &scene, settings);
-  graph.request(kRadiance);
-  graph.request(kDisplay);
+  const FrameOutputs out = technique.add_passes(graph, &scene, settings);
+  graph.request(out.radiance);
+  graph.request(out.display);
   FrameResult result;
   result.report = graph.run(executor, capture);
-  result.radiance = graph.get<ImageRGBA>(kRadiance);
-  result.display = graph.get<ImageRGBA>(kDisplay);
+  result.radiance = graph.get(out.radiance);
+  result.display = graph.get(out.display);
   return result;
 }
 

@@ -1,5 +1,7 @@
-// The technique table behind `speculum render --technique` and `speculum techniques`: one
-// entry per technique, its one-line description and the recipe that builds its graph.
+// The technique table behind `speculum render --technique`, `speculum techniques` and
+// `--help`: one entry per technique with its one-line summary, its recipe, and its
+// parameters (`--param name=value`) with their defaults and valid ranges — the one place
+// they are written.
 #pragma once
 
 #include <functional>
@@ -7,26 +9,40 @@
 #include <string>
 #include <vector>
 
-#include "apps/techniques/envmap.h"
+#include "apps/techniques/frame_settings.h"
 
 namespace speculum::pipeline {
+
+struct TechniqueParam {
+  std::string name;
+  double fallback = 0;  // the default
+  double min = 0, max = 0;
+  bool integer = true;  // only whole numbers are valid
+  std::string doc;      // one line
+};
 
 struct Technique {
   std::string name;
   std::string summary;  // one line
-  // Adds the technique's passes; they must produce kRadiance and kDisplay.
-  std::function<void(par::Graph&, const Scene*, const FrameSettings&)> add_passes;
-  // The names its recipe reads through FrameSettings::param (`--param name=value`); any
-  // other name is an input error (check_technique_params).
-  std::vector<std::string> params;
+  std::function<FrameOutputs(par::Graph&, const Scene*, const FrameSettings&)> recipe;
+  std::vector<TechniqueParam> params;
+
+  // `settings` with every parameter of the table present (defaults where not given).
+  // Throws InputError for an unknown, out-of-range or fractional-where-whole parameter.
+  FrameSettings with_defaults(FrameSettings settings) const;
+  // Adds the technique's passes to `graph` (the recipe, on with_defaults(settings)).
+  FrameOutputs add_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings) const {
+    return recipe(graph, scene, with_defaults(settings));
+  }
+  // "rounds=3 [1, 16] reflector map rounds" lines, one per parameter; "" when it has none.
+  std::string describe_params(const std::string& indent) const;
 };
 
 const std::vector<Technique>& techniques();
 // Throws InputError listing the known names when `name` is unknown.
 const Technique& find_technique(const std::string& name);
-// Throws InputError naming the first parameter in `params` that `technique` does not read,
-// and listing the ones it does.
-void check_technique_params(const Technique& technique,
-                            const std::map<std::string, double>& params);
+// Throws InputError naming the first parameter of `params` that `technique` does not take
+// or whose value is outside its range, with the valid names or range.
+void check_technique_params(const Technique& technique, const std::map<std::string, double>& params);
 
 }  // namespace speculum::pipeline

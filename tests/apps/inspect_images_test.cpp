@@ -7,7 +7,7 @@
 
 #include "apps/inspect/inspect_images.h"
 #include "captured_output.h"
-#include "apps/techniques/envmap.h"
+#include "apps/techniques/frame_settings.h"
 #include "raster/gbuffer.h"
 
 namespace speculum::inspect {

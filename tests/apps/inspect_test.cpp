@@ -35,9 +35,9 @@ std::vector<std::string> expected_order(const std::string& technique) {
   const Scene scene = load_scene(kScene);
   const pipeline::FrameSettings f = pipeline::make_frame_settings(o, scene);
   par::Graph g;
-  pipeline::find_technique(technique).add_passes(g, &scene, f);
-  g.request(pipeline::kRadiance);
-  g.request(pipeline::kDisplay);
+  const pipeline::FrameOutputs out = pipeline::find_technique(technique).add_passes(g, &scene, f);
+  g.request(out.radiance);
+  g.request(out.display);
   g.compile();
   return g.order();
 }
@@ -77,9 +77,9 @@ void expect_complete_manifest(const fs::path& dir, const std::string& technique)
 // The trace-side outputs (apps/inspect/inspect_trace_images.h) a technique must draw: each is
 // drawable, lists PNGs, and every PNG loads with the output's content.
 const std::map<std::string, std::vector<std::string>> kTraceOutputs = {
-    {"ray-hierarchy", {"rays_1", "hierarchy_1", "hits_1", "shadow_hits_1"}},
-    {"yu-lod", {"glossy_rays", "glossy_hits"}},
-    {"layered-distance-map", {"layered_map"}}};
+    {"ray-hierarchy", {"secondary_rays", "ray_hierarchy", "hierarchy_traverse", "shadow_rays"}},
+    {"yu-lod", {"glossy_rays", "lod_trace"}},
+    {"layered-distance-map", {"layered_distance_map"}}};
 
 void expect_trace_outputs_drawn(const fs::path& dir, const std::string& technique) {
   const auto wanted = kTraceOutputs.find(technique);

@@ -1,5 +1,5 @@
-// Job graph: validation errors name node and resource; culling, order, concurrency,
-// counters, capture, cross-frame edges, DOT and trace export.
+// Job graph: typed handles checked when the recipe compiles; culling, order, concurrency,
+// counters, capture, cross-frame edges, a failing pass, DOT and trace export.
 #include "parallel/graph.h"
 
 #include <gtest/gtest.h>
@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <chrono>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -14,31 +15,51 @@
 namespace speculum::par {
 namespace {
 
-// A node with declared ports: out = in * factor, counts the elements.
-class ScaleNode : public Node {
- public:
-  explicit ScaleNode(float factor) : factor_(factor) {}
-  void declare(Ports& p) override { p.input<std::vector<float>>("in").output<std::vector<float>>("out"); }
-  Params parameters() const override { return Params().set("factor", factor_); }
-  void execute(NodeContext& c) override {
-    const auto& in = c.input<std::vector<float>>("in");
-    auto& out = c.output<std::vector<float>>("out");
-    out.resize(in.size());
-    c.executor().parallel_for("scale", in.size(), 64, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) out[i] = in[i] * factor_;
-      c.count("elements", e - b);
-    });
-  }
+using Floats = std::vector<float>;
 
- private:
-  float factor_;
+// A pass: out = in * factor, counting the elements.
+struct Scale {
+  static constexpr const char* description = "multiplies by a factor";
+  float factor = 1;
+  void parameters(Params& p) const { p.set("factor", factor); }
+  Floats operator()(NodeContext& c, const Floats& in) const {
+    Floats out(in.size());
+    c.executor().parallel_for("scale", in.size(), 64, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) out[i] = in[i] * factor;
+      c.count("elements", double(e - b));
+    });
+    return out;
+  }
 };
 
-template <class F>
+// What g.add accepts is decided when the recipe compiles: a handle of the wrong type, a
+// missing or extra input, or a string instead of a handle make the call ill-formed.
+auto sum_pass = [](NodeContext&, const Floats& a, const Floats& b) { return a[0] + b[0]; };
+auto maybe_pass = [](NodeContext&, const int* previous) { return previous ? *previous : 0; };
+static_assert(PassBinds<Scale, Resource<Floats>>);
+static_assert(PassBinds<Scale, PassBuilder<Floats>>);
+static_assert(!PassBinds<Scale, Resource<int>>);
+static_assert(!PassBinds<Scale, Resource<double>>);
+static_assert(!PassBinds<Scale>);
+static_assert(!PassBinds<Scale, Resource<Floats>, Resource<Floats>>);
+static_assert(!PassBinds<Scale, std::string>);
+static_assert(!PassBinds<Scale, const char*>);
+static_assert(PassBinds<decltype(sum_pass), Resource<Floats>, Resource<Floats>>);
+static_assert(!PassBinds<decltype(sum_pass), Resource<Floats>, Resource<float>>);
+// Cross-frame reads only bind optional (pointer) inputs of the same type; own_previous only
+// the pass's own output type.
+static_assert(PassBinds<decltype(maybe_pass), PreviousFrame<int>>);
+static_assert(PassBinds<decltype(maybe_pass), OwnPrevious>);
+static_assert(PassBinds<decltype(maybe_pass), Resource<int>>);
+static_assert(!PassBinds<Scale, PreviousFrame<Floats>>);
+static_assert(!PassBinds<decltype(maybe_pass), PreviousFrame<float>>);
+static_assert(!PassBinds<decltype(sum_pass), OwnPrevious, OwnPrevious>);
+
+template <class E = GraphError, class F>
 std::string error_of(F&& f) {
   try {
     f();
-  } catch (const GraphError& e) {
+  } catch (const E& e) {
     return e.what();
   }
   return "(no error)";
@@ -51,33 +72,33 @@ TEST(Graph, RecipeRunsInOrderWithCountersAndCapture) {
     Executor ex(threads);
     ex.clear_launches();
     Graph g;
-    g.input("src", std::vector<float>{1, 2, 3});
-    g.add<ScaleNode>("double", 2.f).bind("in", "src").bind("out", "doubled");
-    g.add<ScaleNode>("triple", 3.f).bind("in", "src").bind("out", "tripled");
-    g.add("sum", [](NodeContext& c) {
-       const auto& a = c.input<std::vector<float>>("doubled");
-       const auto& b = c.input<std::vector<float>>("tripled");
-       float s = 0;
-       for (std::size_t i = 0; i < a.size(); ++i) s += a[i] + b[i];
-       c.output<float>("total") = s;
-     }).reads<std::vector<float>>("doubled").reads<std::vector<float>>("tripled").writes<float>("total");
-    g.add<ScaleNode>("unused", 5.f).bind("in", "src").bind("out", "never");
-    g.request("total");
+    auto src = g.input("src", Floats{1, 2, 3});
+    auto doubled = g.add("double", Scale{2.f}, src);
+    auto tripled = g.add("triple", Scale{3.f}, src);
+    auto total = g.add("sum", [](NodeContext&, const Floats& a, const Floats& b) {
+      float s = 0;
+      for (std::size_t i = 0; i < a.size(); ++i) s += a[i] + b[i];
+      return s;
+    }, doubled, tripled);
+    g.add("unused", Scale{5.f}, src);
+    g.request(total);
     std::vector<std::string> captured;
     const auto report = g.run(ex, [&](const CapturedOutput& o) {
       captured.push_back(o.node + ":" + o.resource + ":" + o.type_name);
-      if (o.resource == "total") {
+      if (o.resource == "sum") {
         EXPECT_EQ(*o.as<float>(), 30.f);
       }
       EXPECT_EQ(o.as<int>(), nullptr);
     });
-    EXPECT_EQ(g.get<float>("total"), 30.f);
+    EXPECT_EQ(g.get(total), 30.f);
+    EXPECT_EQ(g.get(doubled), (Floats{2, 4, 6}));
     EXPECT_EQ(g.order(), (std::vector<std::string>{"double", "triple", "sum"}));
     EXPECT_EQ(report.culled, (std::vector<std::string>{"unused"}));
     ASSERT_EQ(report.nodes.size(), 3u);
-    EXPECT_EQ(report.find("double")->counters.at("elements"), 3u);
+    EXPECT_EQ(report.find("double")->counters.at("elements"), 3.0);
     EXPECT_EQ(captured.size(), 3u);
-    EXPECT_TRUE(contains(captured.back(), "sum:total:float"));
+    EXPECT_TRUE(contains(captured.back(), "sum:sum:float"));
+    EXPECT_EQ(g.nodes()[1].description, "multiplies by a factor");
     // Launches are attributed to their node and exported with it.
     const auto launches = ex.launches();
     ASSERT_EQ(launches.size(), 2u);
@@ -88,7 +109,67 @@ TEST(Graph, RecipeRunsInOrderWithCountersAndCapture) {
     const std::string dot = g.to_dot();
     EXPECT_TRUE(contains(dot, "factor = 2"));
     EXPECT_TRUE(contains(dot, "\"n:unused\" [shape=box, color=grey"));
-    EXPECT_TRUE(contains(dot, "\"r:doubled\" -> \"n:sum\""));
+    EXPECT_TRUE(contains(dot, "\"r:double\" -> \"n:sum\""));
+  }
+}
+
+// Counters are real numbers; integral deltas from many chunks sum exactly, the same for
+// any thread count.
+TEST(Graph, CountersAreRealNumbers) {
+  for (int threads : {1, 2, 8}) {
+    Executor ex(threads);
+    Graph g;
+    auto out = g.add("ratio", [](NodeContext& c) {
+      c.executor().parallel_for("count", 1000, 7, [&](std::size_t b, std::size_t e) { c.count("items", double(e - b)); });
+      c.count("per_item", 0.25);
+      c.count("per_item", 0.5);
+      return 1;
+    });
+    g.request(out);
+    const RunReport report = g.run(ex);
+    EXPECT_EQ(report.nodes[0].counters.at("items"), 1000.0) << threads;
+    EXPECT_EQ(report.nodes[0].counters.at("per_item"), 0.75) << threads;
+  }
+}
+
+// A pass that throws stops the graph: run() throws NodeError naming the pass with its
+// message and carrying the original exception; passes that need its output never start,
+// and the graph can run again.
+TEST(Graph, FailingPassStopsTheGraphAndIsNamed) {
+  for (int threads : {1, 2, 8}) {
+    Executor ex(threads);
+    std::atomic<int> downstream_runs{0};
+    std::atomic<bool> fail{true};
+    Graph g;
+    auto a = g.add("source", [](NodeContext&) { return 1; });
+    auto bad = g.add("broken", [&](NodeContext&, const int& x) {
+      if (fail) throw std::invalid_argument("scene.glb: triangle 7 has a NaN vertex");
+      return x + 1;
+    }, a);
+    auto side = g.add("independent", [](NodeContext& c) {
+      c.executor().parallel_for("spin", 64, 1, [](std::size_t, std::size_t) {});
+      return 2;
+    });
+    auto after = g.add("after", [&](NodeContext&, const int& x, const int& y) {
+      downstream_runs.fetch_add(1);
+      return x + y;
+    }, bad, side);
+    g.request(after);
+    try {
+      g.run(ex);
+      ADD_FAILURE() << "no error with " << threads << " threads";
+    } catch (const NodeError& e) {
+      EXPECT_EQ(e.node(), "broken");
+      EXPECT_EQ(std::string(e.what()), "node 'broken': scene.glb: triangle 7 has a NaN vertex");
+      EXPECT_EQ(error_of<std::invalid_argument>([&] { std::rethrow_exception(e.cause()); }),
+                "scene.glb: triangle 7 has a NaN vertex");
+    }
+    EXPECT_EQ(downstream_runs.load(), 0) << threads;
+    EXPECT_FALSE(g.has(after));
+    fail = false;
+    g.run(ex);
+    EXPECT_EQ(g.get(after), 4) << threads;
+    EXPECT_EQ(downstream_runs.load(), 1) << threads;
   }
 }
 
@@ -96,19 +177,19 @@ TEST(Graph, IndependentNodesRunConcurrently) {
   // Two nodes wait for each other: only concurrent execution can finish both.
   Executor ex(2);
   std::atomic<int> arrived{0};
-  auto rendezvous = [&](NodeContext& c) {
+  auto rendezvous = [&](NodeContext&) {
     arrived.fetch_add(1);
     // Sleep rather than spin: the machine is shared and the other worker needs a core.
     for (int ms = 0; arrived.load() < 2 && ms < 30000; ++ms)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    c.output<int>(c.node_name()) = arrived.load();
+    return arrived.load();
   };
   Graph g;
-  g.add("a", rendezvous).writes<int>("a");
-  g.add("b", rendezvous).writes<int>("b");
+  auto a = g.add("a", rendezvous);
+  auto b = g.add("b", rendezvous);
   g.run(ex);
-  EXPECT_EQ(g.get<int>("a"), 2);
-  EXPECT_EQ(g.get<int>("b"), 2);
+  EXPECT_EQ(g.get(a), 2);
+  EXPECT_EQ(g.get(b), 2);
 }
 
 // A thread waiting for its launch's stolen chunks must not pick up another node meanwhile:
@@ -124,87 +205,36 @@ TEST(Graph, NodesNeverRunInsideAnotherNodesLaunch) {
   Graph g;
   constexpr int kNodes = 24;
   for (int i = 0; i < kNodes; ++i) {
-    const std::string name = "node" + std::to_string(i);
-    g.add(name, [&nested](NodeContext& c) {
-       if (nodes_on_this_thread++ > 0) nested.fetch_add(1);
-       std::atomic<std::uint64_t> sum{0};
-       c.executor().parallel_for("work", 64, 1, [&](std::size_t b, std::size_t) {
-         std::uint64_t x = b;
-         for (int k = 0; k < 20000; ++k) x = x * 6364136223846793005ull + 1442695040888963407ull;
-         sum.fetch_add(x, std::memory_order_relaxed);
-       });
-       c.output<std::uint64_t>(c.node_name()) = sum.load();
-       --nodes_on_this_thread;
-     }).writes<std::uint64_t>(name);
+    g.add("node" + std::to_string(i), [&nested](NodeContext& c) {
+      if (nodes_on_this_thread++ > 0) nested.fetch_add(1);
+      std::atomic<std::uint64_t> sum{0};
+      c.executor().parallel_for("work", 64, 1, [&](std::size_t b, std::size_t) {
+        std::uint64_t x = b;
+        for (int k = 0; k < 20000; ++k) x = x * 6364136223846793005ull + 1442695040888963407ull;
+        sum.fetch_add(x, std::memory_order_relaxed);
+      });
+      --nodes_on_this_thread;
+      return sum.load();
+    });
   }
   for (int round = 0; round < 5; ++round) g.run(ex);
   EXPECT_EQ(nested.load(), 0);
 }
 
-TEST(Graph, RejectsCycleNamingNodesAndResources) {
-  Graph g;
-  g.add("a", [](NodeContext&) {}).reads<int>("y").writes<int>("x");
-  g.add("b", [](NodeContext&) {}).reads<int>("x").writes<int>("y");
-  const auto msg = error_of([&] { g.compile(); });
-  EXPECT_TRUE(contains(msg, "cycle")) << msg;
-  EXPECT_TRUE(contains(msg, "'a' -(x)-> 'b'")) << msg;
-  EXPECT_TRUE(contains(msg, "'b' -(y)-> 'a'")) << msg;
-  Graph self;
-  self.add("loop", [](NodeContext&) {}).reads<int>("r", "r_in").writes<int>("r");
-  EXPECT_TRUE(contains(error_of([&] { self.compile(); }), "'loop' -(r)-> 'loop'"));
-}
-
-TEST(Graph, RejectsMissingProducer) {
-  Graph g;
-  g.add<ScaleNode>("scale", 1.f);
-  const auto msg = error_of([&] { g.compile(); });
-  EXPECT_TRUE(contains(msg, "node 'scale' reads resource 'in'")) << msg;
-  EXPECT_TRUE(contains(msg, "nothing produces it")) << msg;
+TEST(Graph, RejectsMissingRequestAndEmptyRequiredInput) {
   Graph r;
-  r.request("ghost");
-  EXPECT_TRUE(contains(error_of([&] { r.compile(); }), "'ghost' has no producer"));
-}
-
-TEST(Graph, RejectsTypeMismatch) {
+  Resource<int> never;  // an empty handle
+  r.request(never);
+  EXPECT_TRUE(contains(error_of([&] { r.compile(); }), "'' has no producer"));
   Graph g;
-  g.input("in", 3);  // an int where ScaleNode wants std::vector<float>
-  g.add<ScaleNode>("scale", 1.f);
-  const auto msg = error_of([&] { g.compile(); });
-  EXPECT_TRUE(contains(msg, "node 'scale' reads resource 'in' as std::vector<float>")) << msg;
-  EXPECT_TRUE(contains(msg, "the graph input provides int")) << msg;
-  // Accessing a port with the wrong type inside a node is also named.
-  Graph h;
-  h.add("w", [](NodeContext& c) { c.output<double>("v") = 1; }).writes<float>("v");
+  Resource<Floats> empty;
+  EXPECT_TRUE(contains(error_of([&] { g.add("scale", Scale{}, empty); }),
+                       "node 'scale': required input of type std::vector<float> bound to an empty handle"));
+  // An optional input bound to an empty handle is nullptr.
   Executor ex(1);
-  const auto access = error_of([&] { h.run(ex); });
-  EXPECT_TRUE(contains(access, "node 'w': port 'v' is declared as float but accessed as double")) << access;
-}
-
-// Node → node: "x" produced as one type and read as another is rejected at compile (and by
-// run() before any node executes); the message names the consumer, the resource, the
-// producer and both types — whichever node was added first, and for a cross-frame read too.
-TEST(Graph, RejectsTypeMismatchBetweenNodes) {
-  bool ran = false;
-  auto make = [&](NodeContext& c) { ran = true; c.output<std::vector<float>>("x") = {1.f}; };
-  auto use = [&](NodeContext& c) { ran = true; c.output<int>("y") = int(c.input<double>("x")); };
-  for (bool producer_first : {true, false}) {
-    Graph g;
-    if (producer_first) g.add("make", make).writes<std::vector<float>>("x");
-    g.add("use", use).reads<double>("x").writes<int>("y");
-    if (!producer_first) g.add("make", make).writes<std::vector<float>>("x");
-    const auto msg = error_of([&] { g.compile(); });
-    EXPECT_TRUE(contains(msg, "node 'use' reads resource 'x' as double")) << msg;
-    EXPECT_TRUE(contains(msg, "node 'make' provides std::vector<float>")) << msg;
-    Executor ex(2);
-    EXPECT_EQ(error_of([&] { g.run(ex); }), msg);
-    EXPECT_FALSE(ran);
-  }
-  Graph prev;
-  prev.add("make", make).writes<std::vector<float>>("x");
-  prev.add("late", [](NodeContext&) {}).reads_previous<float>("x").writes<int>("z");
-  const auto msg = error_of([&] { prev.compile(); });
-  EXPECT_TRUE(contains(msg, "node 'late' reads resource 'x' as float")) << msg;
-  EXPECT_TRUE(contains(msg, "node 'make' provides std::vector<float>")) << msg;
+  auto v = g.add("maybe", maybe_pass, Resource<int>{});
+  g.run(ex);
+  EXPECT_EQ(g.get(v), 0);
 }
 
 std::size_t occurrences(const std::string& s, const std::string& part) {
@@ -220,36 +250,35 @@ std::size_t occurrences(const std::string& s, const std::string& part) {
 TEST(Graph, RecordsNodeTimesAndTraceHasOneEventPerNodeAndLaunch) {
   constexpr std::int64_t kSleepNs = 2'000'000;
   auto launch = [](NodeContext& c, const char* name, std::size_t n) {
-    c.executor().parallel_for(name, n, 16, [&](std::size_t b, std::size_t e) { c.count("elements", e - b); });
+    c.executor().parallel_for(name, n, 16, [&](std::size_t b, std::size_t e) { c.count("elements", double(e - b)); });
   };
   for (int threads : {1, 2, 8}) {
     Executor ex(threads);
     ex.clear_launches();
     ex.parallel_for("outside/k", 40, 16, [](std::size_t, std::size_t) {});
     Graph g;
-    g.add("sleep", [&](NodeContext& c) {
-       std::this_thread::sleep_for(std::chrono::nanoseconds(kSleepNs));
-       launch(c, "sleep/k", 100);
-       c.output<int>("a") = 1;
-     }).writes<int>("a");
-    g.add("work", [&](NodeContext& c) {
-       launch(c, "work/k0", 1000);
-       launch(c, "work/k1", 0);  // an empty launch is still a named launch
-       c.output<int>("w") = c.input<int>("a") + 1;
-     }).reads<int>("a").writes<int>("w");
-    g.add("side", [&](NodeContext& c) {
-       for (const char* k : {"side/k0", "side/k1", "side/k2"}) launch(c, k, 33);
-       c.output<int>("b") = 10;
-     }).writes<int>("b");
-    g.add("join", [](NodeContext& c) { c.output<int>("out") = c.input<int>("w") + c.input<int>("b"); })
-        .reads<int>("w").reads<int>("b").writes<int>("out");
+    auto a = g.add("sleep", [&](NodeContext& c) {
+      std::this_thread::sleep_for(std::chrono::nanoseconds(kSleepNs));
+      launch(c, "sleep/k", 100);
+      return 1;
+    });
+    auto w = g.add("work", [&](NodeContext& c, const int& x) {
+      launch(c, "work/k0", 1000);
+      launch(c, "work/k1", 0);  // an empty launch is still a named launch
+      return x + 1;
+    }, a);
+    auto b = g.add("side", [&](NodeContext& c) {
+      for (const char* k : {"side/k0", "side/k1", "side/k2"}) launch(c, k, 33);
+      return 10;
+    });
+    auto out = g.add("join", [](NodeContext&, const int& x, const int& y) { return x + y; }, w, b);
     g.add("culled", [&](NodeContext& c) {
-       launch(c, "culled/k", 10);
-       c.output<int>("unused") = 0;
-     }).writes<int>("unused");
-    g.request("out");
+      launch(c, "culled/k", 10);
+      return 0;
+    });
+    g.request(out);
     const RunReport report = g.run(ex);
-    ASSERT_EQ(g.get<int>("out"), 12);
+    ASSERT_EQ(g.get(out), 12);
     ASSERT_EQ(report.nodes.size(), 4u) << threads;
     const NodeRecord* sleep = report.find("sleep");
     const NodeRecord* work = report.find("work");
@@ -267,8 +296,8 @@ TEST(Graph, RecordsNodeTimesAndTraceHasOneEventPerNodeAndLaunch) {
     EXPECT_GE(join->start_ns, work->start_ns + work->duration_ns) << threads;
     EXPECT_GE(join->start_ns, side->start_ns + side->duration_ns) << threads;
     EXPECT_GE(report.duration_ns, sleep->duration_ns);
-    EXPECT_EQ(work->counters.at("elements"), 1000u);
-    EXPECT_EQ(side->counters.at("elements"), 99u);
+    EXPECT_EQ(work->counters.at("elements"), 1000.0);
+    EXPECT_EQ(side->counters.at("elements"), 99.0);
 
     const auto launches = ex.launches();
     const std::vector<std::pair<std::string, std::string>> expected = {
@@ -301,41 +330,44 @@ TEST(Graph, RecordsNodeTimesAndTraceHasOneEventPerNodeAndLaunch) {
   }
 }
 
-TEST(Graph, RejectsTwoProducersAndBadNames) {
+TEST(Graph, RejectsTwoNodesWithOneName) {
   Graph g;
-  g.add("a", [](NodeContext&) {}).writes<int>("r");
-  g.add("b", [](NodeContext&) {}).writes<int>("r");
-  EXPECT_TRUE(contains(error_of([&] { g.compile(); }), "resource 'r' has two producers: node 'a' and node 'b'"));
-  EXPECT_TRUE(contains(error_of([&] { g.add("a", [](NodeContext&) {}); }), "two graph nodes are named 'a'"));
-  EXPECT_TRUE(contains(error_of([&] { g.add<ScaleNode>("s", 1.f).bind("nope", "x"); }), "node 's' has no port 'nope'"));
-  Graph lazy;
-  lazy.add("lazy", [](NodeContext&) {}).writes<int>("r");
-  Executor ex(1);
-  EXPECT_TRUE(contains(error_of([&] { lazy.run(ex); }), "node 'lazy' did not write its output 'r'"));
+  g.add("a", [](NodeContext&) { return 1; });
+  EXPECT_TRUE(contains(error_of([&] { g.add("a", [](NodeContext&) { return 2; }); }), "two graph nodes are named 'a'"));
+  EXPECT_TRUE(contains(error_of([&] { g.add("", [](NodeContext&) { return 2; }); }), "needs a name"));
+  // An input and a pass cannot produce the same resource.
+  g.input("b", 1);
+  g.add("b", [](NodeContext&) { return 2; });
+  EXPECT_TRUE(contains(error_of([&] { g.compile(); }), "resource 'b' has two producers: the graph input and node 'b'"));
 }
 
 TEST(Graph, PreviousFrameEdge) {
   Executor ex(2);
-  auto accumulate = [](NodeContext& c) {
-    const int prev = c.has_input<int>("acc@previous") ? c.input<int>("acc@previous") : 100;
-    c.output<int>("acc") = prev + 1;
-  };
+  auto accumulate = [](NodeContext&, const int* previous) { return (previous ? *previous : 100) + 1; };
   Graph g;
-  g.add("accumulate", accumulate).reads_previous<int>("acc").writes<int>("acc");
-  g.add("report", [](NodeContext& c) { c.output<int>("shown") = c.input<int>("acc@previous"); })
-      .reads_previous<int>("acc").writes<int>("shown");
-  g.seed_previous("acc", 10);
+  auto acc = g.add("accumulate", accumulate, own_previous);
+  auto shown = g.add("report", [](NodeContext&, const int* previous) { return previous ? *previous : -1; },
+                     previous(acc));
+  g.seed_previous(acc, 10);
   g.run(ex);
-  EXPECT_EQ(g.get<int>("acc"), 11);
-  EXPECT_EQ(g.get<int>("shown"), 10);
+  EXPECT_EQ(g.get(acc), 11);
+  EXPECT_EQ(g.get(shown), 10);
   g.run(ex);
-  EXPECT_EQ(g.get<int>("acc"), 12);
-  EXPECT_EQ(g.get<int>("shown"), 11);
+  EXPECT_EQ(g.get(acc), 12);
+  EXPECT_EQ(g.get(shown), 11);
   EXPECT_TRUE(contains(g.to_dot(), "style=dashed, label=\"previous frame\""));
   Graph unseeded;
-  unseeded.add("accumulate", accumulate).reads_previous<int>("acc").writes<int>("acc");
+  auto u = unseeded.add("accumulate", accumulate, own_previous);
   unseeded.run(ex);
-  EXPECT_EQ(unseeded.get<int>("acc"), 101);
+  EXPECT_EQ(unseeded.get(u), 101);
+  unseeded.run(ex);
+  EXPECT_EQ(unseeded.get(u), 102);
+  // OwnPrevious{false}: the edge is off and the input is always nullptr.
+  Graph off;
+  auto o = off.add("accumulate", accumulate, OwnPrevious{false});
+  off.run(ex);
+  off.run(ex);
+  EXPECT_EQ(off.get(o), 101);
 }
 
 }  // namespace

@@ -12,10 +12,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "apps/techniques/envmap.h"
+#include "apps/techniques/technique_table.h"
 #include "core/optics.h"
 #include "core/scene_loader.h"
-#include "parallel/lanes.h"
 #include "raster_test_scenes.h"
 
 namespace speculum::raster {
@@ -97,15 +96,12 @@ ImageRGBA render_envmap(const Scene& scene, int threads, int lanes) {
   f.shadow_map_size = 64;
   f.cube_map_size = 32;
   f.camera = scene.cameras.front();
-  par::set_default_lanes(lanes);
-  par::Executor ex(threads);
+  par::Executor ex(threads, lanes);
   par::Graph graph;
-  pipeline::add_envmap_passes(graph, &scene, f);
-  graph.request(pipeline::kRadiance);
+  const pipeline::FrameOutputs out = pipeline::find_technique("envmap").add_passes(graph, &scene, f);
+  graph.request(out.radiance);
   graph.run(ex);
-  ImageRGBA out = graph.get<ImageRGBA>(pipeline::kRadiance);
-  par::set_default_lanes(0);
-  return out;
+  return graph.get(out.radiance);
 }
 
 TEST(EnvmapPipeline, BitIdenticalForThreadsAndLanes) {
@@ -119,6 +115,7 @@ TEST(EnvmapPipeline, BitIdenticalForThreadsAndLanes) {
   EXPECT_TRUE(same(render_envmap(scene, 2, 0)));
   EXPECT_TRUE(same(render_envmap(scene, 8, 0)));
   EXPECT_TRUE(same(render_envmap(scene, 2, 1)));
+  EXPECT_TRUE(same(render_envmap(scene, 1, 16)));
   // Not a constant image: the scene is lit and has reflections.
   float lo = 1e30f, hi = -1e30f;
   for (const auto& p : ref.pixels) lo = std::min(lo, p.x), hi = std::max(hi, p.x);

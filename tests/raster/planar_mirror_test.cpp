@@ -10,7 +10,6 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "apps/techniques/planar_mirror.h"
 #include "apps/techniques/technique_table.h"
 #include "apps/techniques/render_frame.h"
 #include "core/camera_rays.h"

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "apps/techniques/render_frame.h"
-#include "apps/techniques/refraction.h"
+#include "trace/refractor_thickness.h"
 #include "apps/techniques/technique_table.h"
 #include "core/scene_loader.h"
 #include "raster/refraction_path.h"
@@ -70,7 +70,7 @@ Passes run_passes(par::Executor& ex, const Scene& s, const Camera& cam, int w, i
   p.vis = render_visibility(ex, s, cam, w, h);
   p.front = resolve_gbuffer(ex, s, p.vis, cam.eye);
   p.back = render_refractor_back_faces(ex, s, cam, w, h);
-  p.thickness = pipeline::refractor_vertex_thickness(s, ex);
+  p.thickness = trace::refractor_vertex_thickness(s, ex);
   p.impostors = render_refractor_impostors(ex, s, 256);
   p.env = build_environment(ex, s.environment, 8);
   return p;
