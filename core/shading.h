@@ -24,12 +24,12 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/scene.h"
-#include <vector>
 
 namespace speculum {
 

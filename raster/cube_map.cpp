@@ -50,6 +50,18 @@ Camera cube_face_camera(int face, const glm::vec3& centre, float znear, float zf
   return c;
 }
 
+CubeDepthRange cube_depth_range(float extent) {
+  CubeDepthRange range;
+  range.znear = 1e-4f * extent;
+  range.zfar = 4.0f * extent;
+  return range;
+}
+
+CubeDepthRange scene_cube_depth_range(const Scene& scene) {
+  const Bounds all = scene.bounds();
+  return cube_depth_range(all.valid() ? glm::length(all.extent()) : 1.0f);
+}
+
 CubeCoord cube_coord(const glm::vec3& d, int size) {
   const glm::vec3 a = glm::abs(d);
   int face;

@@ -49,11 +49,29 @@ struct CubeMap {
 // Colour of one face from its G-buffer; background samples (object == kNoId) too.
 using CubeFaceShader = std::function<ImageRGBA(const GBuffer&, const Camera&)>;
 
+// Near and far planes of a cube map rendered from a point inside or just beside a region
+// whose bounding-box diagonal is `extent`: no point of the region is farther than about one
+// diagonal from such a centre, so far = 4 diagonals clips none of it; near = 1e-4 diagonals
+// clips only what touches the centre, at any scene scale.
+struct CubeDepthRange {
+  float znear = 0.0f;
+  float zfar = 0.0f;
+};
+CubeDepthRange cube_depth_range(float extent);
+// The range for a map that sees the whole scene: extent = the diagonal of scene.bounds()
+// (1 for an empty scene).
+CubeDepthRange scene_cube_depth_range(const Scene& scene);
+
 struct CubeMapOptions {
   int size = 256;
   float znear = 0.01f;
   float zfar = 1000.0f;
   RasterOptions raster;  // e.g. excluded_objects: leave the reflector out of its own map
+
+  void set_depth_range(const CubeDepthRange& range) {
+    znear = range.znear;
+    zfar = range.zfar;
+  }
 };
 
 // Renders the six faces: visibility → G-buffer → `shade` (skipped when empty: a

@@ -7,10 +7,10 @@
 
 #include "core/scene.h"
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/shadow_map.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

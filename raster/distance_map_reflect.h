@@ -8,11 +8,11 @@
 #include <cstdint>
 
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/distance_map_search.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

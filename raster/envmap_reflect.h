@@ -6,10 +6,10 @@
 #pragma once
 
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

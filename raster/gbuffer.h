@@ -13,9 +13,9 @@
 #include "core/scene.h"
 #include "core/shading.h"
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/gbuffer_triangles.h"
 #include "raster/visibility.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

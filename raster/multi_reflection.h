@@ -10,11 +10,11 @@
 
 #include "core/scene.h"
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/distance_map_reflect.h"
 #include "raster/environment.h"
 #include "raster/reflector_maps.h"
 #include "raster/shadow_map.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

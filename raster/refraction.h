@@ -14,13 +14,13 @@
 #include "core/image.h"
 #include "core/scene.h"
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/distance_map_search.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
 #include "raster/refraction_impostor.h"
 #include "raster/visibility.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

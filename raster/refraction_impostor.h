@@ -9,9 +9,9 @@
 
 #include "core/scene.h"
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/cube_map.h"
 #include "raster/distance_map_search.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

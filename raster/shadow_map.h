@@ -10,8 +10,8 @@
 
 #include "core/scene.h"
 #include "parallel/executor.h"
-#include "raster/cube_map.h"
 #include "parallel/graph_node.h"
+#include "raster/cube_map.h"
 
 namespace speculum::raster {
 

@@ -12,9 +12,9 @@
 #include "core/image.h"
 #include "core/scene.h"
 #include "parallel/executor.h"
+#include "parallel/graph_node.h"
 #include "raster/tile_binning.h"
 #include "raster/triangle_setup.h"
-#include "parallel/graph_node.h"
 
 namespace speculum::raster {
 

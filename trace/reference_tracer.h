@@ -14,8 +14,8 @@
 #include "core/image.h"
 #include "core/scene.h"
 #include "parallel/executor.h"
-#include "trace/bvh.h"
 #include "parallel/graph_node.h"
+#include "trace/bvh.h"
 
 namespace speculum::trace {
 

@@ -1,4 +1,4 @@
-// The two rasterizer yardstick workloads of issue 4, built in memory so `bench raster` and
+// The two rasterizer yardstick workloads (the raster benchmark), built in memory so `bench raster` and
 // llvmpipe can draw the same triangles: `bench:spheres-room` (100 UV spheres of ~10k
 // triangles in a box room, ~1.02M) and `bench:random-triangles` (1M small random triangles
 // filling a cube), each with the camera the figures were measured from.
