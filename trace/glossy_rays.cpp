@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/optics.h"
+#include "core/ray_offset.h"
 #include "core/sampling.h"
 #include "parallel/page_buffer.h"
 
@@ -65,9 +66,7 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
       out.fresnel[k] = specular_fresnel(s, std::max(glm::dot(n, v), 0.0f));
       const Onb lobe(glm::normalize(r));
       const glm::vec2 shift = random_float2(i, 0, 0, opt.seed);
-      // Offset along the normal scaled with the point's magnitude (as the reference tracer).
-      const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-      const glm::vec3 origin = p + n * (1e-4f * m);
+      const glm::vec3 origin = offset_ray_origin(p, n);
       const float exponent = s.phong_exponent;
       const std::size_t first = k * N;
       // Origin and t range are per pixel: written as one run, then the per-ray directions.

@@ -8,17 +8,13 @@
 #include <glm/geometric.hpp>
 
 #include "core/optics.h"
+#include "core/ray_offset.h"
 #include "core/sampling.h"
 #include "core/shading.h"
 
 namespace speculum::trace {
 
 namespace {
-
-glm::vec3 offset_point(const glm::vec3& p, const glm::vec3& ng) {
-  const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-  return p + ng * (1e-4f * m);
-}
 
 // The surface at barycentrics (u, v) of triangle t: position, geometric and shading
 // normals (not yet oriented), material.
@@ -65,7 +61,7 @@ TriangleLighting bake_triangle_lighting(par::Executor& ex, const Scene& scene, c
       const SurfacePoint sp = surface_point(scene, static_cast<std::uint32_t>(t), 1.0f / 3.0f, 1.0f / 3.0f);
       // Orient the geometric normal to the shading normal's side (the side the mesh shows).
       const glm::vec3 ng = glm::dot(sp.ng, sp.n) < 0.0f ? -sp.ng : sp.ng;
-      const glm::vec3 above = offset_point(sp.p, ng);
+      const glm::vec3 above = offset_ray_origin(sp.p, ng);
       glm::vec3 lights_e(0.0f);
       for (std::size_t l = 0; l < out.light_count; ++l) {
         const LightSample ls = sample_light(scene.lights[l], sp.p);

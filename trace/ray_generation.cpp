@@ -9,6 +9,7 @@
 #include "core/camera_rays.h"
 #include "core/error.h"
 #include "core/optics.h"
+#include "core/ray_offset.h"
 #include "core/sampling.h"
 
 namespace speculum::trace {
@@ -60,7 +61,6 @@ RayStream generate_rays(RaySetKind kind, const Bvh& bvh, const Camera& camera, i
       const glm::vec3 d = glm::normalize(pr.direction);
       if (glm::dot(ng, d) > 0.0f) ng = -ng;
       const glm::vec3 p = t.a * (1.0f - hits.u[i] - hits.v[i]) + t.b * hits.u[i] + t.c * hits.v[i];
-      const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
       const glm::vec2 u = random_float2(static_cast<std::uint32_t>(i), 0, 0, seed);
       glm::vec3 dir;
       if (kind == RaySetKind::ReflectCone30) {
@@ -69,7 +69,7 @@ RayStream generate_rays(RaySetKind kind, const Bvh& bvh, const Camera& camera, i
         dir = Onb(ng).to_world(sample_cosine_hemisphere(u));
       }
       Ray r;
-      r.origin = p + ng * (1e-4f * m);
+      r.origin = offset_ray_origin(p, ng);
       r.direction = glm::normalize(dir);
       r.tmin = 0.0f;
       r.tmax = 3.0e38f;

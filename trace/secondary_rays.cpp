@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/optics.h"
+#include "core/ray_offset.h"
 
 namespace speculum::trace {
 
@@ -38,17 +39,17 @@ bool continuation(const SurfaceParams& s, const glm::vec3& p, const glm::vec3& n
     glm::vec3 t;
     if (refract(dir, n, nu, t)) {
       const float F = fresnel_dielectric(cos_nv, nu);
-      ray.origin = offset_point(p, -ng);
+      ray.origin = offset_ray_origin(p, -ng);
       ray.direction = glm::normalize(t);
       weight = s.transmission * (1.0f - F) * s.base_color;
     } else {
-      ray.origin = offset_point(p, ng);
+      ray.origin = offset_ray_origin(p, ng);
       ray.direction = reflect(dir, n);
       weight = glm::vec3(s.transmission);
     }
     return true;
   }
-  ray.origin = offset_point(p, ng);
+  ray.origin = offset_ray_origin(p, ng);
   ray.direction = reflect(dir, n);
   weight = specular_fresnel(s, cos_nv);
   return true;
@@ -66,11 +67,6 @@ void count_active(SecondaryRays& g) {
 }
 
 }  // namespace
-
-glm::vec3 offset_point(const glm::vec3& p, const glm::vec3& n) {
-  const float m = std::max({1.0f, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-  return p + n * (1e-4f * m);
-}
 
 SecondaryRays secondary_rays(par::Executor& ex, const Buffer2D<glm::vec3>& position,
                              const Buffer2D<glm::vec3>& normal, const Buffer2D<SurfaceParams>& surface,
@@ -136,7 +132,7 @@ SecondaryRays shadow_rays(par::Executor& ex, const Scene& scene, const Light& li
                                         gen.rays.get(i).direction);
       const LightSample ls = sample_light(light, hs.p);
       if (!light_reaches(hs, ls)) continue;
-      const glm::vec3 above = offset_point(hs.p, hs.ng);
+      const glm::vec3 above = offset_ray_origin(hs.p, hs.ng);
       Ray r;
       if (light.type == LightType::Directional) {
         r.origin = above;

@@ -36,9 +36,6 @@ inline bool has_secondary_ray(const SurfaceParams& s) {
   return s.is_refractor() || s.roughness < kGlossyRoughness;
 }
 
-// Offsets p along the unit normal n by 1e-4 × max(1, |p|∞) (as the reference tracer).
-glm::vec3 offset_point(const glm::vec3& p, const glm::vec3& n);
-
 // From G-buffer planes (object id kNoId = background): mirror/glossy pixels get the mirror
 // ray R = reflect(V, N) with weight F (Schlick, specular_fresnel); glossy surfaces trace
 // the lobe's axis only (no lobe sampling). Refractors get the refracted ray with weight
