@@ -126,27 +126,27 @@ struct Loader {
     return m;
   }
 
-  // Converts one primitive instance; returns false when it was skipped.
-  void add_primitive(std::size_t mesh_index, std::size_t prim_index, const glm::mat4& world,
-                     const std::string& node_name) {
-    const tinygltf::Mesh& gmesh = model.meshes[mesh_index];
-    const tinygltf::Primitive& prim = gmesh.primitives[prim_index];
-    const std::string what = "mesh " + std::to_string(mesh_index) +
-                             (gmesh.name.empty() ? "" : " '" + gmesh.name + "'") +
-                             " primitive " + std::to_string(prim_index);
+  static int attribute(const tinygltf::Primitive& prim, const char* name) {
+    auto it = prim.attributes.find(name);
+    return it == prim.attributes.end() ? -1 : it->second;
+  }
+
+  // The primitive's triangle topology (list, strip or fan); -1 (with a warning) for points
+  // and lines, which are skipped.
+  int triangle_mode(const tinygltf::Primitive& prim, const std::string& what) {
     const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-      if (mode < 0 || mode > 6) throw InputError(path, what + " has invalid mode " + std::to_string(mode));
-      if (report) ++report->skipped_primitives;
-      warn(what + ": points/lines primitive skipped");
-      return;
-    }
-    auto attr = [&](const char* name) {
-      auto it = prim.attributes.find(name);
-      return it == prim.attributes.end() ? -1 : it->second;
-    };
-    const int pos_acc = attr("POSITION");
+    if (mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+        mode == TINYGLTF_MODE_TRIANGLE_FAN)
+      return mode;
+    if (mode < 0 || mode > 6) throw InputError(path, what + " has invalid mode " + std::to_string(mode));
+    if (report) ++report->skipped_primitives;
+    warn(what + ": points/lines primitive skipped");
+    return -1;
+  }
+
+  // POSITION as local-space vertices, every coordinate finite.
+  std::vector<glm::vec3> read_positions(const tinygltf::Primitive& prim, const std::string& what) const {
+    const int pos_acc = attribute(prim, "POSITION");
     if (pos_acc < 0) throw InputError(path, what + " has no POSITION attribute");
     const auto pos_view = gltf::checked_accessor(model, pos_acc, path, what + " POSITION",
                                                  {TINYGLTF_TYPE_VEC3},
@@ -157,8 +157,14 @@ struct Loader {
       if (!std::isfinite(pos[i]))
         throw InputError(path, what + " vertex " + std::to_string(i / 3) +
                                    " has a NaN or infinite position");
+    std::vector<glm::vec3> p(nv);
+    for (std::size_t i = 0; i < nv; ++i) p[i] = {pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
+    return p;
+  }
 
-    // Indices, then strips and fans unrolled into triangle lists (glTF §3.7.2.1).
+  // The index list (0..nv-1 when the primitive has none), every index below nv.
+  std::vector<std::uint32_t> read_indices(const tinygltf::Primitive& prim, std::size_t nv,
+                                          const std::string& what) const {
     std::vector<std::uint32_t> idx;
     if (prim.indices >= 0) {
       const auto iv = gltf::checked_accessor(
@@ -175,6 +181,12 @@ struct Loader {
       idx.resize(nv);
       for (std::size_t i = 0; i < nv; ++i) idx[i] = static_cast<std::uint32_t>(i);
     }
+    return idx;
+  }
+
+  // Strips and fans unrolled into a triangle list (glTF §3.7.2.1).
+  std::vector<std::uint32_t> triangle_list(const std::vector<std::uint32_t>& idx, int mode,
+                                           const std::string& what) {
     std::vector<std::uint32_t> tris;
     if (mode == TINYGLTF_MODE_TRIANGLES) {
       if (idx.size() % 3 != 0)
@@ -189,19 +201,15 @@ struct Loader {
     } else {
       for (std::size_t i = 2; i < idx.size(); ++i) tris.insert(tris.end(), {idx[0], idx[i - 1], idx[i]});
     }
-    if (tris.empty()) {
-      warn(what + ": no triangles");
-      return;
-    }
-    if (scene.mesh.triangle_count() + tris.size() / 3 > kMaxTriangles)
-      throw InputError(path, "more than " + std::to_string(kMaxTriangles) + " triangles");
+    return tris;
+  }
 
-    // Local positions first; attributes are transformed to world space below.
-    std::vector<glm::vec3> p(nv);
-    for (std::size_t i = 0; i < nv; ++i) p[i] = {pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
-
+  // NORMAL when every normal is usable, otherwise area-weighted normals of the triangles.
+  std::vector<glm::vec3> read_normals(const tinygltf::Primitive& prim, const std::vector<glm::vec3>& p,
+                                      const std::vector<std::uint32_t>& tris, const std::string& what) {
+    const std::size_t nv = p.size();
     std::vector<glm::vec3> n;
-    if (int a = attr("NORMAL"); a >= 0) {
+    if (int a = attribute(prim, "NORMAL"); a >= 0) {
       const auto v = gltf::checked_accessor(model, a, path, what + " NORMAL", {TINYGLTF_TYPE_VEC3},
                                             {TINYGLTF_COMPONENT_TYPE_FLOAT});
       if (v.count != nv) throw InputError(path, what + " NORMAL count differs from POSITION count");
@@ -219,31 +227,46 @@ struct Loader {
       }
     }
     if (n.empty()) n = area_weighted_normals(p, tris);
+    return n;
+  }
 
-    auto read_uv = [&](const char* name) {
-      std::vector<glm::vec2> uv;
-      const int a = attr(name);
-      if (a < 0) return uv;
-      const auto v = gltf::checked_accessor(
-          model, a, path, what + " " + name, {TINYGLTF_TYPE_VEC2},
-          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
-      if (v.count != nv) throw InputError(path, what + " " + name + " count differs from POSITION count");
-      const auto f = gltf::read_floats(v);
-      uv.resize(nv);
-      for (std::size_t i = 0; i < nv; ++i) {
-        uv[i] = {f[2 * i], f[2 * i + 1]};
-        if (!std::isfinite(uv[i].x) || !std::isfinite(uv[i].y))
-          throw InputError(path, what + " " + name + " has a NaN or infinite value");
-      }
-      return uv;
-    };
-    std::vector<glm::vec2> uv0 = read_uv("TEXCOORD_0");
-    std::vector<glm::vec2> uv1 = read_uv("TEXCOORD_1");
+  // Texture coordinate set `name` (empty when absent), every value finite.
+  std::vector<glm::vec2> read_uv(const tinygltf::Primitive& prim, const char* name, std::size_t nv,
+                                 const std::string& what) const {
+    std::vector<glm::vec2> uv;
+    const int a = attribute(prim, name);
+    if (a < 0) return uv;
+    const auto v = gltf::checked_accessor(
+        model, a, path, what + " " + name, {TINYGLTF_TYPE_VEC2},
+        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+    if (v.count != nv) throw InputError(path, what + " " + name + " count differs from POSITION count");
+    const auto f = gltf::read_floats(v);
+    uv.resize(nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      uv[i] = {f[2 * i], f[2 * i + 1]};
+      if (!std::isfinite(uv[i].x) || !std::isfinite(uv[i].y))
+        throw InputError(path, what + " " + name + " has a NaN or infinite value");
+    }
+    return uv;
+  }
 
-    const std::uint32_t material = materials.scene_material(prim.material);
+  // The local-space attributes of one primitive, one entry per vertex (uv0, uv1, t may be
+  // empty), and its triangle list.
+  struct PrimitiveGeometry {
+    std::vector<glm::vec3> p, n;
+    std::vector<glm::vec2> uv0, uv1;
+    std::vector<glm::vec4> t;  // xyz tangent, w bitangent sign
+    std::vector<std::uint32_t> tris;
+  };
+
+  // TANGENT when given, otherwise derived from the UV set the material's normal map reads
+  // (none when the material has no normal map or that set is missing).
+  std::vector<glm::vec4> read_tangents(const tinygltf::Primitive& prim, std::uint32_t material,
+                                       const PrimitiveGeometry& g, const std::string& what) const {
+    const std::size_t nv = g.p.size();
     std::vector<glm::vec4> t;
-    if (int a = attr("TANGENT"); a >= 0) {
+    if (int a = attribute(prim, "TANGENT"); a >= 0) {
       const auto v = gltf::checked_accessor(model, a, path, what + " TANGENT", {TINYGLTF_TYPE_VEC4},
                                             {TINYGLTF_COMPONENT_TYPE_FLOAT});
       if (v.count != nv) throw InputError(path, what + " TANGENT count differs from POSITION count");
@@ -255,13 +278,20 @@ struct Loader {
       }
     } else if (scene.materials[material].normal_texture.valid()) {
       const int set = scene.materials[material].normal_texture.texcoord;
-      const auto& uv = set == 1 && !uv1.empty() ? uv1 : uv0;
-      if (!uv.empty()) t = uv_tangents(p, n, uv, tris);
+      const auto& uv = set == 1 && !g.uv1.empty() ? g.uv1 : g.uv0;
+      if (!uv.empty()) t = uv_tangents(g.p, g.n, uv, g.tris);
     }
+    return t;
+  }
 
-    // World transform: positions by M, normals by the inverse transpose, tangents by M.
+  // Appends the primitive's vertices to the scene mesh in world space: positions by M,
+  // normals by the inverse transpose, tangents by M. Returns the first new vertex's index;
+  // `det` receives det(M) (negative: a mirroring transform).
+  std::uint32_t append_world_vertices(const PrimitiveGeometry& g, const glm::mat4& world,
+                                      const std::string& what, float& det) {
+    const std::size_t nv = g.p.size();
     const glm::mat3 m3(world);
-    const float det = glm::determinant(m3);
+    det = glm::determinant(m3);
     if (!std::isfinite(det) || std::fabs(det) < 1e-30f)
       throw InputError(path, what + " is instanced with a singular transform");
     const glm::mat3 nm = glm::transpose(glm::inverse(m3));
@@ -270,29 +300,36 @@ struct Loader {
     if (mesh.positions.size() + nv > std::size_t{0xfffffff0u})
       throw InputError(path, "too many vertices for 32-bit indices");
     // Scenes may lack tangents or TEXCOORD_1 for earlier objects: keep streams aligned.
-    if (!t.empty() && mesh.tangents.size() < base)
+    if (!g.t.empty() && mesh.tangents.size() < base)
       mesh.tangents.resize(base, glm::vec4(1, 0, 0, 1));
-    if (!uv1.empty() && mesh.uvs1.size() < base) mesh.uvs1.resize(base, glm::vec2(0.0f));
+    if (!g.uv1.empty() && mesh.uvs1.size() < base) mesh.uvs1.resize(base, glm::vec2(0.0f));
     for (std::size_t i = 0; i < nv; ++i) {
-      mesh.positions.push_back(glm::vec3(world * glm::vec4(p[i], 1.0f)));
-      glm::vec3 wn = nm * n[i];
+      mesh.positions.push_back(glm::vec3(world * glm::vec4(g.p[i], 1.0f)));
+      glm::vec3 wn = nm * g.n[i];
       const float len = glm::length(wn);
       wn = (len > 0.0f && std::isfinite(len)) ? wn / len : glm::vec3(0, 0, 1);
       mesh.normals.push_back(wn);
-      mesh.uvs.push_back(uv0.empty() ? glm::vec2(0.0f) : uv0[i]);
-      if (!uv1.empty()) mesh.uvs1.push_back(uv1[i]);
-      if (!t.empty()) {
-        glm::vec3 wt = m3 * glm::vec3(t[i]);
+      mesh.uvs.push_back(g.uv0.empty() ? glm::vec2(0.0f) : g.uv0[i]);
+      if (!g.uv1.empty()) mesh.uvs1.push_back(g.uv1[i]);
+      if (!g.t.empty()) {
+        glm::vec3 wt = m3 * glm::vec3(g.t[i]);
         wt -= wn * glm::dot(wn, wt);
         const float tl = glm::length(wt);
         wt = (tl > 1e-12f && std::isfinite(tl)) ? wt / tl : any_perpendicular(wn);
         // A mirroring transform flips the bitangent's handedness.
-        mesh.tangents.push_back(glm::vec4(wt, det < 0.0f ? -t[i].w : t[i].w));
+        mesh.tangents.push_back(glm::vec4(wt, det < 0.0f ? -g.t[i].w : g.t[i].w));
       }
     }
     if (!mesh.tangents.empty()) mesh.tangents.resize(mesh.positions.size(), glm::vec4(1, 0, 0, 1));
     if (!mesh.uvs1.empty()) mesh.uvs1.resize(mesh.positions.size(), glm::vec2(0.0f));
+    return base;
+  }
 
+  // Appends the primitive's triangles (vertex indices from `base`) as a new scene object.
+  void append_object(const tinygltf::Mesh& gmesh, std::size_t prim_index, const std::string& node_name,
+                     const std::string& what, const std::vector<std::uint32_t>& tris,
+                     std::uint32_t material, std::uint32_t base, float det) {
+    auto& mesh = scene.mesh;
     const std::uint32_t object = static_cast<std::uint32_t>(scene.objects.size());
     Object obj;
     obj.name = node_name.empty() ? (gmesh.name.empty() ? what : gmesh.name) : node_name;
@@ -308,6 +345,37 @@ struct Loader {
       mesh.triangle_material.push_back(material);
       mesh.triangle_object.push_back(object);
     }
+  }
+
+  // Converts one primitive instance into a scene object (skipped, with a warning, when it
+  // has no triangles).
+  void add_primitive(std::size_t mesh_index, std::size_t prim_index, const glm::mat4& world,
+                     const std::string& node_name) {
+    const tinygltf::Mesh& gmesh = model.meshes[mesh_index];
+    const tinygltf::Primitive& prim = gmesh.primitives[prim_index];
+    const std::string what = "mesh " + std::to_string(mesh_index) +
+                             (gmesh.name.empty() ? "" : " '" + gmesh.name + "'") +
+                             " primitive " + std::to_string(prim_index);
+    const int mode = triangle_mode(prim, what);
+    if (mode < 0) return;
+    PrimitiveGeometry g;
+    g.p = read_positions(prim, what);
+    const std::size_t nv = g.p.size();
+    g.tris = triangle_list(read_indices(prim, nv, what), mode, what);
+    if (g.tris.empty()) {
+      warn(what + ": no triangles");
+      return;
+    }
+    if (scene.mesh.triangle_count() + g.tris.size() / 3 > kMaxTriangles)
+      throw InputError(path, "more than " + std::to_string(kMaxTriangles) + " triangles");
+    g.n = read_normals(prim, g.p, g.tris, what);
+    g.uv0 = read_uv(prim, "TEXCOORD_0", nv, what);
+    g.uv1 = read_uv(prim, "TEXCOORD_1", nv, what);
+    const std::uint32_t material = materials.scene_material(prim.material);
+    g.t = read_tangents(prim, material, g, what);
+    float det = 0.0f;
+    const std::uint32_t base = append_world_vertices(g, world, what, det);
+    append_object(gmesh, prim_index, node_name, what, g.tris, material, base, det);
   }
 
   // Depth-first flattening with an explicit stack; a node met again on the current
@@ -439,9 +507,9 @@ struct Loader {
   }
 };
 
-}  // namespace
-
-Scene load_gltf(const std::string& path, LoadReport* report) {
+// Reads and parses the file (JSON .gltf or binary .glb) and rejects required extensions
+// the loader does not implement.
+tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
   const bool is_glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
   const std::string ext = std::filesystem::path(path).extension().string();
@@ -463,13 +531,12 @@ Scene load_gltf(const std::string& path, LoadReport* report) {
   for (const std::string& e : model.extensionsRequired)
     if (!gltf::extension_supported(e))
       throw InputError(path, "requires unsupported extension " + e);
+  return model;
+}
 
-  Scene scene;
-  scene.name = path;
-  Loader loader{path, model, scene, report, gltf::MaterialTable(path, model, scene), {}, {}, 0};
-
-  // Materials in file order (not order of use), so indices match the file's.
-  for (std::size_t i = 0; i < model.materials.size(); ++i) loader.materials.scene_material(static_cast<int>(i));
+// The root nodes to flatten: the default scene's (scene 0 when none is named), or every
+// parentless node when the file has no scenes.
+std::vector<int> root_nodes(const tinygltf::Model& model, const std::string& path) {
   std::vector<int> roots;
   if (!model.scenes.empty()) {
     int s = model.defaultScene >= 0 ? model.defaultScene : 0;
@@ -485,6 +552,20 @@ Scene load_gltf(const std::string& path, LoadReport* report) {
     for (std::size_t i = 0; i < model.nodes.size(); ++i)
       if (!has_parent[i]) roots.push_back(static_cast<int>(i));
   }
+  return roots;
+}
+
+}  // namespace
+
+Scene load_gltf(const std::string& path, LoadReport* report) {
+  const tinygltf::Model model = parse_model(path, report);
+  Scene scene;
+  scene.name = path;
+  Loader loader{path, model, scene, report, gltf::MaterialTable(path, model, scene), {}, {}, 0};
+
+  // Materials in file order (not order of use), so indices match the file's.
+  for (std::size_t i = 0; i < model.materials.size(); ++i) loader.materials.scene_material(static_cast<int>(i));
+  const std::vector<int> roots = root_nodes(model, path);
   loader.flatten(roots);
   if (scene.mesh.triangle_count() == 0)
     throw InputError(path, "contains no triangles to render" +

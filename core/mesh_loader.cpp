@@ -143,23 +143,23 @@ struct SilenceOpenMesh {
   }
 };
 
-}  // namespace
-
-Scene load_mesh_file(const std::string& path, LoadReport* report) {
-  static const SilenceOpenMesh silence;
+// The size of an existing, non-empty regular file.
+std::uintmax_t checked_file_size(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) throw InputError(path, "cannot read file size");
   if (size == 0) throw InputError(path, "file is empty");
-  const std::string ext = lower_ext(path);
-  check_declared_counts(path, ext, size);
+  return size;
+}
 
-  OmMesh om;
+// Reads the file with OpenMesh, asking for vertex normals and texture coordinates; `opt`
+// then says which of them the file had.
+void read_with_openmesh(const std::string& path, OmMesh& om, OpenMesh::IO::Options& opt) {
   om.request_vertex_normals();
   om.request_vertex_texcoords2D();
-  OpenMesh::IO::Options opt = OpenMesh::IO::Options::VertexNormal | OpenMesh::IO::Options::VertexTexCoord;
+  opt = OpenMesh::IO::Options::VertexNormal | OpenMesh::IO::Options::VertexTexCoord;
   bool ok = false;
   try {
     ok = OpenMesh::IO::read_mesh(om, path, opt);
@@ -171,10 +171,11 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
   if (!ok) throw InputError(path, "OpenMesh could not read the file (malformed or truncated)");
   if (om.n_faces() == 0) throw InputError(path, "contains no faces");
   if (om.n_vertices() >= 0xfffffff0u) throw InputError(path, "too many vertices");
+}
 
-  Scene scene;
-  scene.name = path;
-  auto& mesh = scene.mesh;
+// Positions (all finite) and the triangles among the faces (faces with fewer than three
+// vertices are dropped, larger ones keep their first three).
+void copy_positions_and_triangles(const std::string& path, const OmMesh& om, TriangleMesh& mesh) {
   mesh.positions.reserve(om.n_vertices());
   for (auto vh : om.vertices()) {
     const auto& p = om.point(vh);
@@ -197,8 +198,11 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
     mesh.indices.insert(mesh.indices.end(), tri, tri + 3);
   }
   if (mesh.indices.empty()) throw InputError(path, "contains no triangles");
+}
 
-  // Normals: the file's when present and sane, else area-weighted from the triangles.
+// Normals: the file's when present and sane, else area-weighted from the triangles.
+void copy_or_compute_normals(const std::string& path, const OmMesh& om, const OpenMesh::IO::Options& opt,
+                             TriangleMesh& mesh, LoadReport* report) {
   bool file_normals = opt.check(OpenMesh::IO::Options::VertexNormal);
   if (file_normals) {
     mesh.normals.reserve(mesh.positions.size());
@@ -215,6 +219,10 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
     if (!file_normals && report) report->warn(path + ": bad normals in file, recomputed");
   }
   if (!file_normals) mesh.normals = area_weighted_normals(mesh.positions, mesh.indices);
+}
+
+// Texture coordinates: the file's (a non-finite pair becomes 0), else all 0.
+void copy_uvs(const OmMesh& om, const OpenMesh::IO::Options& opt, TriangleMesh& mesh) {
   if (opt.check(OpenMesh::IO::Options::VertexTexCoord)) {
     for (auto vh : om.vertices()) {
       const auto& t = om.texcoord2D(vh);
@@ -225,9 +233,14 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
   } else {
     mesh.uvs.assign(mesh.positions.size(), glm::vec2(0.0f));
   }
-  const std::size_t nt = mesh.triangle_count();
-  mesh.triangle_material.assign(nt, 0);
-  mesh.triangle_object.assign(nt, 0);
+}
+
+// These formats carry no materials: the whole mesh is one object (named after the file)
+// with one default material.
+void add_single_object(const std::string& path, Scene& scene) {
+  const std::size_t nt = scene.mesh.triangle_count();
+  scene.mesh.triangle_material.assign(nt, 0);
+  scene.mesh.triangle_object.assign(nt, 0);
   Material m;
   m.name = "default";
   m.metallic = 0.0f;
@@ -237,6 +250,24 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
   obj.name = std::filesystem::path(path).stem().string();
   obj.triangle_count = static_cast<std::uint32_t>(nt);
   scene.objects.push_back(obj);
+}
+
+}  // namespace
+
+Scene load_mesh_file(const std::string& path, LoadReport* report) {
+  static const SilenceOpenMesh silence;
+  const std::uintmax_t size = checked_file_size(path);
+  check_declared_counts(path, lower_ext(path), size);
+  OmMesh om;
+  OpenMesh::IO::Options opt;
+  read_with_openmesh(path, om, opt);
+
+  Scene scene;
+  scene.name = path;
+  copy_positions_and_triangles(path, om, scene.mesh);
+  copy_or_compute_normals(path, om, opt, scene.mesh, report);
+  copy_uvs(om, opt, scene.mesh);
+  add_single_object(path, scene);
   finish_scene(scene);
   return scene;
 }

@@ -10,7 +10,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "trace/bvh.h"
@@ -267,23 +270,18 @@ void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt,
   }
 }
 
-}  // namespace
-
-Bvh Bvh::build(const TriangleMesh& mesh, par::Executor& executor, const BvhBuildOptions& options) {
-  return build(mesh.positions, mesh.indices, executor, options, "scene mesh");
+// The triangle of leaf slot `t` as stored for traversal.
+LeafTriangle leaf_triangle(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
+                           std::uint32_t t) {
+  return {positions[indices[3 * t]], positions[indices[3 * t + 1]], positions[indices[3 * t + 2]]};
 }
 
-Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
-               par::Executor& ex, const BvhBuildOptions& options, const std::string& source) {
-  const auto t0 = std::chrono::steady_clock::now();
-  if (indices.size() % 3 != 0) throw InputError(source, "index count is not a multiple of 3");
+// One reference per triangle (its box and id), in triangle order. Throws
+// InputError(source, ...) for an index out of range or a non-finite position.
+std::vector<PrimRef> make_prim_refs(const std::vector<glm::vec3>& positions,
+                                    const std::vector<std::uint32_t>& indices, par::Executor& ex,
+                                    const std::string& source) {
   const std::size_t tri_count = indices.size() / 3;
-  if (tri_count >= kMaxTriangles) throw InputError(source, "too many triangles for the BVH (max 2^28)");
-  BvhBuildOptions opt = options;
-  opt.bins = std::clamp(opt.bins, 2, kMaxBins);
-  opt.max_leaf_size = std::clamp(opt.max_leaf_size, 1, 16);
-
-  Bvh bvh;
   std::vector<PrimRef> refs(tri_count);
   std::vector<std::uint8_t> bad((tri_count + kPrimChunk - 1) / kPrimChunk, 0);
   ex.parallel_for("bvh_prim_refs", tri_count, kPrimChunk, [&](std::size_t b, std::size_t e) {
@@ -306,182 +304,237 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
       r.pad = 0;
     }
   });
+  std::uint8_t any_bad = 0;
+  for (std::uint8_t b : bad) any_bad |= b;
+  if (any_bad & 1) throw InputError(source, "triangle index out of range");
+  if (any_bad & 2) throw InputError(source, "non-finite vertex position");
+  return refs;
+}
+
+// The range refs[begin, end) with its box and centroid bounds, reduced over fixed chunks
+// in parallel (min/max: exact in any order).
+Range range_bounds(par::Executor& ex, const std::vector<PrimRef>& refs, std::uint32_t begin, std::uint32_t end) {
+  const std::size_t n = end - begin;
+  const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
+  std::vector<Aabb> box(chunks), cbox(chunks);
+  ex.parallel_for("bvh_range_bounds", n, kBinChunk, [&](std::size_t b, std::size_t e) {
+    Aabb bx, cb;
+    for (std::size_t i = begin + b; i < begin + e; ++i) {
+      bx.lo = glm::min(bx.lo, refs[i].lo);
+      bx.hi = glm::max(bx.hi, refs[i].hi);
+      cb.grow(refs[i].centroid2());
+    }
+    box[b / kBinChunk] = bx;
+    cbox[b / kBinChunk] = cb;
+  });
+  Range r{begin, end, {}, {}};
+  for (std::size_t c = 0; c < chunks; ++c) {
+    r.box.grow(box[c]);
+    r.cbox.grow(cbox[c]);
+  }
+  return r;
+}
+
+// The bins of one large range, filled per fixed chunk in parallel and merged in chunk
+// order (min/max/count: exact in any order).
+Bins bin_range_parallel(par::Executor& ex, const std::vector<PrimRef>& refs, const Range& range,
+                        const Binner& binner, int nbins) {
+  const std::size_t n = range.end - range.begin;
+  const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
+  std::vector<Bins> part(chunks);
+  ex.parallel_for("bvh_bin", n, kBinChunk, [&](std::size_t b, std::size_t e) {
+    Bins& local = part[b / kBinChunk];
+    for (auto& axis : local) axis.fill(Bin{});
+    bin_refs(refs.data() + range.begin + b, e - b, binner, local);
+  });
+  Bins bins;
+  for (auto& axis : bins) axis.fill(Bin{});
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < nbins; ++i) {
+        bins[a][i].lo = _mm_min_ps(part[c][a][i].lo, bins[a][i].lo);
+        bins[a][i].hi = _mm_max_ps(part[c][a][i].hi, bins[a][i].hi);
+        bins[a][i].count += part[c][a][i].count;
+      }
+  return bins;
+}
+
+// The top of the tree: the nodes above the subtree tasks (node 0 is the root) and the
+// ranges left for the tasks, in task order.
+struct TopTree {
+  std::vector<TempNode> nodes;
+  std::vector<Range> tasks;
+};
+
+// Top phase: splits ranges above kParallelRange one tree level at a time (the FIFO is
+// breadth-first): each range is binned in parallel over chunks, then the level's
+// partitions run in parallel, one range per chunk. Nodes and tasks are numbered in FIFO
+// order, as a one-at-a-time loop would number them. Reorders `refs`.
+TopTree split_top_ranges(par::Executor& ex, std::vector<PrimRef>& refs, const BvhBuildOptions& opt) {
+  TopTree top;
+  if (refs.empty()) return top;
+  struct Item {
+    Range range;
+    std::size_t node;
+    bool is_left;
+    std::size_t parent;
+  };
+  std::vector<Item> fifo;
+  top.nodes.push_back({});
+  fifo.push_back({range_bounds(ex, refs, 0, static_cast<std::uint32_t>(refs.size())), 0, false, 0});
+  struct Pending {
+    Item item;
+    Binner binner;
+    Split split;
+    Range left, right;
+  };
+  std::size_t head = 0;
+  while (head < fifo.size()) {
+    const std::size_t level_end = fifo.size();
+    std::vector<Pending> splits;
+    for (; head < level_end; ++head) {
+      const Item it = fifo[head];
+      const std::size_t n = it.range.end - it.range.begin;
+      if (n <= kParallelRange) {
+        const auto task = static_cast<std::int64_t>(top.tasks.size());
+        top.tasks.push_back(it.range);
+        if (it.node == 0) top.nodes[0].left_task = task;  // the whole tree is one task
+        else if (it.is_left) top.nodes[it.parent].left_task = task;
+        else top.nodes[it.parent].right_task = task;
+        continue;
+      }
+      const Binner binner(it.range.cbox, opt.bins);
+      const Bins bins = bin_range_parallel(ex, refs, it.range, binner, opt.bins);
+      top.nodes[it.node].box = it.range.box;
+      splits.push_back({it, binner, best_split(bins, it.range.cbox, n, opt), {}, {}});
+    }
+    ex.parallel_for("bvh_top_partition", splits.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        Pending& p = splits[k];
+        std::tie(p.left, p.right) = partition(refs.data(), p.item.range, p.split, p.binner);
+      }
+    });
+    for (const Pending& p : splits) {
+      const std::size_t l = top.nodes.size();
+      top.nodes.push_back({});
+      top.nodes.push_back({});
+      top.nodes[p.item.node].left = static_cast<std::int64_t>(l);
+      top.nodes[p.item.node].right = static_cast<std::int64_t>(l + 1);
+      fifo.push_back({p.left, l, true, p.item.node});
+      fifo.push_back({p.right, l + 1, false, p.item.node});
+    }
+  }
+  return top;
+}
+
+// Parallel phase: each task builds its subtree alone; chunk = 1 task.
+std::vector<Subtree> build_subtrees(par::Executor& ex, std::vector<PrimRef>& refs,
+                                    const std::vector<Range>& tasks, const BvhBuildOptions& opt) {
+  std::vector<Subtree> sub(tasks.size());
+  ex.parallel_for("bvh_subtrees", tasks.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t) build_subtree(refs.data(), tasks[t], opt, sub[t]);
+  });
+  return sub;
+}
+
+// Leaf triangles and their ids in ref order.
+void gather_leaf_triangles(par::Executor& ex, const std::vector<PrimRef>& refs,
+                           const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
+                           std::vector<LeafTriangle>& triangles, std::vector<std::uint32_t>& triangle_id) {
+  triangles.resize(refs.size());
+  triangle_id.resize(refs.size());
+  ex.parallel_for("bvh_gather_triangles", refs.size(), kPrimChunk, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const std::uint32_t t = refs[i].id;
+      triangle_id[i] = t;
+      triangles[i] = leaf_triangle(positions, indices, t);
+    }
+  });
+}
+
+// Splices the top nodes and subtrees depth-first into the final binary layout: a serial
+// walk over the few top nodes places each subtree at its offset, then the subtrees are
+// copied (shifting `right`) in parallel, one task per subtree. Fills the depth and leaf
+// counts of `stats`. `top` must hold the root (a non-empty build).
+void splice_depth_first(par::Executor& ex, const TopTree& top, const std::vector<Subtree>& sub,
+                        std::vector<BinaryNode>& binary, BvhStats& stats) {
+  struct Placement {
+    std::size_t task;
+    std::uint32_t offset, depth;
+  };
+  std::vector<Placement> placements;
+  std::vector<std::pair<std::uint32_t, BinaryNode>> top_out;  // (final index, node)
+  std::uint32_t cursor = 0;
+  auto place_task = [&](std::int64_t task, std::uint32_t depth) {
+    const auto t = static_cast<std::size_t>(task);
+    placements.push_back({t, cursor, depth});
+    cursor += static_cast<std::uint32_t>(sub[t].nodes.size());
+  };
+  auto place_top = [&](auto&& self, std::size_t idx, std::uint32_t depth) -> void {
+    const TempNode& n = top.nodes[idx];
+    const std::uint32_t me = cursor++;
+    top_out.push_back({me, BinaryNode{}});
+    const std::size_t slot = top_out.size() - 1;
+    top_out[slot].second.box = n.box;
+    stats.max_depth = std::max(stats.max_depth, depth);
+    if (n.left_task >= 0) place_task(n.left_task, depth + 1);
+    else self(self, static_cast<std::size_t>(n.left), depth + 1);
+    top_out[slot].second.right = cursor;
+    if (n.right_task >= 0) place_task(n.right_task, depth + 1);
+    else self(self, static_cast<std::size_t>(n.right), depth + 1);
+  };
+  if (top.nodes[0].left < 0) place_task(top.nodes[0].left_task, 0);  // the whole tree is one task
+  else place_top(place_top, 0, 0);
+  binary.resize(cursor);
+  for (const auto& [index, node] : top_out) binary[index] = node;
+  ex.parallel_for("bvh_splice", placements.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) {
+      const Placement& pl = placements[p];
+      const std::vector<BinaryNode>& nodes = sub[pl.task].nodes;
+      BinaryNode* out = binary.data() + pl.offset;
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        out[i] = nodes[i];
+        if (!nodes[i].is_leaf()) out[i].right += pl.offset;
+      }
+    }
+  });
+  for (const Placement& pl : placements) {
+    stats.max_depth = std::max(stats.max_depth, pl.depth + sub[pl.task].max_depth);
+    stats.leaves += sub[pl.task].leaves;
+  }
+}
+
+}  // namespace
+
+Bvh Bvh::build(const TriangleMesh& mesh, par::Executor& executor, const BvhBuildOptions& options) {
+  return build(mesh.positions, mesh.indices, executor, options, "scene mesh");
+}
+
+Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
+               par::Executor& ex, const BvhBuildOptions& options, const std::string& source) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (indices.size() % 3 != 0) throw InputError(source, "index count is not a multiple of 3");
+  const std::size_t tri_count = indices.size() / 3;
+  if (tri_count >= kMaxTriangles) throw InputError(source, "too many triangles for the BVH (max 2^28)");
+  BvhBuildOptions opt = options;
+  opt.bins = std::clamp(opt.bins, 2, kMaxBins);
+  opt.max_leaf_size = std::clamp(opt.max_leaf_size, 1, 16);
   auto lap = [t = t0]() mutable {
     const auto now = std::chrono::steady_clock::now();
     const double ms = std::chrono::duration<double, std::milli>(now - t).count();
     t = now;
     return ms;
   };
+
+  Bvh bvh;
+  std::vector<PrimRef> refs = make_prim_refs(positions, indices, ex, source);
   bvh.stats_.refs_ms = lap();
-  std::uint8_t any_bad = 0;
-  for (std::uint8_t b : bad) any_bad |= b;
-  if (any_bad & 1) throw InputError(source, "triangle index out of range");
-  if (any_bad & 2) throw InputError(source, "non-finite vertex position");
-
-  // Top phase: split large ranges one at a time, bounds and bins in parallel over chunks.
-  std::vector<TempNode> top;
-  std::vector<Range> tasks;  // subtrees left for the parallel phase, in order
-  if (tri_count > 0) {
-    auto bounds_of = [&](std::uint32_t begin, std::uint32_t end) {
-      const std::size_t n = end - begin;
-      const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
-      std::vector<Aabb> box(chunks), cbox(chunks);
-      ex.parallel_for("bvh_range_bounds", n, kBinChunk, [&](std::size_t b, std::size_t e) {
-        Aabb bx, cb;
-        for (std::size_t i = begin + b; i < begin + e; ++i) {
-          bx.lo = glm::min(bx.lo, refs[i].lo);
-          bx.hi = glm::max(bx.hi, refs[i].hi);
-          cb.grow(refs[i].centroid2());
-        }
-        box[b / kBinChunk] = bx;
-        cbox[b / kBinChunk] = cb;
-      });
-      Range r{begin, end, {}, {}};
-      for (std::size_t c = 0; c < chunks; ++c) {
-        r.box.grow(box[c]);
-        r.cbox.grow(cbox[c]);
-      }
-      return r;
-    };
-    struct Item {
-      Range range;
-      std::size_t node;
-      bool is_left;
-      std::size_t parent;
-    };
-    std::vector<Item> fifo;
-    top.push_back({});
-    fifo.push_back({bounds_of(0, static_cast<std::uint32_t>(tri_count)), 0, false, 0});
-    // One tree level at a time (the FIFO is breadth-first): each range is binned in parallel
-    // over chunks, then the level's partitions run in parallel, one range per chunk. Nodes
-    // and tasks are numbered in FIFO order, as a one-at-a-time loop would number them.
-    struct Pending {
-      Item item;
-      Binner binner;
-      Split split;
-      Range left, right;
-    };
-    std::size_t head = 0;
-    while (head < fifo.size()) {
-      const std::size_t level_end = fifo.size();
-      std::vector<Pending> splits;
-      for (; head < level_end; ++head) {
-        const Item it = fifo[head];
-        const std::size_t n = it.range.end - it.range.begin;
-        if (n <= kParallelRange) {
-          const auto task = static_cast<std::int64_t>(tasks.size());
-          tasks.push_back(it.range);
-          if (it.node == 0) top[0].left_task = task;  // the whole tree is one task
-          else if (it.is_left) top[it.parent].left_task = task;
-          else top[it.parent].right_task = task;
-          continue;
-        }
-        const Binner binner(it.range.cbox, opt.bins);
-        const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
-        std::vector<Bins> part(chunks);
-        ex.parallel_for("bvh_bin", n, kBinChunk, [&](std::size_t b, std::size_t e) {
-          Bins& local = part[b / kBinChunk];
-          for (auto& axis : local) axis.fill(Bin{});
-          bin_refs(refs.data() + it.range.begin + b, e - b, binner, local);
-        });
-        Bins bins;
-        for (auto& axis : bins) axis.fill(Bin{});
-        for (std::size_t c = 0; c < chunks; ++c)
-          for (int a = 0; a < 3; ++a)
-            for (int i = 0; i < opt.bins; ++i) {
-              bins[a][i].lo = _mm_min_ps(part[c][a][i].lo, bins[a][i].lo);
-              bins[a][i].hi = _mm_max_ps(part[c][a][i].hi, bins[a][i].hi);
-              bins[a][i].count += part[c][a][i].count;
-            }
-        top[it.node].box = it.range.box;
-        splits.push_back({it, binner, best_split(bins, it.range.cbox, n, opt), {}, {}});
-      }
-      ex.parallel_for("bvh_top_partition", splits.size(), 1, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-          Pending& p = splits[k];
-          std::tie(p.left, p.right) = partition(refs.data(), p.item.range, p.split, p.binner);
-        }
-      });
-      for (const Pending& p : splits) {
-        const std::size_t l = top.size();
-        top.push_back({});
-        top.push_back({});
-        top[p.item.node].left = static_cast<std::int64_t>(l);
-        top[p.item.node].right = static_cast<std::int64_t>(l + 1);
-        fifo.push_back({p.left, l, true, p.item.node});
-        fifo.push_back({p.right, l + 1, false, p.item.node});
-      }
-    }
-  }
-
+  const TopTree top = split_top_ranges(ex, refs, opt);
   bvh.stats_.top_ms = lap();
-  // Parallel phase: each task builds its subtree alone; chunk = 1 task.
-  std::vector<Subtree> sub(tasks.size());
-  ex.parallel_for("bvh_subtrees", tasks.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t t = b; t < e; ++t) build_subtree(refs.data(), tasks[t], opt, sub[t]);
-  });
+  const std::vector<Subtree> sub = build_subtrees(ex, refs, top.tasks, opt);
   bvh.stats_.subtrees_ms = lap();
-
-  // Leaf triangles in ref order.
-  bvh.triangles_.resize(tri_count);
-  bvh.triangle_id_.resize(tri_count);
-  ex.parallel_for("bvh_gather_triangles", tri_count, kPrimChunk, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const std::uint32_t t = refs[i].id;
-      bvh.triangle_id_[i] = t;
-      bvh.triangles_[i] = {positions[indices[3 * t]], positions[indices[3 * t + 1]], positions[indices[3 * t + 2]]};
-    }
-  });
-
-  // Splice depth-first into the final binary layout: a serial walk over the few top nodes
-  // places each subtree at its offset, then the subtrees are copied (shifting `right`) in
-  // parallel, one task per subtree.
-  if (tri_count > 0) {
-    struct Placement {
-      std::size_t task;
-      std::uint32_t offset, depth;
-    };
-    std::vector<Placement> placements;
-    std::vector<std::pair<std::uint32_t, BinaryNode>> top_out;  // (final index, node)
-    std::uint32_t cursor = 0;
-    auto place_task = [&](std::int64_t task, std::uint32_t depth) {
-      const auto t = static_cast<std::size_t>(task);
-      placements.push_back({t, cursor, depth});
-      cursor += static_cast<std::uint32_t>(sub[t].nodes.size());
-    };
-    auto place_top = [&](auto&& self, std::size_t idx, std::uint32_t depth) -> void {
-      const TempNode& n = top[idx];
-      const std::uint32_t me = cursor++;
-      top_out.push_back({me, BinaryNode{}});
-      const std::size_t slot = top_out.size() - 1;
-      top_out[slot].second.box = n.box;
-      bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, depth);
-      if (n.left_task >= 0) place_task(n.left_task, depth + 1);
-      else self(self, static_cast<std::size_t>(n.left), depth + 1);
-      top_out[slot].second.right = cursor;
-      if (n.right_task >= 0) place_task(n.right_task, depth + 1);
-      else self(self, static_cast<std::size_t>(n.right), depth + 1);
-    };
-    if (top[0].left < 0) place_task(top[0].left_task, 0);  // the whole tree is one task
-    else place_top(place_top, 0, 0);
-    bvh.binary_.resize(cursor);
-    for (const auto& [index, node] : top_out) bvh.binary_[index] = node;
-    ex.parallel_for("bvh_splice", placements.size(), 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t p = b; p < e; ++p) {
-        const Placement& pl = placements[p];
-        const std::vector<BinaryNode>& nodes = sub[pl.task].nodes;
-        BinaryNode* out = bvh.binary_.data() + pl.offset;
-        for (std::size_t i = 0; i < nodes.size(); ++i) {
-          out[i] = nodes[i];
-          if (!nodes[i].is_leaf()) out[i].right += pl.offset;
-        }
-      }
-    });
-    for (const Placement& pl : placements) {
-      bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, pl.depth + sub[pl.task].max_depth);
-      bvh.stats_.leaves += sub[pl.task].leaves;
-    }
-  }
+  gather_leaf_triangles(ex, refs, positions, indices, bvh.triangles_, bvh.triangle_id_);
+  if (tri_count > 0) splice_depth_first(ex, top, sub, bvh.binary_, bvh.stats_);
   bvh.stats_.binary_nodes = bvh.binary_.size();
   bvh.stats_.splice_ms = lap();
   bvh.derive_layouts(ex);
@@ -499,8 +552,7 @@ void Bvh::refit(const std::vector<glm::vec3>& positions, const std::vector<std::
     if (i >= positions.size()) throw InputError("bvh refit", "triangle index out of range");
   ex.parallel_for("bvh_refit_triangles", triangle_id_.size(), kPrimChunk, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      const std::uint32_t t = triangle_id_[i];
-      triangles_[i] = {positions[indices[3 * t]], positions[indices[3 * t + 1]], positions[indices[3 * t + 2]]};
+      triangles_[i] = leaf_triangle(positions, indices, triangle_id_[i]);
     }
   });
   // Children follow their parent in depth-first order, so a reverse sweep sees them first.

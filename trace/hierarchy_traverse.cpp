@@ -54,45 +54,65 @@ struct Traversal {
       level_pairs[l] = m;
       if (4 * m > capacity) return false;
       tests += 4 * m;
-      const std::size_t n = std::size_t(1) << l, row = 2 * n;
-      const auto& child = h.nodes[l + 1];
-      const auto& sn = h.sin_alpha[l + 1];
-      const auto& cs = h.cos_alpha[l + 1];
-      keep.resize(4 * m);
-      auto t_test = std::chrono::steady_clock::now();
-      // One kernel per level: the triangle's sphere against the node's 4 children.
-      ex.parallel_for("hierarchy_level_" + std::to_string(l), m, kPairChunk, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-          const std::size_t x = node[k] % n, y = node[k] / n;
-          const BoundingSphere& s = spheres[tri[k]];
-          for (int j = 0; j < 4; ++j) {
-            const std::size_t c = (2 * y + std::size_t(j >> 1)) * row + 2 * x + std::size_t(j & 1);
-            keep[4 * k + j] = !child[c].empty() && cone_sphere_intersects(child[c], sn[c], cs[c], s);
-          }
-        }
-      });
-      stats.tests_ms += ms_since(t_test);
-      auto t_compact = std::chrono::steady_clock::now();
-      kept.resize(4 * m);
-      const std::size_t count = par::compact_hierarchical(ex, "hierarchy_compact_" + std::to_string(l),
-                                                          keep, kept, block_size, &scratch);
-      next_node.resize(count);
-      next_tri.resize(count);
-      ex.parallel_for("hierarchy_gather_" + std::to_string(l), count, kPairChunk, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
-          const std::size_t src = kept[i] / 4, j = kept[i] % 4;
-          const std::size_t x = node[src] % n, y = node[src] / n;
-          next_node[i] = std::uint32_t((2 * y + (j >> 1)) * row + 2 * x + (j & 1));
-          next_tri[i] = tri[src];
-        }
-      });
-      std::swap(node, next_node);
-      std::swap(tri, next_tri);
-      stats.compaction_ms += ms_since(t_compact);
+      descend_level(l);
     }
     level_pairs[h.levels] = node.size();
+    const std::size_t m = node.size();
+    exact_tests_and_merge();
 
-    // Exact tests of the surviving (leaf, triangle) pairs; closest per ray by segmented min.
+    if (stats.pairs_per_level.size() < level_pairs.size()) stats.pairs_per_level.resize(level_pairs.size(), 0);
+    for (std::size_t l = 0; l < level_pairs.size(); ++l) stats.pairs_per_level[l] += level_pairs[l];
+    stats.cone_sphere_tests += tests;
+    stats.candidates += m;
+    stats.level_passes += std::uint64_t(h.levels);
+    ++stats.batches;
+    return true;
+  }
+
+  // Level l -> l+1 of the descent: one kernel tests each (node, triangle) pair's sphere
+  // against the node's 4 children, then the surviving (child, triangle) pairs replace
+  // node/tri, compacted in order.
+  void descend_level(int l) {
+    const std::size_t m = node.size();
+    const std::size_t n = std::size_t(1) << l, row = 2 * n;
+    const auto& child = h.nodes[l + 1];
+    const auto& sn = h.sin_alpha[l + 1];
+    const auto& cs = h.cos_alpha[l + 1];
+    keep.resize(4 * m);
+    auto t_test = std::chrono::steady_clock::now();
+    ex.parallel_for("hierarchy_level_" + std::to_string(l), m, kPairChunk, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const std::size_t x = node[k] % n, y = node[k] / n;
+        const BoundingSphere& s = spheres[tri[k]];
+        for (int j = 0; j < 4; ++j) {
+          const std::size_t c = (2 * y + std::size_t(j >> 1)) * row + 2 * x + std::size_t(j & 1);
+          keep[4 * k + j] = !child[c].empty() && cone_sphere_intersects(child[c], sn[c], cs[c], s);
+        }
+      }
+    });
+    stats.tests_ms += ms_since(t_test);
+    auto t_compact = std::chrono::steady_clock::now();
+    kept.resize(4 * m);
+    const std::size_t count = par::compact_hierarchical(ex, "hierarchy_compact_" + std::to_string(l),
+                                                        keep, kept, block_size, &scratch);
+    next_node.resize(count);
+    next_tri.resize(count);
+    ex.parallel_for("hierarchy_gather_" + std::to_string(l), count, kPairChunk, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const std::size_t src = kept[i] / 4, j = kept[i] % 4;
+        const std::size_t x = node[src] % n, y = node[src] / n;
+        next_node[i] = std::uint32_t((2 * y + (j >> 1)) * row + 2 * x + (j & 1));
+        next_tri[i] = tri[src];
+      }
+    });
+    std::swap(node, next_node);
+    std::swap(tri, next_tri);
+    stats.compaction_ms += ms_since(t_compact);
+  }
+
+  // Exact tests of the surviving (leaf, triangle) pairs; the closest hit per ray by
+  // segmented min, merged into `best`.
+  void exact_tests_and_merge() {
     auto t_exact = std::chrono::steady_clock::now();
     const std::size_t m = node.size();
     const std::size_t side = std::size_t(h.side), width = std::size_t(h.width);
@@ -134,14 +154,6 @@ struct Traversal {
       }
     });
     stats.exact_ms += ms_since(t_exact);
-
-    if (stats.pairs_per_level.size() < level_pairs.size()) stats.pairs_per_level.resize(level_pairs.size(), 0);
-    for (std::size_t l = 0; l < level_pairs.size(); ++l) stats.pairs_per_level[l] += level_pairs[l];
-    stats.cone_sphere_tests += tests;
-    stats.candidates += m;
-    stats.level_passes += std::uint64_t(h.levels);
-    ++stats.batches;
-    return true;
   }
 
   void run(std::uint32_t t0, std::uint32_t t1) {

@@ -145,6 +145,55 @@ struct Entry {
   float tnear;
 };
 
+// Leaf child k of n: every ray whose own box test passes is tested against the leaf's
+// triangle packs; best[r] (and p.best_t[r]) keep ray r's closest hit, ties to the lower
+// triangle id. True when some ray's best improved.
+[[gnu::always_inline]] inline bool intersect_leaf(const WideNode& n, int k, const TrianglePack* packs,
+                                                  Packet& p, Hit* best, TraversalCounters& c) {
+  bool improved = false;
+  const std::uint32_t ref = n.child[k];
+  const std::uint32_t first = (ref & ~kLeafBit) >> 2, npacks = (ref & 3u) + 1;
+  for (unsigned rb = rays_box_hits(n, k, p); rb; rb &= rb - 1) {
+    const int r = __builtin_ctz(rb);
+    const wide::PackRay pr(p.shear[r]);
+    for (std::uint32_t q = first; q < first + npacks; ++q) {
+      const TrianglePack& pk = packs[q];
+      c.triangle_tests += 4;
+      float t[4], u[4], v[4];
+      unsigned hit = wide::intersect_pack(pk, pr, p.tmin[r], best[r].t, t, u, v);
+      while (hit) {
+        const int l = __builtin_ctz(hit);
+        hit &= hit - 1;
+        if (t[l] < best[r].t || (t[l] == best[r].t && pk.id[l] < best[r].triangle)) {
+          best[r] = {t[l], u[l], v[l], pk.id[l]};
+          p.best_t[r] = t[l];
+          improved = true;
+        }
+      }
+    }
+  }
+  return improved;
+}
+
+// The inner children in `bits` whose entry bound tn[k] is within max_t, sorted far to
+// near into `hits` (the nearest last, where the descent continues); returns their count.
+[[gnu::always_inline]] inline int children_far_to_near(const WideNode& n, unsigned bits, const float* tn,
+                                                        float max_t, Entry* hits) {
+  int m = 0;
+  for (; bits; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    if (!(tn[k] <= max_t)) continue;
+    const Entry e{n.child[k], tn[k]};
+    int j = m++;
+    while (j > 0 && hits[j - 1].tnear < e.tnear) {
+      hits[j] = hits[j - 1];
+      --j;
+    }
+    hits[j] = e;
+  }
+  return m;
+}
+
 }  // namespace
 
 bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, TraversalCounters* counters) {
@@ -182,44 +231,13 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
     while (leaves) {
       const int k = __builtin_ctz(leaves);
       leaves &= leaves - 1;
-      const std::uint32_t ref = n.child[k];
-      const std::uint32_t first = (ref & ~kLeafBit) >> 2, npacks = (ref & 3u) + 1;
-      for (unsigned rb = rays_box_hits(n, k, p); rb; rb &= rb - 1) {
-        const int r = __builtin_ctz(rb);
-        const wide::PackRay pr(p.shear[r]);
-        for (std::uint32_t q = first; q < first + npacks; ++q) {
-          const TrianglePack& pk = packs[q];
-          c.triangle_tests += 4;
-          float t[4], u[4], v[4];
-          unsigned hit = wide::intersect_pack(pk, pr, p.tmin[r], best[r].t, t, u, v);
-          while (hit) {
-            const int l = __builtin_ctz(hit);
-            hit &= hit - 1;
-            if (t[l] < best[r].t || (t[l] == best[r].t && pk.id[l] < best[r].triangle)) {
-              best[r] = {t[l], u[l], v[l], pk.id[l]};
-              p.best_t[r] = t[l];
-              improved = true;
-            }
-          }
-        }
-      }
+      if (intersect_leaf(n, k, packs, p, best, c)) improved = true;
     }
     if (improved) max_t = lane_max(p.best_t);
     // Inner children: descend into the nearest, push the others far-to-near.
     if (bits) {
       Entry hits[kWideArity];
-      int m = 0;
-      for (; bits; bits &= bits - 1) {
-        const int k = __builtin_ctz(bits);
-        if (!(tn[k] <= max_t)) continue;
-        const Entry e{n.child[k], tn[k]};
-        int j = m++;
-        while (j > 0 && hits[j - 1].tnear < e.tnear) {
-          hits[j] = hits[j - 1];
-          --j;
-        }
-        hits[j] = e;
-      }
+      const int m = children_far_to_near(n, bits, tn, max_t, hits);
       if (m > 0) {
         for (int i = 0; i + 1 < m; ++i) {
           if (sp == kTraversalStackSize) {
