@@ -90,9 +90,6 @@ struct Onb {
     b = glm::vec3(bb, sign + unit_n.y * unit_n.y * a, -unit_n.y);
   }
   glm::vec3 to_world(const glm::vec3& local) const { return local.x * t + local.y * b + local.z * n; }
-  glm::vec3 to_local(const glm::vec3& w) const {
-    return {glm::dot(w, t), glm::dot(w, b), glm::dot(w, n)};
-  }
 };
 
 // A direction with polar cosine cos_theta about +Z and azimuth 2π u.
@@ -106,13 +103,11 @@ inline glm::vec3 spherical_local(float cos_theta, float u) {
 inline glm::vec3 sample_cosine_hemisphere(glm::vec2 u) {
   return spherical_local(std::sqrt(1.0f - u.x), u.y);
 }
-inline float cosine_hemisphere_pdf(float cos_theta) { return cos_theta > 0.0f ? cos_theta / kPi : 0.0f; }
 
 // Uniform within a cone of half-angle acos(cos_max) about +Z: pdf = 1 / (2π (1 - cos_max)).
 inline glm::vec3 sample_uniform_cone(glm::vec2 u, float cos_max) {
   return spherical_local(1.0f - u.x * (1.0f - cos_max), u.y);
 }
-inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
 
 // Normalized Phong lobe about +Z (the lobe axis, e.g. the mirror direction R), YU eq.4:
 // cosθ = u1^(1/(n+1)), φ = 2π u2; pdf(θ) = (n+1)/(2π) cos^n θ over the hemisphere about the

@@ -38,8 +38,6 @@ struct Aabb {
 struct BvhBuildOptions {
   int bins = 16;               // SAH bins per axis
   int max_leaf_size = 4;       // ranges this small become leaves (at most 16)
-  float traversal_cost = 1.0f;  // SAH costs relative to one triangle test
-  float triangle_cost = 1.0f;
 };
 
 // A binary node in depth-first order: an inner node's left child is the next node.

@@ -13,12 +13,6 @@
 
 namespace speculum::trace {
 
-float box_solid_angle(const Aabb& box, const glm::vec3& x) {
-  const glm::vec3 diag = box.hi - box.lo;
-  const glm::vec3 to_center = box.center() - x;
-  return kPi * glm::dot(diag, diag) / (4.0f * glm::dot(to_center, to_center));
-}
-
 namespace {
 
 struct Sums {

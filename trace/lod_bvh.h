@@ -26,7 +26,9 @@ struct LodNode {
   glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};  // quad: origin + s edge_u + t edge_v
   glm::vec3 normal{0.0f};     // unit mean normal of a quad proxy (zero without one)
   float area = 0.0f;          // total triangle area of the subtree
-  float box_solid_angle_k = 0.0f;  // π |pmax - pmin|² / 4, the numerator of eq.6
+  // π |pmax - pmin|² / 4, the numerator of eq.6: the box's solid angle seen from x is
+  // k / |(pmax + pmin)/2 - x|².
+  float box_solid_angle_k = 0.0f;
   glm::vec3 radiance{0.0f};   // filtered (area-weighted mean) radiance
   std::uint32_t parent = kThreadEnd;
   bool quad = false;
@@ -46,8 +48,5 @@ struct LodBvh {
 // `triangle_radiance` is indexed by original triangle (size bvh.triangle_count()); throws
 // InputError otherwise.
 LodBvh build_lod_bvh(const Bvh& bvh, const std::vector<glm::vec3>& triangle_radiance);
-
-// Box solid angle seen from x, YU eq.6: π |pmax - pmin|² / (4 |(pmax + pmin)/2 - x|²).
-float box_solid_angle(const Aabb& box, const glm::vec3& x);
 
 }  // namespace speculum::trace

@@ -33,17 +33,6 @@ inline void test_leaf_closest(const Bvh& bvh, const RayPrep& r, std::uint32_t fi
   }
 }
 
-inline bool test_leaf_any(const Bvh& bvh, const RayPrep& r, std::uint32_t first, std::uint32_t count,
-                          TraversalCounters& c) {
-  const auto& tris = bvh.leaf_triangles();
-  for (std::uint32_t k = first; k < first + count; ++k) {
-    ++c.triangle_tests;
-    TriangleHit h;
-    if (intersect_triangle_watertight(r.shear, tris[k].a, tris[k].b, tris[k].c, r.tmin, r.tmax, h)) return true;
-  }
-  return false;
-}
-
 [[gnu::always_inline]] inline void test_packs_closest(const TrianglePack* packs, const wide::PackRay& r, float tmin,
                                                           std::uint32_t ref, Hit& best, TraversalCounters& c) {
   const std::uint32_t first = (ref & ~kLeafBit) >> 2, count = (ref & 3u) + 1;
@@ -234,30 +223,6 @@ Hit closest_hit_threaded(const Bvh& bvh, const Ray& ray, TraversalCounters* coun
   return best;
 }
 
-bool any_hit_threaded(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
-  TraversalCounters c;
-  c.rays = 1;
-  bool found = false;
-  const auto& nodes = bvh.threaded_nodes();
-  if (valid_ray(ray) && !nodes.empty()) {
-    const RayPrep r(ray);
-    std::uint32_t i = 0;
-    while (i != kThreadEnd && !found) {
-      const ThreadedNode& n = nodes[i];
-      ++c.nodes_visited;
-      float tnear;
-      if (!box_hit(r, n.box, r.tmax, tnear)) {
-        i = n.miss;
-        continue;
-      }
-      if (n.count) found = test_leaf_any(bvh, r, n.first, n.count, c);
-      i = n.hit;
-    }
-  }
-  if (counters) counters->add(c);
-  return found;
-}
-
 Hit closest_hit_oracle(const std::vector<glm::vec3>& p, const std::vector<std::uint32_t>& idx, const Ray& ray) {
   Hit best;
   best.t = ray.tmax;
@@ -327,21 +292,6 @@ void closest_hit_stream(const Bvh& bvh, const RayStream& rays, HitStream& hits, 
       hits.v[i] = h.v;
       hits.triangle[i] = h.triangle;
     }
-    if (counters) per_chunk[b / kRayChunk] = c;
-  });
-  if (counters)
-    for (const auto& c : per_chunk) counters->add(c);
-}
-
-void any_hit_stream(const Bvh& bvh, const RayStream& rays, std::vector<std::uint8_t>& occluded,
-                    par::Executor& ex, TraversalCounters* counters) {
-  const std::size_t n = rays.size();
-  occluded.resize(n);
-  const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
-  std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
-  ex.parallel_for("trace_any", n, kRayChunk, [&](std::size_t b, std::size_t e) {
-    TraversalCounters c;
-    for (std::size_t i = b; i < e; ++i) occluded[i] = any_hit(bvh, rays.get(i), &c) ? 1 : 0;
     if (counters) per_chunk[b / kRayChunk] = c;
   });
   if (counters)

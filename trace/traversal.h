@@ -49,7 +49,6 @@ Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit,
 
 // Threaded layout, stackless, fixed depth-first order.
 Hit closest_hit_threaded(const Bvh& bvh, const Ray& ray, TraversalCounters* counters = nullptr);
-bool any_hit_threaded(const Bvh& bvh, const Ray& ray, TraversalCounters* counters = nullptr);
 
 // Every ray against every triangle (the test oracle).
 Hit closest_hit_oracle(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
@@ -77,8 +76,5 @@ constexpr std::size_t kRayChunk = 256;
 // Closest hits for a stream, chunks of kRayChunk rays on the executor (kernel "trace_closest").
 void closest_hit_stream(const Bvh& bvh, const RayStream& rays, HitStream& hits, par::Executor& executor,
                         TraversalCounters* counters = nullptr);
-// occluded[i] = 1 when ray i hits anything in [tmin, tmax] (kernel "trace_any").
-void any_hit_stream(const Bvh& bvh, const RayStream& rays, std::vector<std::uint8_t>& occluded,
-                    par::Executor& executor, TraversalCounters* counters = nullptr);
 
 }  // namespace speculum::trace

@@ -33,6 +33,16 @@ struct PlaneMap {
   }
 };
 
+// One SURVEY eq.5 step between guesses d_l and d_p, from the search's own ratio and
+// secant_from_ratios (the search takes its ratios from the linear march instead).
+template <class DistanceFn>
+float secant_step(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r, float d_l,
+                  float d_p) {
+  int lookups = 0;
+  return secant_from_ratios(d_l, distance_search_detail::ratio(distance_towards, x, r, d_l, lookups),
+                            d_p, distance_search_detail::ratio(distance_towards, x, r, d_p, lookups));
+}
+
 std::vector<glm::vec3> sphere_directions(int n) {  // Fibonacci sphere
   std::vector<glm::vec3> out;
   for (int i = 0; i < n; ++i) {

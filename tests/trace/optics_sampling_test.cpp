@@ -112,6 +112,13 @@ TEST(Sampling, OnbIsOrthonormal) {
 }
 
 TEST(Shading, EquirectRoundTripsAndLights) {
+  // The inverse mapping: u = 0.5 + φ/2π with φ = atan2(x, -z), v = θ/π with cos θ = y.
+  const auto equirect_direction = [](glm::vec2 uv) {
+    const float phi = (uv.x - 0.5f) * 2.0f * kPi;
+    const float theta = uv.y * kPi;
+    const float st = std::sin(theta);
+    return glm::vec3(st * std::sin(phi), std::cos(theta), -st * std::cos(phi));
+  };
   for (int i = 0; i < 100; ++i) {
     const glm::vec3 d = sample_uniform_cone(random_float2(i, 0, 0, 11), -1.0f);
     EXPECT_NEAR(glm::length(equirect_direction(equirect_uv(d)) - d), 0.0f, 1e-4f);

@@ -42,7 +42,6 @@ inline int expect_single_rays_match_oracle(const std::vector<glm::vec3>& positio
     const bool oa = any_hit_oracle(positions, indices, r);
     EXPECT_EQ(oa, o.hit()) << "ray " << i;
     EXPECT_EQ(oa, any_hit(bvh, r, &c)) << "wide any, ray " << i;
-    EXPECT_EQ(oa, any_hit_threaded(bvh, r, &c)) << "threaded any, ray " << i;
   }
   return hits;
 }

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "core/sampling.h"
+#include "parallel/executor.h"
+#include "trace/bvh.h"
 #include "trace/glossy_rays.h"
 #include "trace/hit_radiance.h"
 #include "trace/lod_bvh.h"
@@ -123,13 +125,22 @@ TEST(YuSampling, Eq6AgainstTheBoundingSphereSolidAngle) {
   // eq.6 is π r²/D² for the bounding sphere of radius r = |pmax-pmin|/2 at distance D: the
   // small-angle (projected disc) form of the exact 2π(1 - sqrt(1 - r²/D²)). It never exceeds
   // the exact value and their ratio is 1 + x/4 + O(x²), x = r²/D².
+  // eq.6 as the LOD trace evaluates it: the node's numerator k = π |pmax-pmin|²/4 against
+  // budget × D². Two triangles spanning the box's diagonal make it the root node's box.
   Aabb box;
   box.lo = glm::vec3(-1.0f, -0.5f, -2.0f);
   box.hi = glm::vec3(1.0f, 0.5f, 2.0f);
+  par::Executor ex(1);
+  const std::vector<glm::vec3> corners{box.lo, {box.hi.x, box.lo.y, box.lo.z}, box.hi, {box.lo.x, box.hi.y, box.hi.z}};
+  const Bvh bvh = Bvh::build(corners, {0, 1, 2, 0, 2, 3}, ex);
+  const LodBvh lod = build_lod_bvh(bvh, std::vector<glm::vec3>(2, glm::vec3(1.0f)));
+  ASSERT_EQ(bvh.threaded_nodes()[0].box.lo, box.lo);
+  ASSERT_EQ(bvh.threaded_nodes()[0].box.hi, box.hi);
   const double r = glm::length(box.hi - box.lo) / 2.0;
   for (double D : {1.05 * r, 1.5 * r, 3.0 * r, 10.0 * r, 100.0 * r, 1000.0 * r}) {
     const glm::vec3 x = box.center() + glm::normalize(glm::vec3(0.3f, 0.9f, -0.2f)) * static_cast<float>(D);
-    const double eq6 = box_solid_angle(box, x);
+    const glm::vec3 to_center = box.center() - x;
+    const double eq6 = lod.nodes[0].box_solid_angle_k / glm::dot(to_center, to_center);
     const double xx = r * r / (D * D);
     const double exact = 2.0 * kPi * (1.0 - std::sqrt(1.0 - xx));
     EXPECT_NEAR(eq6, kPi * xx, 1e-5 * kPi * xx);
