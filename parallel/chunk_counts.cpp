@@ -57,7 +57,7 @@ std::vector<std::uint32_t> count_ids_per_chunk(Executor& ex, std::string_view na
                                                std::span<const std::uint32_t> ids,
                                                std::size_t bins, std::size_t chunk,
                                                std::string_view what, std::string_view id_kind) {
-  return dispatch_lanes(default_lanes(), [&](auto w) {
+  return dispatch_lanes(ex.lanes(), [&](auto w) {
     return count_ids_per_chunk<w.value>(ex, name, phase, ids, bins, chunk, what, id_kind);
   });
 }

@@ -15,7 +15,7 @@ namespace speculum::par {
 // counts[c * bins + id] = how many elements of chunk c carry `id`. Launch "<name>/<phase>".
 // Throws std::invalid_argument("<what>: a <id_kind> id is >= the <id_kind> count N") when an
 // id is out of range. The template range-checks W ids per lane compare (Lanes<W>) and counts
-// the lanes of each group in element order; the plain function uses default_lanes().
+// the lanes of each group in element order; the plain function uses ex.lanes().
 template <int W>
 std::vector<std::uint32_t> count_ids_per_chunk(Executor& ex, std::string_view name,
                                                std::string_view phase,

@@ -215,24 +215,19 @@ std::size_t compact_hierarchical(Executor& ex, std::string_view name,
   return total;
 }
 
-// The plain forms run at the process-wide width (`--lanes W`).
+// The plain forms run at the executor's width (Executor::lanes(), `--lanes W`).
 std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const std::uint8_t> keep,
                             std::span<std::uint32_t> out, std::size_t chunk) {
-  return dispatch_lanes(default_lanes(), [&](auto w) { return compact_scatter<w.value>(ex, name, keep, out, chunk); });
+  return dispatch_lanes(ex.lanes(), [&](auto w) { return compact_scatter<w.value>(ex, name, keep, out, chunk); });
 }
 
 std::size_t compact_hierarchical(Executor& ex, std::string_view name,
                                  std::span<const std::uint8_t> keep, std::span<std::uint32_t> out,
                                  std::size_t block_size, std::vector<std::uint32_t>* scratch,
                                  HierarchicalCompactStats* stats) {
-  return dispatch_lanes(default_lanes(), [&](auto w) {
+  return dispatch_lanes(ex.lanes(), [&](auto w) {
     return compact_hierarchical<w.value>(ex, name, keep, out, block_size, scratch, stats);
   });
-}
-
-std::size_t compact_block_gather(std::span<const std::uint8_t> block, std::span<std::uint32_t> psum,
-                                 std::span<std::uint32_t> out, std::uint64_t& steps) {
-  return dispatch_lanes(default_lanes(), [&](auto w) { return compact_block_gather<w.value>(block, psum, out, steps); });
 }
 
 #define SPECULUM_COMPACT_INSTANTIATE(W)                                                                   \

@@ -32,7 +32,7 @@ inline constexpr std::size_t kCompactChunk = std::size_t(1) << 18;
 // "<name>/chained_scatter"): each chunk counts, takes its offset by look-back and scatters;
 // otherwise per-chunk counts, serial offsets and the size check, then the scatter. The template runs the count and the left-pack scatter over Lanes<W> (W = 1, 4, 8,
 // 16 are instantiated; every W gives the same output); the plain function uses
-// default_lanes() (`--lanes W`).
+// the executor's width, ex.lanes() (`--lanes W`).
 template <int W>
 std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const std::uint8_t> keep,
                             std::span<std::uint32_t> out, std::size_t chunk = kCompactChunk);
@@ -46,7 +46,7 @@ std::size_t compact_scatter(Executor& ex, std::string_view name, std::span<const
 // (concatenation, Fig.4.8). `scratch` holds the block-local results (resized to n rounded
 // up to s); pass one in to avoid reallocating it each call. The template computes pSum with
 // in-register prefix sums over W flags and searches W output slots at once (same output and
-// search_steps for every W); the plain function uses default_lanes().
+// search_steps for every W); the plain function uses ex.lanes().
 template <int W>
 std::size_t compact_hierarchical(Executor& ex, std::string_view name,
                                  std::span<const std::uint8_t> keep, std::span<std::uint32_t> out,
@@ -62,8 +62,6 @@ std::size_t compact_hierarchical(Executor& ex, std::string_view name,
 // branch-free bisection on j - pSum[j]) and returns count; `psum` receives the inclusive
 // empty counts. `steps` accumulates psum probes.
 template <int W>
-std::size_t compact_block_gather(std::span<const std::uint8_t> block, std::span<std::uint32_t> psum,
-                                 std::span<std::uint32_t> out, std::uint64_t& steps);
 std::size_t compact_block_gather(std::span<const std::uint8_t> block, std::span<std::uint32_t> psum,
                                  std::span<std::uint32_t> out, std::uint64_t& steps);
 

@@ -7,6 +7,8 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include "parallel/lanes.h"
+
 namespace speculum::par {
 
 namespace {
@@ -21,13 +23,17 @@ int resolve_threads(int threads) {
 }
 }  // namespace
 
-Executor::Executor(int threads)
-    : threads_(resolve_threads(threads)), epoch_(std::chrono::steady_clock::now()) {
+Executor::Executor(int threads, int lanes)
+    : threads_(resolve_threads(threads)),
+      lanes_(resolve_lane_width(lanes)),
+      epoch_(std::chrono::steady_clock::now()) {
   if (threads_ > tbb::info::default_concurrency())
     oversubscribe_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                            std::size_t(threads_));
   if (threads_ > 1) arena_ = std::make_unique<tbb::task_arena>(threads_);
 }
+
+void Executor::set_lanes(int lanes) { lanes_ = resolve_lane_width(lanes); }
 
 std::vector<LaunchRecord> Executor::launches() const {
   std::lock_guard lock(records_mutex_);

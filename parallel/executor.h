@@ -58,7 +58,11 @@ class Executor {
   // calling thread (the debugging mode). threads < 0 throws std::invalid_argument. More
   // threads than cores is allowed and really runs that many (oversubscribed: a way to shake
   // out ordering bugs); results never depend on it.
-  explicit Executor(int threads = 0);
+  // lanes: the lane width W (1, 4, 8 or 16; 0 = the build's native widest, kNativeLanes in
+  // lanes.h) at which the primitives not given an explicit W run on this executor
+  // (`--lanes W`); any other value throws std::invalid_argument. Results never depend on it
+  // either, and executors of different widths may run side by side.
+  explicit Executor(int threads = 0, int lanes = 0);
 
   // Number of chunks parallel_for(n, chunk) uses; chunk 0 is treated as 1.
   static std::size_t chunk_count(std::size_t n, std::size_t chunk) {
@@ -68,6 +72,12 @@ class Executor {
 
   int threads() const { return threads_; }
   bool synchronous() const { return threads_ == 1; }
+
+  // The resolved lane width: 1, 4, 8 or 16, never 0.
+  int lanes() const { return lanes_; }
+  // Same rules as the constructor's `lanes`. Call it before launching work: kernels read the
+  // width when they start, without synchronization.
+  void set_lanes(int lanes);
 
   // Calls body(begin, end) for each chunk [c*chunk, min(n, (c+1)*chunk)).
   template <class Body>
@@ -154,6 +164,7 @@ class Executor {
               std::int64_t duration);
 
   int threads_;
+  int lanes_;
   // Raises TBB's process-wide worker limit (default: the core count) while an executor asks
   // for more threads than cores, so `--threads 8` on 2 cores really runs 8 threads.
   std::unique_ptr<tbb::global_control> oversubscribe_;

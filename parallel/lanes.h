@@ -24,15 +24,16 @@
 //       L::store_partial(L::load_partial(x + i, count) * k, y + i, count);
 //     }
 //   }
-//   dispatch_lanes(default_lanes(), [&](auto w) { scale<decltype(w)::value>(x, y, n, 2.f); });
+//   dispatch_lanes(executor.lanes(), [&](auto w) { scale<decltype(w)::value>(x, y, n, 2.f); });
 //
 // Which kernels take W (what `--lanes` changes): map_lanes (stream.h); the 32-bit sum scans
 // (scan_kernels.h); both compactions, stable partition, histogram, segmented min and the
 // radix sort (compact.cpp, partition.cpp, chunk_counts.cpp, segmented.cpp, radix_sort.cpp),
-// each `template <int W>` instantiated for 1, 4, 8 and 16 beside a plain overload that uses
-// default_lanes(); and the tile rasterizer's coverage and depth test. Their extra lane ops
-// (prefix sums, streaming stores, left-packing, ...) are in lanes_stream.h and lanes_pack.h,
-// with intrinsic paths where a width is one register. Scans and reductions with an
+// each `template <int W>` instantiated for 1, 4, 8 and 16 beside a plain overload that runs
+// at the width of the Executor it is given (Executor::lanes()); and the tile rasterizer's
+// coverage and depth test (RasterOptions::lanes, else the Executor's width). Their extra
+// lane ops (prefix sums, streaming stores, left-packing, ...) are in lanes_stream.h and
+// lanes_pack.h, with intrinsic paths where a width is one register. Scans and reductions with an
 // arbitrary operator fold element by element (their association must not depend on W).
 // Not width-generic: the G-buffer resolve and the BVH traversal kernels, written with fixed
 // 8-wide AVX2 for the 8-child BVH node layout; they do the same IEEE operations per element
@@ -230,24 +231,24 @@ struct Lanes {
 // Calls f(std::integral_constant<int, W>{}) for the requested width; w == 0 picks the
 // build's native width. Every supported width is instantiated (fixed_size lanes wider than
 // a register are emulated), so tests can compare all of them in one binary.
+// The width `w` asks for: w itself if supported, kNativeLanes for 0. Throws
+// std::invalid_argument for any other value.
+inline int resolve_lane_width(int w) {
+  if (w == 0) return kNativeLanes;
+  if (!is_supported_lane_width(w))
+    throw std::invalid_argument("unsupported lane width " + std::to_string(w) +
+                                " (use 0 = native, 1, 4, 8 or 16)");
+  return w;
+}
+
 template <class F>
 decltype(auto) dispatch_lanes(int w, F&& f) {
-  if (w == 0) w = kNativeLanes;
-  switch (w) {
+  switch (resolve_lane_width(w)) {
     case 1: return std::forward<F>(f)(std::integral_constant<int, 1>{});
     case 4: return std::forward<F>(f)(std::integral_constant<int, 4>{});
     case 8: return std::forward<F>(f)(std::integral_constant<int, 8>{});
-    case 16: return std::forward<F>(f)(std::integral_constant<int, 16>{});
-    default:
-      throw std::invalid_argument("unsupported lane width " + std::to_string(w) +
-                                  " (use 0 = native, 1, 4, 8 or 16)");
+    default: return std::forward<F>(f)(std::integral_constant<int, 16>{});
   }
 }
-
-// Process-wide lane width chosen by `--lanes W` (0 = native). Kernels that are not given
-// an explicit width use default_lanes(). set_default_lanes throws std::invalid_argument
-// for unsupported widths. Set it before launching work; reads are atomic.
-int default_lanes();  // never 0: returns the resolved width
-void set_default_lanes(int w);
 
 }  // namespace speculum::par

@@ -48,7 +48,7 @@ void partition_stable(Executor& ex, std::string_view name, std::span<const std::
 void partition_stable(Executor& ex, std::string_view name, std::span<const std::uint32_t> bucket,
                       std::uint32_t p, std::span<std::uint32_t> out,
                       std::span<std::uint32_t> bucket_begin, std::size_t chunk) {
-  dispatch_lanes(default_lanes(), [&](auto w) { partition_stable<w.value>(ex, name, bucket, p, out, bucket_begin, chunk); });
+  dispatch_lanes(ex.lanes(), [&](auto w) { partition_stable<w.value>(ex, name, bucket, p, out, bucket_begin, chunk); });
 }
 
 template void partition_stable<1>(Executor&, std::string_view, std::span<const std::uint32_t>, std::uint32_t,

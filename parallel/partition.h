@@ -23,7 +23,7 @@ inline constexpr std::size_t kScatterChunk = 1 << 16;
 // A bucket id >= p throws std::invalid_argument. The template range-checks and counts over
 // Lanes<W> (count_ids_per_chunk<W>) and scatters W-groups lane by lane in element order (the
 // scatter is per element); every W gives the same output. The plain function uses
-// default_lanes().
+// ex.lanes().
 template <int W>
 void partition_stable(Executor& ex, std::string_view name, std::span<const std::uint32_t> bucket,
                       std::uint32_t p, std::span<std::uint32_t> out,
@@ -49,7 +49,7 @@ struct RadixSortScratch {
 // passes of <= 11 bits over the whole array with write-combining scatters.
 // payload may be empty (keys only); otherwise it must have keys.size() elements.
 // radix_sort<W> runs its kernels at lane width W (1, 4, 8, 16); the plain overloads use
-// default_lanes(). The output does not depend on W.
+// ex.lanes(). The output does not depend on W.
 template <int W>
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch = nullptr,

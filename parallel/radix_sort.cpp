@@ -536,13 +536,13 @@ SPECULUM_RADIX_SORT_AT(16)
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint32_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint32_t>* scratch,
                 std::size_t chunk) {
-  dispatch_lanes(default_lanes(), [&](auto w) { radix_sort<w.value>(ex, name, keys, payload, scratch, chunk); });
+  dispatch_lanes(ex.lanes(), [&](auto w) { radix_sort<w.value>(ex, name, keys, payload, scratch, chunk); });
 }
 
 void radix_sort(Executor& ex, std::string_view name, std::span<std::uint64_t> keys,
                 std::span<std::uint32_t> payload, RadixSortScratch<std::uint64_t>* scratch,
                 std::size_t chunk) {
-  dispatch_lanes(default_lanes(), [&](auto w) { radix_sort<w.value>(ex, name, keys, payload, scratch, chunk); });
+  dispatch_lanes(ex.lanes(), [&](auto w) { radix_sort<w.value>(ex, name, keys, payload, scratch, chunk); });
 }
 
 }  // namespace speculum::par

@@ -63,12 +63,12 @@ T scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> 
                       });
 }
 
-// W = 0: the width `--lanes` chose (default_lanes()).
+// W = 0: the executor's width, ex.lanes() (`--lanes W`).
 template <int W, bool Inclusive, class T, class Op>
 T scan_at_width(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out, T init,
                 Op op, std::size_t chunk) {
   if constexpr (W == 0) {
-    return dispatch_lanes(default_lanes(), [&](auto w) {
+    return dispatch_lanes(ex.lanes(), [&](auto w) {
       return scan<decltype(w)::value, Inclusive>(ex, name, in, out, init, op, chunk);
     });
   } else {
@@ -78,7 +78,7 @@ T scan_at_width(Executor& ex, std::string_view name, std::span<const T> in, std:
 }  // namespace detail
 
 // out[i] = init ⊕ in[0] ⊕ ... ⊕ in[i-1]; returns the total init ⊕ in[0..n). out may alias in.
-// W: lane width of the kernels (1, 4, 8, 16; 0 = default_lanes()); the bits do not depend on it.
+// W: lane width of the kernels (1, 4, 8, 16; 0 = ex.lanes()); the bits do not depend on it.
 template <int W = 0, class T, class Op = std::plus<T>>
 T exclusive_scan(Executor& ex, std::string_view name, std::span<const T> in, std::span<T> out,
                  T init = T{}, Op op = {}, std::size_t chunk = kScanChunk) {

@@ -101,7 +101,7 @@ void segmented_min_sorted(Executor& ex, std::string_view name, std::span<const s
 void segmented_min_sorted(Executor& ex, std::string_view name, std::span<const std::uint32_t> segment,
                           std::span<const float> value, std::uint32_t segments,
                           std::span<float> min_value, std::span<std::uint32_t> min_index) {
-  dispatch_lanes(default_lanes(), [&](auto w) {
+  dispatch_lanes(ex.lanes(), [&](auto w) {
     segmented_min_sorted<w.value>(ex, name, segment, value, segments, min_value, min_index);
   });
 }
@@ -130,7 +130,7 @@ void segmented_min(Executor& ex, std::string_view name, std::span<const std::uin
 void segmented_min(Executor& ex, std::string_view name, std::span<const std::uint32_t> segment,
                    std::span<const float> value, std::uint32_t segments,
                    std::span<float> min_value, std::span<std::uint32_t> min_index) {
-  dispatch_lanes(default_lanes(), [&](auto w) { segmented_min<w.value>(ex, name, segment, value, segments, min_value, min_index); });
+  dispatch_lanes(ex.lanes(), [&](auto w) { segmented_min<w.value>(ex, name, segment, value, segments, min_value, min_index); });
 }
 
 template <int W>
@@ -153,7 +153,7 @@ void histogram(Executor& ex, std::string_view name, std::span<const std::uint32_
 
 void histogram(Executor& ex, std::string_view name, std::span<const std::uint32_t> bin,
                std::span<std::uint64_t> count, std::size_t chunk) {
-  dispatch_lanes(default_lanes(), [&](auto w) { histogram<w.value>(ex, name, bin, count, chunk); });
+  dispatch_lanes(ex.lanes(), [&](auto w) { histogram<w.value>(ex, name, bin, count, chunk); });
 }
 
 #define SPECULUM_SEGMENTED_INSTANTIATE(W)                                                                     \

@@ -18,7 +18,7 @@ namespace speculum::par {
 // binary search over `segment`. Throws std::invalid_argument on unsorted or out-of-range ids.
 // The template validates W ids per lane compare and scans a segment W values at a time
 // (Lanes<W>: NaN lanes masked out, the lowest lane holding the group minimum wins); every W
-// gives the same bits. The plain functions below use default_lanes().
+// gives the same bits. The plain functions below run at the executor's width, ex.lanes().
 template <int W>
 void segmented_min_sorted(Executor& ex, std::string_view name, std::span<const std::uint32_t> segment,
                           std::span<const float> value, std::uint32_t segments,

@@ -14,7 +14,6 @@
 #include "apps/cli/json_output.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
-#include "parallel/lanes.h"
 #include "raster/gbuffer.h"
 #include "raster/visibility.h"
 
@@ -51,7 +50,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   if (o.cull == "back") raster_options.cull = raster::CullMode::Back;
   else if (o.cull == "front") raster_options.cull = raster::CullMode::Front;
   else if (o.cull != "none") throw InputError("--cull", "expected none, back or front");
-  par::Executor executor(global.threads);
+  par::Executor executor(global.threads, global.lanes);
   std::vector<double> frame_ms;
   std::map<std::string, std::vector<double>> kernel_ms;
   std::size_t covered = 0;
@@ -93,7 +92,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
     OrderedJson kernels = OrderedJson::object();
     for (const auto& [name, v] : kernel_ms) kernels[name] = rounded(median(v), 3);
     const OrderedJson j{{"scene", scene.name}, {"triangles", triangles}, {"width", o.width},
-                        {"height", o.height}, {"threads", executor.threads()}, {"lanes", par::default_lanes()},
+                        {"height", o.height}, {"threads", executor.threads()}, {"lanes", executor.lanes()},
                         {"cull", o.cull}, {"repeat", o.repeat}, {"ms_median", rounded(med, 3)},
                         {"ms_min", rounded(lo, 3)}, {"ms_max", rounded(hi, 3)},
                         {"mtris_per_s", rounded(triangles / (med * 1e-3) / 1e6, 3)},

@@ -282,7 +282,7 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
     return;
   }
   if (o.mesh.empty()) throw InputError("bench trace", "no MESH given");
-  par::Executor ex(global.threads);
+  par::Executor ex(global.threads, global.lanes);
   const Scene scene = load_scene(o.mesh);
   if (!o.emit.empty()) {
     const trace::RaySetKind kind = trace::parse_ray_set_kind(o.emit);

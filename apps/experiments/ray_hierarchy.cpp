@@ -119,7 +119,7 @@ void run_row(const Scene& scene, const std::string& name, const trace::Bvh& bvh,
 void run_ray_hierarchy_experiment(const RayHierarchyExperimentOptions& o, const GlobalOptions& global) {
   if (o.min_width > o.max_width)
     throw InputError("--min-width", "must not exceed --max-width (" + std::to_string(o.max_width) + ")");
-  par::Executor ex(global.threads);
+  par::Executor ex(global.threads, global.lanes);
   ResultTable table(o.json);
   const std::vector<std::string>& scenes = o.scenes.empty() ? kScenes : o.scenes;
   std::size_t widths = 0;

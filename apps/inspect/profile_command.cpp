@@ -54,7 +54,7 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
     fs::create_directories(o.output, ec);
     if (ec || !fs::is_directory(o.output)) throw InputError(o.output, "cannot create the output directory");
   }
-  par::Executor executor(global.threads);
+  par::Executor executor(global.threads, global.lanes);
   Progress progress("profile " + technique.name, std::size_t(o.warmup + o.repeat), global.quiet);
   for (int i = 0; i < o.warmup; ++i) {
     pipeline::render_frame(scene, technique, settings, executor);

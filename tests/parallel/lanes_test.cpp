@@ -111,18 +111,14 @@ TEST(Lanes, HorizontalOps) {
   EXPECT_EQ(part[5], 9.f);
 }
 
-TEST(Lanes, DispatchAndDefault) {
+TEST(Lanes, DispatchAndResolve) {
   EXPECT_EQ(dispatch_lanes(0, [](auto w) { return int(w.value); }), kNativeLanes);
   for (int w : {1, 4, 8, 16}) EXPECT_EQ(dispatch_lanes(w, [](auto lw) { return int(lw.value); }), w);
   EXPECT_THROW(dispatch_lanes(3, [](auto) { return 0; }), std::invalid_argument);
   EXPECT_THROW(dispatch_lanes(32, [](auto) { return 0; }), std::invalid_argument);
-  const int before = default_lanes();
-  set_default_lanes(4);
-  EXPECT_EQ(default_lanes(), 4);
-  set_default_lanes(0);
-  EXPECT_EQ(default_lanes(), kNativeLanes);
-  EXPECT_THROW(set_default_lanes(5), std::invalid_argument);
-  set_default_lanes(before);
+  EXPECT_EQ(resolve_lane_width(0), kNativeLanes);
+  for (int w : {1, 4, 8, 16}) EXPECT_EQ(resolve_lane_width(w), w);
+  for (int bad : {-4, -1, 2, 5, 12, 32}) EXPECT_THROW(resolve_lane_width(bad), std::invalid_argument) << bad;
 }
 
 }  // namespace

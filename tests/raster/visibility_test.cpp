@@ -315,6 +315,9 @@ TEST(RasterDeterminism, BitIdenticalAcrossThreadsAndLanes) {
     opt.lanes = lanes;
     par::Executor ex(2);
     EXPECT_TRUE(same_bits(ref, render_visibility(ex, scene, cam, 333, 250, opt))) << lanes;
+    // RasterOptions::lanes = 0 takes the executor's width.
+    par::Executor ex_at_width(2, lanes);
+    EXPECT_TRUE(same_bits(ref, render_visibility(ex_at_width, scene, cam, 333, 250, {}))) << lanes;
   }
 }
 
