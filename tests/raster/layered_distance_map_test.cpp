@@ -68,6 +68,7 @@ TEST(LayeredDistanceMap, MoreLayersReduceTheErrorOnAnOccludedSetUp) {
   pipeline::FrameSettings f = small_frame(s);
   pipeline::FrameSettings ref = f;
   ref.spp = 4;
+  ref.params.clear();  // the reference takes no technique parameters
   const ImageRGBA reference = frame(s, "reference", ref);
   f.params["layers"] = 1;
   const double one = image_error(frame(s, "layered-distance-map", f), reference).mae8;
