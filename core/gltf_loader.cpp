@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -18,6 +19,7 @@
 
 #include "core/error.h"
 #include "core/gltf_accessors.h"
+#include "core/gltf_environment.h"
 #include "core/gltf_material.h"
 #include "core/mesh_normals.h"
 
@@ -555,6 +557,87 @@ std::vector<int> root_nodes(const tinygltf::Model& model, const std::string& pat
   return roots;
 }
 
+// One finite float from `v` (a JSON number), or InputError naming `what`.
+float finite_number(const std::string& path, const tinygltf::Value& v, const std::string& what) {
+  const double x = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+  if (!std::isfinite(x) || std::fabs(x) > std::numeric_limits<float>::max())
+    throw InputError(path, what + " must be a finite number");
+  return static_cast<float>(x);
+}
+
+int positive_int(const std::string& path, const tinygltf::Value& v, const std::string& what, int max) {
+  if (!v.IsInt() || v.Get<int>() < 1 || v.Get<int>() > max)
+    throw InputError(path, what + " must be an integer in [1, " + std::to_string(max) + "]");
+  return v.Get<int>();
+}
+
+// The equirect image of extras.speculum_environment.equirect (gltf_environment.h): its
+// bufferView must hold exactly width x height RGBA32F pixels inside its buffer.
+ImageRGBA read_equirect(const std::string& path, const tinygltf::Model& model, const tinygltf::Value& q) {
+  const std::string what = std::string("extras.") + gltf::kEnvironmentExtrasKey + ".equirect";
+  if (!q.IsObject()) throw InputError(path, what + " must be an object");
+  for (const char* key : {"bufferView", "width", "height", "format"})
+    if (!q.Has(key)) throw InputError(path, what + " has no \"" + key + "\"");
+  if (!q.Get("format").IsString() || q.Get("format").Get<std::string>() != gltf::kEquirectFormat)
+    throw InputError(path, what + ".format must be \"" + gltf::kEquirectFormat + "\"");
+  const int width = positive_int(path, q.Get("width"), what + ".width", gltf::kMaxEquirectSide);
+  const int height = positive_int(path, q.Get("height"), what + ".height", gltf::kMaxEquirectSide);
+  const tinygltf::Value& bv = q.Get("bufferView");
+  if (!bv.IsInt() || bv.Get<int>() < 0 || static_cast<std::size_t>(bv.Get<int>()) >= model.bufferViews.size())
+    throw InputError(path, what + ".bufferView does not name a bufferView");
+  const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(bv.Get<int>())];
+  const std::uint64_t bytes = std::uint64_t(width) * std::uint64_t(height) * gltf::kEquirectBytesPerPixel;
+  if (view.byteLength != bytes || (view.byteStride != 0 && view.byteStride != gltf::kEquirectBytesPerPixel))
+    throw InputError(path, what + ": bufferView " + std::to_string(bv.Get<int>()) + " holds " +
+                               std::to_string(view.byteLength) + " bytes, " + std::to_string(width) +
+                               "x" + std::to_string(height) + " RGBA32F needs " + std::to_string(bytes));
+  if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size() ||
+      std::uint64_t(view.byteOffset) + bytes > model.buffers[static_cast<std::size_t>(view.buffer)].data.size())
+    throw InputError(path, what + ": bufferView " + std::to_string(bv.Get<int>()) +
+                               " runs past the end of its buffer");
+  const unsigned char* p = model.buffers[static_cast<std::size_t>(view.buffer)].data.data() + view.byteOffset;
+  ImageRGBA img(width, height);
+  for (std::size_t i = 0; i < img.pixels.size(); ++i)
+    for (int c = 0; c < 4; ++c) {
+      const std::uint32_t bits = le32(p + 16 * i + 4 * static_cast<std::size_t>(c));
+      float v;
+      std::memcpy(&v, &bits, 4);
+      if (!std::isfinite(v))
+        throw InputError(path, what + " pixel " + std::to_string(i % static_cast<std::size_t>(width)) +
+                                   "," + std::to_string(i / static_cast<std::size_t>(width)) +
+                                   " has a NaN or infinite value");
+      img.pixels[i][c] = v;
+    }
+  return img;
+}
+
+// Scene::environment from the root extras a speculum export writes (gltf_environment.h);
+// left at its default (black) when the file carries none. Extras that are not an object, or
+// carry other keys, belong to other tools and are left alone.
+void read_environment(const std::string& path, const tinygltf::Model& model, Scene& scene,
+                      LoadReport* report) {
+  if (!model.extras.IsObject() || !model.extras.Has(gltf::kEnvironmentExtrasKey)) return;
+  const std::string what = std::string("extras.") + gltf::kEnvironmentExtrasKey;
+  const tinygltf::Value& e = model.extras.Get(gltf::kEnvironmentExtrasKey);
+  if (!e.IsObject()) throw InputError(path, what + " must be an object");
+  Environment env;
+  if (e.Has("color")) {
+    const tinygltf::Value& c = e.Get("color");
+    if (!c.IsArray() || c.ArrayLen() != 3) throw InputError(path, what + ".color must be an array of 3 numbers");
+    for (int k = 0; k < 3; ++k) env.constant[k] = finite_number(path, c.Get(k), what + ".color");
+  }
+  if (e.Has("intensity")) {
+    env.intensity = finite_number(path, e.Get("intensity"), what + ".intensity");
+    if (env.intensity < 0.0f) throw InputError(path, what + ".intensity must not be negative");
+  }
+  if (e.Has("equirect")) env.equirect = read_equirect(path, model, e.Get("equirect"));
+  env.source = path;
+  for (const std::string& key : e.Keys())
+    if (key != "color" && key != "intensity" && key != "equirect" && report)
+      report->warn(what + ": unknown key \"" + key + "\" ignored");
+  scene.environment = std::move(env);
+}
+
 }  // namespace
 
 Scene load_gltf(const std::string& path, LoadReport* report) {
@@ -574,6 +657,7 @@ Scene load_gltf(const std::string& path, LoadReport* report) {
                                                : ""));
   loader.add_cameras();
   loader.add_lights();
+  read_environment(path, model, scene, report);
   loader.materials.finish();
   finish_scene(scene);
   return scene;

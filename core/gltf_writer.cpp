@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <set>
 #include <unordered_map>
 
 #include <tiny_gltf.h>
@@ -14,6 +15,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "core/error.h"
+#include "core/gltf_environment.h"
 
 namespace speculum {
 namespace {
@@ -23,6 +25,10 @@ using tinygltf::Value;
 struct Writer {
   const Scene& scene;
   tinygltf::Model model;
+  // Every extension written anywhere, recorded as it is written (put_extension), so
+  // extensionsUsed lists exactly those (glTF 2.0 spec §3.12: every extension used anywhere
+  // in the asset is listed in the top-level extensionsUsed).
+  std::set<std::string> extensions_used;
   std::vector<unsigned char>& bin() { return model.buffers[0].data; }
 
   int add_view(const void* data, std::size_t bytes, int target) {
@@ -80,7 +86,12 @@ struct Writer {
     model.textures.push_back(tex);
   }
 
-  static void set_transform_ext(const TextureRef& ref, tinygltf::ExtensionMap& ext) {
+  void put_extension(tinygltf::ExtensionMap& map, const char* name, Value::Object body) {
+    map[name] = Value(std::move(body));
+    extensions_used.insert(name);
+  }
+
+  void set_transform_ext(const TextureRef& ref, tinygltf::ExtensionMap& ext) {
     const glm::mat3& m = ref.uv_transform;
     if (m == glm::mat3(1.0f)) return;
     // uv_transform = T R S: column 0 = sx (cos, sin), column 1 = sy (-sin, cos).
@@ -89,11 +100,11 @@ struct Writer {
     t["rotation"] = Value(double(std::atan2(m[0][1], m[0][0])));
     t["scale"] = Value(Value::Array{Value(double(glm::length(glm::vec2(m[0])))),
                                     Value(double(glm::length(glm::vec2(m[1]))))});
-    ext["KHR_texture_transform"] = Value(t);
+    put_extension(ext, "KHR_texture_transform", std::move(t));
   }
 
   template <class Info>
-  static void bind(const TextureRef& ref, Info& info) {
+  void bind(const TextureRef& ref, Info& info) {
     if (!ref.valid()) return;
     info.index = ref.texture;
     info.texCoord = ref.texcoord;
@@ -119,7 +130,7 @@ struct Writer {
       g.emissiveFactor = {m.emissive.x / peak, m.emissive.y / peak, m.emissive.z / peak};
       Value::Object e;
       e["emissiveStrength"] = Value(double(peak));
-      g.extensions["KHR_materials_emissive_strength"] = Value(e);
+      put_extension(g.extensions, "KHR_materials_emissive_strength", std::move(e));
     } else {
       g.emissiveFactor = {m.emissive.x, m.emissive.y, m.emissive.z};
     }
@@ -130,14 +141,19 @@ struct Writer {
         Value::Object ti;
         ti["index"] = Value(m.transmission_texture.texture);
         ti["texCoord"] = Value(m.transmission_texture.texcoord);
+        // A textureInfo inside an extension is plain JSON to tinygltf: its own extensions
+        // object is built by hand.
+        tinygltf::ExtensionMap ti_ext;
+        set_transform_ext(m.transmission_texture, ti_ext);
+        if (!ti_ext.empty()) ti["extensions"] = Value(Value::Object(ti_ext.begin(), ti_ext.end()));
         t["transmissionTexture"] = Value(ti);
       }
-      g.extensions["KHR_materials_transmission"] = Value(t);
+      put_extension(g.extensions, "KHR_materials_transmission", std::move(t));
     }
     if (m.ior != 1.5f) {
       Value::Object t;
       t["ior"] = Value(double(m.ior));
-      g.extensions["KHR_materials_ior"] = Value(t);
+      put_extension(g.extensions, "KHR_materials_ior", std::move(t));
     }
     model.materials.push_back(g);
   }
@@ -240,9 +256,39 @@ struct Writer {
     node.name = l.name;
     Value::Object ext;
     ext["light"] = Value(static_cast<int>(model.lights.size() - 1));
-    node.extensions["KHR_lights_punctual"] = Value(ext);
+    put_extension(node.extensions, "KHR_lights_punctual", std::move(ext));
     place(node, l.position, l.direction, glm::vec3(0, 1, 0));
     add_root(node);
+  }
+
+  // The environment as root extras (schema in gltf_environment.h); an equirect image goes
+  // into the binary buffer as raw little-endian float32 RGBA, so it survives bit-exactly.
+  void add_environment(const Environment& env) {
+    auto num = [](float v) { return Value(static_cast<double>(v)); };
+    Value::Object e;
+    e["color"] = Value(Value::Array{num(env.constant.x), num(env.constant.y), num(env.constant.z)});
+    e["intensity"] = num(env.intensity);
+    if (env.has_image()) {
+      const ImageRGBA& img = env.equirect;
+      std::vector<unsigned char> bytes(img.pixels.size() * gltf::kEquirectBytesPerPixel);
+      for (std::size_t i = 0; i < img.pixels.size(); ++i)
+        for (int c = 0; c < 4; ++c) {
+          std::uint32_t bits = 0;
+          std::memcpy(&bits, &img.pixels[i][c], 4);
+          for (int k = 0; k < 4; ++k)
+            bytes[16 * i + 4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(k)] =
+                static_cast<unsigned char>(bits >> (8 * k));
+        }
+      Value::Object q;
+      q["bufferView"] = Value(add_view(bytes.data(), bytes.size(), 0));
+      q["width"] = Value(img.width);
+      q["height"] = Value(img.height);
+      q["format"] = Value(std::string(gltf::kEquirectFormat));
+      e["equirect"] = Value(q);
+    }
+    Value::Object root;
+    root[gltf::kEnvironmentExtrasKey] = Value(e);
+    model.extras = Value(root);
   }
 };
 
@@ -261,7 +307,7 @@ void write_gltf(const Scene& scene, const std::string& path) {
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext != ".glb" && ext != ".gltf")
     throw InputError(path, "export needs a .glb or .gltf file name");
-  Writer w{scene, {}};
+  Writer w{scene, {}, {}};
   auto& model = w.model;
   model.asset.version = "2.0";
   model.asset.generator = "speculum";
@@ -279,16 +325,8 @@ void write_gltf(const Scene& scene, const std::string& path) {
   for (const auto& c : scene.cameras) w.add_camera(c);
   for (const auto& l : scene.lights) w.add_light(l);
 
-  auto use = [&](const char* name) {
-    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), name) == model.extensionsUsed.end())
-      model.extensionsUsed.push_back(name);
-  };
-  for (const auto& m : model.materials)
-    for (const auto& [name, v] : m.extensions) use(name.c_str());
-  for (const auto& m : model.materials)
-    for (const auto* info : {&m.pbrMetallicRoughness.baseColorTexture, &m.emissiveTexture})
-      if (info->extensions.count("KHR_texture_transform")) use("KHR_texture_transform");
-  if (!model.lights.empty()) use("KHR_lights_punctual");
+  w.add_environment(scene.environment);
+  model.extensionsUsed.assign(w.extensions_used.begin(), w.extensions_used.end());
   if (model.textures.empty()) model.samplers.clear();
 
   const std::string tmp = path + ".tmp-speculum";

@@ -1,7 +1,10 @@
 // Scene → glTF 2.0 (.glb or .gltf with embedded buffers) through tinygltf, so other
 // viewers can open the built-in scenes: one mesh per object, materials with
 // KHR_materials_transmission/_ior/_emissive_strength, embedded PNG textures, cameras and
-// KHR_lights_punctual lights. The environment is not exported (glTF has no such concept).
+// KHR_lights_punctual lights. glTF has no environment: it is carried in the root `extras`
+// (constant colour, intensity and any equirect image, bit-exact; see gltf_environment.h),
+// which load_gltf reads back and other viewers ignore. extensionsUsed lists exactly the
+// extensions written.
 #pragma once
 
 #include <string>

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   app.add_option("--lanes", global.lanes, "SIMD lane width 1, 4, 8 or 16 (0: widest built)")
       ->check(CLI::IsMember({0, 1, 4, 8, 16}))
       ->capture_default_str();
-  app.add_flag("--quiet,-q", global.quiet, "No progress output on stderr");
+  app.add_flag("--quiet,-q", global.quiet, "No progress output or warnings on stderr");
   // The global options may also follow the subcommand (`speculum bench trace m.ply --threads 2`):
   // a subcommand hands options it does not know to its parent, and every subcommand, nested
   // ones included, inherits this setting when it is added below.

@@ -31,6 +31,19 @@ void list_scenes() {
               "e.g. `speculum info bumpy-sphere:size=200k,n=12`.\n");
 }
 
+// "512x256 equirect x 0.5" or "constant 0.05 0.05 0.05 x 1", for the export warning.
+std::string environment_summary(const Environment& env) {
+  char text[160];
+  if (env.has_image())
+    std::snprintf(text, sizeof text, "%dx%d equirect x %g", env.equirect.width,
+                  env.equirect.height, static_cast<double>(env.intensity));
+  else
+    std::snprintf(text, sizeof text, "constant %g %g %g x %g", static_cast<double>(env.constant.x),
+                  static_cast<double>(env.constant.y), static_cast<double>(env.constant.z),
+                  static_cast<double>(env.intensity));
+  return text;
+}
+
 }  // namespace
 
 void add_scenes_command(CLI::App& app, GlobalOptions& global) {
@@ -44,7 +57,8 @@ void add_scenes_command(CLI::App& app, GlobalOptions& global) {
   auto opts = std::make_shared<ExportOptions>();
   auto* exp = cmd->add_subcommand(
       "export",
-      "Write a scene (built-in name or file) as glTF 2.0: .glb (binary) or .gltf (embedded)\n"
+      "Write a scene (built-in name or file) as glTF 2.0: .glb (binary) or .gltf (embedded);\n"
+      "the environment goes into the root extras, which only speculum reads back\n"
       "Example: speculum scenes export living-room room.glb --size 200000");
   exp->add_option("scene", opts->scene, "Built-in scene name (NAME[:size=N,...]) or scene file")
       ->required();
@@ -59,6 +73,18 @@ void add_scenes_command(CLI::App& app, GlobalOptions& global) {
     so.report = &report;
     const Scene scene = load_scene(opts->scene, so);
     write_gltf(scene, opts->output);
+    if (!global.quiet) {
+      // What the loader skipped or repaired is not in the export either.
+      for (const std::string& w : report.warnings)
+        std::fprintf(stderr, "speculum: warning: %s: %s\n", opts->scene.c_str(), w.c_str());
+      // Only speculum reads the environment back (gltf_environment.h); a black one loses nothing.
+      const Environment& env = scene.environment;
+      if (env.intensity != 0.0f && (env.has_image() || env.constant != glm::vec3(0.0f)))
+        std::fprintf(stderr,
+                     "speculum: warning: %s: the environment (%s) is stored in the root "
+                     "extras.speculum_environment; other glTF viewers will not show it\n",
+                     opts->output.c_str(), environment_summary(env).c_str());
+    }
     if (!global.quiet)
       std::printf("wrote %s: %zu triangles, %zu vertices, %zu materials, %zu textures, "
                   "%zu cameras, %zu lights\n",
