@@ -1,6 +1,7 @@
 // glTF 2.0 loader (tinygltf): .gltf + .bin, .glb, data URIs; the node hierarchy flattened
 // to world space; materials with KHR transmission/ior/emissive_strength/texture_transform;
-// KHR_lights_punctual; perspective cameras. Every accessor is validated before it is read.
+// KHR_lights_punctual; perspective cameras; the environment a speculum export keeps in the
+// root extras (gltf_environment.h). Every accessor is validated before it is read.
 #pragma once
 
 #include <string>
