@@ -50,7 +50,9 @@ struct Material {
   MaterialKind kind() const;
   // Phong exponent n from roughness r: alpha = r^2, n = 2/alpha^2 - 2 (the usual
   // Beckmann-to-Phong correspondence),
-  // clamped to [0, 1e6] so a perfect mirror stays finite.
+  // clamped to [0, 1e6] so a perfect mirror stays finite. The one roughness -> exponent
+  // mapping: indirect glossy lobes (YU eq.4) sample/prefilter with it; direct lights use
+  // the glTF GGX BRDF instead (core/shading.h).
   float phong_exponent() const;
 };
 

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 
+#include "core/brdf.h"
 #include "core/optics.h"
 #include "core/sampling.h"
 
@@ -120,23 +121,32 @@ glm::vec3 specular_fresnel(const SurfaceParams& s, float cos_nv) {
 }
 
 glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv) {
-  const glm::vec3 f = specular_fresnel(s, cos_nv);
-  return (glm::vec3(1.0f) - f) * s.base_color * ((1.0f - s.metallic) * (1.0f - s.transmission) / kPi);
+  // The dielectric's own Fresnel weight, as in shade_light's fresnel_mix (core/brdf.h), with
+  // V·H replaced by N·V: for irradiance from many directions there is no single H.
+  const float f = fresnel_schlick(cos_nv, fresnel_f0(s.ior));
+  return s.base_color * ((1.0f - s.metallic) * (1.0f - s.transmission) * (1.0f - f) / kPi);
+}
+
+BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s) {
+  BrdfParams p;
+  p.base_color = s.base_color;
+  p.metallic = s.metallic;
+  const float r = std::max(s.roughness, kMinPunctualRoughness);
+  p.alpha = r * r;
+  p.dielectric_f0 = fresnel_f0(s.ior);
+  p.transmission = s.transmission;
+  return p;
 }
 
 glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
                       const LightSample& light) {
   const float cos_nl = glm::dot(n, light.direction);
   if (cos_nl <= 0.0f) return glm::vec3(0.0f);
-  const float cos_nv = std::max(glm::dot(n, v), 0.0f);
-  glm::vec3 out = diffuse_albedo_over_pi(s, cos_nv) * light.irradiance * cos_nl;
-  if (!s.is_mirror_lobe()) {
-    const glm::vec3 r = reflect(-v, n);
-    const float cos_rl = glm::dot(r, light.direction);
-    out += specular_fresnel(s, cos_nv) * (phong_lobe_pdf(cos_rl, s.phong_exponent) * light.irradiance);
-  }
-  if (s.is_refractor()) out *= (1.0f - s.transmission);
-  return out;
+  const BrdfValue f = gltf_brdf(brdf_params_for_punctual_light(s), n, light.direction, v);
+  // Mirror-class surfaces: the delta lobe's image of a point light is a point of zero solid
+  // angle, which camera rays never see directly either, so it adds nothing (see shading.h).
+  const glm::vec3 brdf = s.is_mirror_lobe() ? f.diffuse : f.total();
+  return brdf * (cos_nl * light.irradiance);
 }
 
 glm::vec2 equirect_uv(const glm::vec3& d) {

@@ -1,19 +1,31 @@
 // The one shading model shared by the rasterizer's direct_light node and the reference
 // tracer, so techniques and the ground truth agree (glTF metallic-roughness materials;
 // KHR_lights_punctual units). The model, in full:
-// - F0 = mix(fresnel_f0(ior) [0.04 at ior 1.5], base_color, metallic); F = Schlick(N·V, F0).
-// - Diffuse: f_d = (1 - F) (1 - metallic) (1 - transmission) base_color / π (Lambert).
-// - Specular: a normalized Phong lobe of exponent n = Material::phong_exponent() about the
-//   mirror direction R = reflect(-V, N). Reflected radiance = F × the lobe-weighted mean of
-//   incident radiance, L_s = F ∫ p(ω) L(ω) dω with p = (n+1)/(2π) cos^n(R,ω) (YU eq.4), so a
-//   lobe sample's weight is exactly F and the mirror limit (n → ∞) is L_s = F L(R).
-//   Directions under the surface horizon (N·ω <= 0) contribute nothing.
-//   For a punctual light of irradiance E (at normal incidence): L_s = F p(ω_l) E when N·ω_l > 0.
-// - Roughness classes: r <= kMirrorRoughness: the lobe is a delta — direct lights give no
-//   highlight, reflections are traced/looked up along R; r < kGlossyRoughness: glossy
-//   lobe, indirect by lobe sampling; otherwise only the direct-light highlight.
+// - Direct light (punctual lights): glTF 2.0's metallic-roughness BRDF (glTF 2.0 spec,
+//   Appendix B; formulas in core/brdf.h): GGX D with α = roughness², height-correlated
+//   Smith V, Schlick F on V·H with F0 = mix(fresnel_f0(ior) [0.04 at ior 1.5], base_color,
+//   metallic), Lambert diffuse (1 - metallic)(1 - transmission)(1 - F_dielectric) base_color/π.
+//   Reflected radiance L = f(l, v) (N·L) E. α is clamped to kMinPunctualRoughness² so the
+//   highlight of a delta light stays finite. The BRDF is smooth in l, so there is no edge
+//   anywhere on a lit surface.
+// - Mirror-class surfaces (r <= kMirrorRoughness) get the diffuse term but no direct
+//   highlight: in the spec's limit α → 0 the lobe is a delta, and a delta lobe's image of a
+//   point light is a point of zero solid angle — the same invisible point the camera sees
+//   when it looks at the light itself (lights are not geometry). Their reflections are
+//   traced/looked up along R = reflect(-V, N) instead, weighted by Schlick F(N·V).
+// - Indirect glossy reflection (r < kGlossyRoughness, by sampling or prefiltering) does NOT
+//   use the GGX lobe: it uses a normalized Phong lobe of exponent n =
+//   Material::phong_exponent() (the one roughness → exponent mapping, core/scene.h) about R,
+//   L_s = F(N·V) ∫ p(ω) L(ω) dω with p = (n+1)/(2π) cos^n(R,ω) (YU eq.4), so a lobe
+//   sample's weight is exactly F and the mirror limit (n → ∞) is L_s = F L(R). Directions
+//   under the surface horizon (N·ω <= 0) contribute nothing. Rougher surfaces have no
+//   indirect specular.
+// - Environment/ambient diffuse: diffuse_albedo_over_pi = the Lambert term above with
+//   F_dielectric taken at N·V, times the irradiance.
 // - Refractors (transmission > 0.5): smooth dielectric, exact Fresnel (fresnel_dielectric),
-//   transmitted light tinted by base_color; the opaque terms are scaled by (1-transmission).
+//   transmitted light tinted by base_color. KHR_materials_transmission replaces the diffuse
+//   lobe by the transmission: the direct light's diffuse is scaled by (1 - transmission)
+//   once; its specular highlight is not scaled.
 // - Emission adds `emissive` towards every direction.
 // - Lights (KHR_lights_punctual): point/spot intensity in candela, E = I/d² times the range
 //   window clamp(1 - (d/range)^4, 0, 1) (range 0: infinite); spot cone smoothstep-free
@@ -29,6 +41,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/brdf.h"
 #include "core/scene.h"
 
 namespace speculum {
@@ -41,7 +54,7 @@ struct SurfaceParams {
   float transmission = 0.0f;
   float ior = 1.5f;
   glm::vec3 emissive{0.0f};
-  float phong_exponent = 0.0f;
+  float phong_exponent = 0.0f;  // Material::phong_exponent(): indirect glossy lobes only
 
   bool is_refractor() const { return transmission > 0.5f; }
   bool is_mirror_lobe() const { return roughness <= kMirrorRoughness; }
@@ -70,11 +83,15 @@ glm::vec3 specular_f0(const SurfaceParams& s);
 glm::vec3 specular_fresnel(const SurfaceParams& s, float cos_nv);
 
 // Radiance reflected towards V (unit, surface → viewer) from one light sample, N unit:
-// diffuse + specular highlight as above, times (1 - transmission) for refractors. The
+// f(l, v) (N·L) E with the glTF BRDF above (no highlight on mirror-class surfaces). The
 // caller decides visibility (shadow ray or shadow map).
 glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
                       const LightSample& light);
-// The diffuse part alone: the weight of incident irradiance-cosine, i.e. f_d (1/sr).
+// The BRDF inputs shade_light uses (roughness clamped to kMinPunctualRoughness).
+BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s);
+// The diffuse part alone, for irradiance from many directions (environment, ambient): the
+// weight of incident irradiance, (1 - metallic)(1 - transmission)(1 - F_dielectric(N·V))
+// base_color / π (1/sr).
 glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv);
 
 // Equirect mapping (see the header comment) and the environment radiance towards -d
