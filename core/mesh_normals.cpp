@@ -5,6 +5,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/normal_mapping.h"
+
 namespace speculum {
 
 glm::vec3 any_perpendicular(const glm::vec3& n) {
@@ -38,36 +40,21 @@ std::vector<glm::vec4> uv_tangents(std::span<const glm::vec3> positions,
                                    std::span<const glm::vec2> uvs,
                                    std::span<const std::uint32_t> indices) {
   const std::size_t nv = positions.size();
-  std::vector<glm::vec3> tan(nv, glm::vec3(0.0f)), bit(nv, glm::vec3(0.0f));
+  std::vector<UvGradients> sum(nv);
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
     const std::uint32_t v[3] = {indices[i], indices[i + 1], indices[i + 2]};
     if (v[0] >= nv || v[1] >= nv || v[2] >= nv) continue;
-    const glm::vec3 e1 = positions[v[1]] - positions[v[0]];
-    const glm::vec3 e2 = positions[v[2]] - positions[v[0]];
-    const glm::vec2 d1 = uvs[v[1]] - uvs[v[0]];
-    const glm::vec2 d2 = uvs[v[2]] - uvs[v[0]];
-    const float det = d1.x * d2.y - d2.x * d1.y;
-    if (std::fabs(det) < 1e-20f) continue;
-    // Solve [e1 e2] = [T B] [d1 d2] for the uv gradients T = dP/du, B = dP/dv. Not
-    // dividing by det keeps the area weighting (det is proportional to uv area).
-    const float s = det > 0.0f ? 1.0f : -1.0f;
-    const glm::vec3 t = (e1 * d2.y - e2 * d1.y) * s;
-    const glm::vec3 b = (e2 * d1.x - e1 * d2.x) * s;
-    if (!std::isfinite(t.x + t.y + t.z + b.x + b.y + b.z)) continue;
+    const UvGradients g = triangle_uv_gradients(positions[v[1]] - positions[v[0]],
+                                                positions[v[2]] - positions[v[0]],
+                                                uvs[v[1]] - uvs[v[0]], uvs[v[2]] - uvs[v[0]]);
+    if (!g.valid) continue;
     for (std::uint32_t k : v) {
-      tan[k] += t;
-      bit[k] += b;
+      sum[k].t += g.t;
+      sum[k].v += g.v;
     }
   }
   std::vector<glm::vec4> out(nv);
-  for (std::size_t k = 0; k < nv; ++k) {
-    const glm::vec3 n = normals[k];
-    glm::vec3 t = tan[k] - n * glm::dot(n, tan[k]);
-    const float len = glm::length(t);
-    t = (len > 1e-20f && std::isfinite(len)) ? t / len : any_perpendicular(n);
-    const float w = glm::dot(glm::cross(n, t), bit[k]) < 0.0f ? -1.0f : 1.0f;
-    out[k] = glm::vec4(t, w);
-  }
+  for (std::size_t k = 0; k < nv; ++k) out[k] = tangent_from_gradients(normals[k], sum[k]);
   return out;
 }
 

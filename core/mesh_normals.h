@@ -18,8 +18,9 @@ std::vector<glm::vec3> area_weighted_normals(std::span<const glm::vec3> position
                                              std::span<const std::uint32_t> indices);
 
 // Unit tangent per vertex (w = bitangent handedness +-1) from the uv gradients of the
-// triangles around it, Gram-Schmidt orthogonalised against the vertex normal. Where the
-// uvs are degenerate an arbitrary tangent perpendicular to the normal is used.
+// triangles around it, Gram-Schmidt orthogonalised against the vertex normal, in glTF's
+// convention: cross(n, t) * w points up the image, along -dP/dv (core/normal_mapping.h).
+// Where the uvs are degenerate an arbitrary tangent perpendicular to the normal is used.
 std::vector<glm::vec4> uv_tangents(std::span<const glm::vec3> positions,
                                    std::span<const glm::vec3> normals,
                                    std::span<const glm::vec2> uvs,

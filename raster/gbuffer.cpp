@@ -1,6 +1,5 @@
-// The `gbuffer` node: see gbuffer.h. Normal mapping follows glTF: tangent-space normal
-// n_t = 2·texel − 1 with xy scaled by normal_scale, N' = normalize(T n_t.x + B n_t.y + N n_t.z),
-// B = w · (N × T).
+// The `gbuffer` node: see gbuffer.h. Normal mapping is core's (core/normal_mapping.h, the
+// glTF convention), the same as the ray tracers' hit shading.
 #include "raster/gbuffer.h"
 
 #include <algorithm>
@@ -14,6 +13,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "core/error.h"
+#include "core/normal_mapping.h"
 #include "raster/gbuffer_normals.h"
 #include "raster/gbuffer_stream.h"
 
@@ -21,27 +21,6 @@ namespace speculum::raster {
 namespace {
 
 constexpr std::size_t kPixelChunk = 4096;
-
-glm::vec3 apply_normal_map(const Scene& scene, const Material& m, const glm::vec3& n,
-                           const glm::vec4& tangent, glm::vec2 uv, glm::vec2 uv1) {
-  const TextureRef& ref = m.normal_texture;
-  if (!ref.valid() || static_cast<std::size_t>(ref.texture) >= scene.textures.size()) return n;
-  const glm::vec2 base = ref.texcoord == 1 ? uv1 : uv;
-  const glm::vec2 tuv = glm::vec2(ref.uv_transform * glm::vec3(base, 1.0f));
-  const glm::vec4 texel = sample_bilinear_repeat(scene.textures[ref.texture], tuv);
-  glm::vec3 nt = glm::vec3(texel) * 2.0f - 1.0f;
-  nt.x *= m.normal_scale;
-  nt.y *= m.normal_scale;
-  glm::vec3 t = glm::vec3(tangent);
-  t = t - glm::dot(t, n) * n;  // Gram–Schmidt: interpolated tangents drift off the plane
-  const float tl = glm::length(t);
-  if (!(tl > 1e-8f)) return n;
-  t /= tl;
-  const glm::vec3 b = (tangent.w < 0.0f ? -1.0f : 1.0f) * glm::cross(n, t);
-  const glm::vec3 mapped = t * nt.x + b * nt.y + n * nt.z;
-  const float ml = glm::length(mapped);
-  return ml > 1e-8f ? mapped / ml : n;
-}
 
 template <class T>
 void ensure_size(Buffer2D<T>& b, int width, int height) {
@@ -183,13 +162,17 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
   const std::uint32_t mat = r.material;
   const MaterialInfo& info = c.materials[mat];
   SurfaceParams& sp = out.surface[j];
+  const glm::vec3 unmapped = n;  // decides the side (below); the map tilts within it
   if (info.textured || info.normal_mapped) {  // rare: the extra vertex streams come from the mesh
     const TriangleMesh& m = c.m;
     const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
     auto lerp_mesh = [&](const auto& a) { return b0 * a[i0] + b.x * a[i1] + b.y * a[i2]; };
     const glm::vec2 uv1 = !m.uvs1.empty() ? lerp_mesh(m.uvs1) : glm::vec2(0.0f);
-    if (info.normal_mapped)
-      n = apply_normal_map(c.scene, c.scene.materials[mat], n, lerp_mesh(m.tangents), uv, uv1);
+    if (info.normal_mapped) {
+      const Material& material = c.scene.materials[mat];
+      n = normal_mapped(c.scene, material, n,
+                        surface_tangent(m, t, b.x, b.y, n, material.normal_texture.texcoord), uv, uv1);
+    }
     sp = info.textured ? surface_params(c.scene, mat, uv, uv1) : info.constant;
   } else {
     sp = info.constant;
@@ -197,8 +180,9 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
   // Opaque surfaces are shaded on the side the camera sees (double-sided or not, a visible
   // back face would otherwise shade black); refractors keep their orientation so the
   // reflection node knows whether the ray enters or leaves. Only the sign of N·V matters,
-  // so V is not normalized.
-  if (!sp.is_refractor() && glm::dot(n, c.eye - p) < 0.0f) n = -n;
+  // so V is not normalized. The side is the unperturbed normal's: a normal map tilting the
+  // normal past the horizon would otherwise be mirrored into the surface.
+  if (!sp.is_refractor() && glm::dot(unmapped, c.eye - p) < 0.0f) n = -n;
   out.object[j] = object;
   out.position[j] = p;
   out.normal[j] = n;
@@ -326,7 +310,7 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
     info.constant = surface_params(mat);
     info.textured = mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
                     mat.emissive_texture.valid() || mat.transmission_texture.valid();
-    info.normal_mapped = !m.tangents.empty() && mat.normal_texture.valid();
+    info.normal_mapped = mat.normal_texture.valid();
     info.simple = !info.textured && !info.normal_mapped;
     info.keep_side = info.constant.is_refractor() ? ~0u : 0u;
     info.specular = is_specular(info.constant);

@@ -3,6 +3,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/normal_mapping.h"
+
 namespace speculum::trace {
 
 HitSurface hit_surface(const Scene& scene, const Hit& h, const glm::vec3& ray_direction) {
@@ -26,11 +28,20 @@ HitSurface hit_surface(const Scene& scene, const Hit& h, const glm::vec3& ray_di
   if (m.uvs1.size() == m.positions.size()) uv1 = m.uvs1[i0] * w0 + m.uvs1[i1] * h.u + m.uvs1[i2] * h.v;
   const std::uint32_t mat = t < m.triangle_material.size() ? m.triangle_material[t] : 0u;
   out.s = surface_params(scene, mat, uv, uv1);
+  // The normal map perturbs the interpolated normal in the surface's own frame; the side
+  // it is turned to is decided by the unperturbed normal (as in the G-buffer), so a map
+  // tilting it past the incident side's horizon is not mirrored into the surface.
+  glm::vec3 shading = n;
+  if (mat < scene.materials.size() && scene.materials[mat].normal_texture.valid()) {
+    const Material& material = scene.materials[mat];
+    shading = normal_mapped(scene, material, n,
+                            surface_tangent(m, t, h.u, h.v, n, material.normal_texture.texcoord), uv, uv1);
+  }
   out.entering = glm::dot(ng, dir) < 0.0f;
   if (!out.entering) ng = -ng;
-  if (glm::dot(n, ng) < 0.0f) n = -n;
+  if (glm::dot(n, ng) < 0.0f) shading = -shading;
   out.ng = ng;
-  out.n = n;
+  out.n = shading;
   return out;
 }
 

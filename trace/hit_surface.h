@@ -11,7 +11,8 @@
 namespace speculum::trace {
 
 // The surface at a closest hit: position from the barycentrics, geometric and interpolated
-// shading normal (both facing the incident side), material at the hit's uv.
+// shading normal (both facing the incident side; the shading normal perturbed by the
+// material's normal texture, core/normal_mapping.h), material at the hit's uv.
 struct HitSurface {
   glm::vec3 p{0.0f}, ng{0.0f, 0.0f, 1.0f}, n{0.0f, 0.0f, 1.0f};
   SurfaceParams s;

@@ -184,12 +184,13 @@ TEST(GltfLoader, MaterialsLightsCamerasAndExtensions) {
   EXPECT_NEAR(uv.x, 0.5f, 1e-5f);
   EXPECT_NEAR(uv.y, 2.0f, 1e-5f);
   // Normal map → tangents computed: unit, orthogonal to n, along dP/du = +x; the quad's v
-  // runs down the image while y goes up, so dP/dv = -y and the handedness is -1.
+  // runs down the image while y goes up, so the image's up is +y = cross(n, t): the map is
+  // not mirrored and the handedness is +1.
   ASSERT_EQ(s.mesh.tangents.size(), s.mesh.positions.size());
   for (const auto& t : s.mesh.tangents) {
     EXPECT_NEAR(t.x, 1.0f, 1e-5f);
     EXPECT_NEAR(std::fabs(t.y) + std::fabs(t.z), 0.0f, 1e-5f);
-    EXPECT_EQ(t.w, -1.0f);
+    EXPECT_EQ(t.w, 1.0f);
   }
   ASSERT_EQ(s.lights.size(), 3u);
   EXPECT_EQ(s.lights[0].type, LightType::Point);

@@ -70,8 +70,9 @@ TEST(MeshNormals, TangentsAreUnitOrthogonalAndFollowU) {
     EXPECT_NEAR(glm::length(glm::vec3(t[i])), 1.0f, 1e-6f);
     EXPECT_NEAR(glm::dot(glm::vec3(t[i]), n[i]), 0.0f, 1e-6f);
     EXPECT_NEAR(glm::dot(glm::vec3(t[i]), e1), 1.0f, 1e-6f);
-    // Handedness: cross(n, t) * w points along dP/dv = e2.
-    EXPECT_GT(glm::dot(glm::cross(n[i], glm::vec3(t[i])) * t[i].w, e2), 0.99f);
+    // Handedness (glTF: the map's +Y is up the image, against v): cross(n, t) * w points
+    // along -dP/dv = -e2.
+    EXPECT_GT(glm::dot(glm::cross(n[i], glm::vec3(t[i])) * t[i].w, -e2), 0.99f);
   }
 }
 

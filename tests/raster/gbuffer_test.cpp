@@ -140,6 +140,7 @@ OracleSample oracle_sample(const Scene& scene, const VisibilityBuffer& vis, glm:
                   : glm::normalize(glm::cross(m.positions[i1] - m.positions[i0],
                                               m.positions[i2] - m.positions[i0]));
   o.uv = lerp3(m.uvs);
+  const glm::vec3 unmapped = n;  // the side is decided before the normal map
   const Material& mat = scene.materials[m.triangle_material[t]];
   if (mat.normal_texture.valid()) {  // glTF tangent-space normal mapping
     const glm::vec4 texel = sample_bilinear_repeat(
@@ -157,7 +158,7 @@ OracleSample oracle_sample(const Scene& scene, const VisibilityBuffer& vis, glm:
     n = mapped / glm::length(mapped);
   }
   o.surface = surface_params(scene, m.triangle_material[t], o.uv, glm::vec2(0.0f));
-  if (!o.surface.is_refractor() && glm::dot(n, eye - o.position) < 0.0f) n = -n;
+  if (!o.surface.is_refractor() && glm::dot(unmapped, eye - o.position) < 0.0f) n = -n;
   o.normal = n;
   o.reflector = is_specular(o.surface) ? o.object : kNoId;
   return o;
