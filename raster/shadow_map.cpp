@@ -17,10 +17,24 @@ namespace {
 
 constexpr float kDirectionalDistance = 50.0f;  // in scene radii
 
-float slope_bias(float texel_world, const glm::vec3& n, const glm::vec3& l) {
-  const float c = std::clamp(glm::dot(n, l), 0.05f, 1.0f);
-  const float tan_theta = std::sqrt(1.0f - c * c) / c;
-  return texel_world * (1.5f + std::min(tan_theta, 8.0f));
+// Self-shadowing bias, in receiver footprints (the world width of one map texel at the
+// receiver, across the light's rays). The 3×3 PCF compares the receiver's distance with
+// texels up to 1.5 texels away along each map axis, ≈ 2.1 footprints along the diagonal.
+// Across that offset s a planar receiver at angle θ between n and l moves s·tan θ nearer
+// the light, the slope term that makes acne. Moving the lookup point off the surface by
+// δ along n moves it δ/cos θ farther in front of the plane along the light ray; with
+// δ = k·footprint·sin θ that is k·footprint·tan θ, so k > 2.1 cancels the slope term at
+// every angle, grazing included, while the point moves by at most k footprints.
+constexpr float kNormalOffset = 2.5f;
+// What remains is independent of the slope: curvature of the receiver across the kernel,
+// and the map's float distances. One footprint along the ray bounds the light that can leak
+// under an occluder touching the receiver (no slope-scaled term: it grows without bound at
+// grazing incidence, lighting the plane behind thin occluders).
+constexpr float kDepthBias = 1.0f;
+
+float normal_offset(float footprint, const glm::vec3& n, const glm::vec3& l) {
+  const float c = std::clamp(glm::dot(n, l), 0.0f, 1.0f);
+  return kNormalOffset * footprint * std::sqrt(1.0f - c * c);
 }
 
 }  // namespace
@@ -67,27 +81,35 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
 }
 
 float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const {
+  // The receiver's footprint: world width of one map texel at p, across the light's rays.
+  // A cube texel subtends at most 2/size radians (its width on the unit-distance face
+  // plane, at the face centre); a directional texel is one slice of the far camera's frustum.
+  const glm::vec3 eye = type == LightType::Directional ? camera.eye : cube.centre;
+  const float texel_angle =
+      type == LightType::Directional
+          ? 2.0f * std::tan(glm::radians(camera.vfov_degrees) * 0.5f) / static_cast<float>(size)
+          : 2.0f / static_cast<float>(cube.size);
+  const float footprint = glm::length(p - eye) * texel_angle;
+  const float q = normal_offset(footprint, n, l);
+  const glm::vec3 lookup = p + n * q;
+  const glm::vec3 d = lookup - eye;
+  const float dist = glm::length(d);
+  if (dist <= 0.0f) return 1.0f;
+
   const ImageF* img;
   glm::vec2 pixel;
-  float dist, texel_world;
   if (type == LightType::Directional) {
-    const glm::vec4 clip = view_projection * glm::vec4(p, 1.0f);
+    const glm::vec4 clip = view_projection * glm::vec4(lookup, 1.0f);
     if (clip.w <= 0.0f) return 1.0f;
     pixel = {(clip.x / clip.w * 0.5f + 0.5f) * size, (0.5f - clip.y / clip.w * 0.5f) * size};
     if (pixel.x < 0 || pixel.y < 0 || pixel.x >= size || pixel.y >= size) return 1.0f;
     img = &distance;
-    dist = glm::length(p - camera.eye);
-    texel_world = dist * 2.0f * std::tan(glm::radians(camera.vfov_degrees) * 0.5f) / size;
   } else {
-    const glm::vec3 d = p - cube.centre;
-    dist = glm::length(d);
-    if (dist <= 0.0f) return 1.0f;
     const CubeCoord c = cube_coord(d, cube.size);
     img = &cube.distance[c.face];
     pixel = c.pixel;
-    texel_world = dist * 2.0f / cube.size;
   }
-  const float biased = dist - slope_bias(texel_world, n, l);
+  const float biased = dist - kDepthBias * footprint;
   const int cx = std::min(static_cast<int>(pixel.x), size - 1);
   const int cy = std::min(static_cast<int>(pixel.y), size - 1);
   int lit = 0;
