@@ -20,16 +20,18 @@ constexpr float kDirectionalDistance = 50.0f;  // in scene radii
 // Self-shadowing bias, in receiver footprints (the world width of one map texel at the
 // receiver, across the light's rays). The 3×3 PCF compares the receiver's distance with
 // texels up to 1.5 texels away along each map axis, ≈ 2.1 footprints along the diagonal.
-// Across that offset s a planar receiver at angle θ between n and l moves s·tan θ nearer
-// the light, the slope term that makes acne. Moving the lookup point off the surface by
-// δ along n moves it δ/cos θ farther in front of the plane along the light ray; with
-// δ = k·footprint·sin θ that is k·footprint·tan θ, so k > 2.1 cancels the slope term at
-// every angle, grazing included, while the point moves by at most k footprints.
-constexpr float kNormalOffset = 2.5f;
-// What remains is independent of the slope: curvature of the receiver across the kernel,
-// and the map's float distances. One footprint along the ray bounds the light that can leak
-// under an occluder touching the receiver (no slope-scaled term: it grows without bound at
-// grazing incidence, lighting the plane behind thin occluders).
+// Across that offset s a planar receiver at angle θ between n and l comes s·tan θ nearer
+// the light: the slope term that makes acne, unbounded at grazing incidence. Moving the
+// lookup point off the surface by δ = k·footprint·sin θ along n puts it δ/cos θ =
+// k·footprint·tan θ in front of the plane along the light ray, so it cancels the slope
+// term at every angle; what the offset leaves, (2.1 − k)·tan θ, the depth bias below
+// covers up to θ ≈ 83° (cos θ ≈ 0.12, where the light is dim). The shadow-test point moves
+// by at most k footprints, which is also how far shadow edges can shift.
+constexpr float kNormalOffset = 2.0f;
+// Slope-independent: curvature of the receiver across the kernel and the map's float
+// distances. One footprint along the ray bounds the light that can leak under an occluder
+// touching the receiver (a slope-scaled term would grow without bound at grazing incidence
+// and light the plane behind thin occluders).
 constexpr float kDepthBias = 1.0f;
 
 float normal_offset(float footprint, const glm::vec3& n, const glm::vec3& l) {

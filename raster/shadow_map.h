@@ -25,7 +25,7 @@ struct ShadowMap {
 
   // Fraction of the 3×3 PCF taps that see point p (unit normal n, unit direction to the
   // light l) lit. Against self-shadowing the lookup point moves off the surface along n by
-  // 2.5·sin θ texel footprints (θ between n and l; the footprint is one texel's world width
+  // 2·sin θ texel footprints (θ between n and l; the footprint is one texel's world width
   // at p), and the depth test allows one footprint: a plane is lit at every incidence,
   // and light leaks at most about one footprint under an occluder touching the receiver.
   float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
