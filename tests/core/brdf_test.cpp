@@ -90,7 +90,7 @@ Albedo directional_albedo(const BrdfParams& p, const glm::vec3& v, int n_theta, 
 // Reflection") states that fresnel_mix's (1 − F(V·H)) weighting breaks energy
 // conservation, and this implementation keeps the spec's coupling; up to 30° from the
 // normal it still conserves, which is asserted.
-TEST(GltfBrdf, WhiteFurnaceNeverGainsEnergy) {
+TEST(GltfBrdf, WhiteFurnaceLayersAndMetalNeverGainEnergy) {
   for (float roughness : {0.05f, 0.1f, 0.25f, 0.5f, 0.75f, 1.0f}) {
     for (float metallic : {0.0f, 1.0f}) {
       for (float theta_v : {0.0f, 0.5f, 1.0f, 1.3f, 1.5f}) {
