@@ -2,7 +2,6 @@
 // estimate per path sample over the shared shading model of core/shading.h.
 #include "trace/reference_tracer.h"
 
-
 #include <algorithm>
 #include <cmath>
 #include <vector>
