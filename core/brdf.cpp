@@ -2,7 +2,9 @@
 #include "core/brdf.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -22,7 +24,128 @@ float ggx_from_cos_sin(float cos2, float sin2, float alpha) {
   const float d = cos2 * a2 + sin2;
   return a2 / (kPi * d * d);
 }
+
+// The albedo table: kTableSize² entries over μ_i = i/(n−1) (clamped to ≥ 1e-3: at the
+// horizon itself the viewer sees nothing) and roughness r_j = j/(n−1), α = r_j²; columns in
+// √α resolve the smooth end, where the albedo changes fastest.
+constexpr int kTableSize = 32;
+constexpr int kQuadraturePoints = 1024;
+
+struct AlbedoTable {
+  std::array<SpecularAlbedo, kTableSize * kTableSize> e{};  // [roughness][μ]
+  std::array<SpecularAlbedo, kTableSize> average{};         // [roughness]
+};
+
+// E(μ, α) by importance sampling visible normals over a fixed Hammersley set, summed in
+// double: the estimator F_x G2/G1 has bounded variance, so 1024 points give ~1e-3.
+SpecularAlbedo integrate_albedo(float mu, float alpha) {
+  if (alpha <= 0.0f) {
+    const float c5 = std::pow(1.0f - mu, 5.0f);
+    return {1.0f - c5, c5};
+  }
+  const glm::vec3 v(std::sqrt(std::max(1.0f - mu * mu, 0.0f)), 0.0f, mu);
+  double scale = 0.0, bias = 0.0;
+  for (int k = 0; k < kQuadraturePoints; ++k) {
+    const glm::vec3 h = sample_ggx_visible_normal(v, alpha, hamersley(k, kQuadraturePoints));
+    const float cos_vh = glm::dot(v, h);
+    const glm::vec3 l = 2.0f * cos_vh * h - v;
+    const double w = ggx_sample_weight(l.z, mu, alpha);
+    const double c5 = std::pow(1.0 - std::clamp(double(cos_vh), 0.0, 1.0), 5.0);
+    scale += w * (1.0 - c5);
+    bias += w * c5;
+  }
+  return {float(scale / kQuadraturePoints), float(bias / kQuadraturePoints)};
+}
+
+const AlbedoTable& albedo_table() {
+  static const AlbedoTable table = [] {
+    AlbedoTable t;
+    for (int j = 0; j < kTableSize; ++j) {
+      const float r = float(j) / float(kTableSize - 1);
+      double avg_scale = 0.0, avg_bias = 0.0;
+      for (int i = 0; i < kTableSize; ++i) {
+        const float mu = std::max(float(i) / float(kTableSize - 1), 1e-3f);
+        const SpecularAlbedo e = integrate_albedo(mu, r * r);
+        t.e[std::size_t(j * kTableSize + i)] = e;
+        // 2 ∫ E μ dμ by the trapezoid rule on the table's own μ grid.
+        const double w = (i == 0 || i == kTableSize - 1 ? 0.5 : 1.0) * 2.0 * (float(i) / float(kTableSize - 1)) /
+                         double(kTableSize - 1);
+        avg_scale += w * e.scale;
+        avg_bias += w * e.bias;
+      }
+      t.average[std::size_t(j)] = {float(avg_scale), float(avg_bias)};
+    }
+    return t;
+  }();
+  return table;
+}
+
+SpecularAlbedo lerp(const SpecularAlbedo& a, const SpecularAlbedo& b, float t) {
+  return {a.scale + (b.scale - a.scale) * t, a.bias + (b.bias - a.bias) * t};
+}
+
+// Position of x ∈ [0, 1] on the table grid: cell index and fraction.
+std::pair<int, float> grid(float x) {
+  const float f = std::clamp(x, 0.0f, 1.0f) * float(kTableSize - 1);
+  const int i = std::min(static_cast<int>(f), kTableSize - 2);
+  return {i, f - float(i)};
+}
+
+// The diffuse weight (1 − E(N·V))(1 − E(N·L)) / (1 − E_avg) of the dielectric (brdf.h).
+float coupled_diffuse_weight(float cos_nl, float cos_nv, float alpha, float f0) {
+  const float e_v = specular_albedo(cos_nv, alpha)(f0);
+  const float e_l = specular_albedo(cos_nl, alpha)(f0);
+  const float e_avg = average_specular_albedo(alpha)(f0);
+  return (1.0f - e_v) * (1.0f - e_l) / std::max(1.0f - e_avg, 1e-6f);
+}
+
 }  // namespace
+
+SpecularAlbedo specular_albedo(float cos_nv, float alpha) {
+  const AlbedoTable& t = albedo_table();
+  const auto [j, tr] = grid(std::sqrt(std::clamp(alpha, 0.0f, 1.0f)));
+  const auto [i, tm] = grid(cos_nv);
+  auto at = [&](int jj, int ii) { return t.e[std::size_t(jj * kTableSize + ii)]; };
+  return lerp(lerp(at(j, i), at(j, i + 1), tm), lerp(at(j + 1, i), at(j + 1, i + 1), tm), tr);
+}
+
+SpecularAlbedo average_specular_albedo(float alpha) {
+  const AlbedoTable& t = albedo_table();
+  const auto [j, tr] = grid(std::sqrt(std::clamp(alpha, 0.0f, 1.0f)));
+  return lerp(t.average[std::size_t(j)], t.average[std::size_t(j + 1)], tr);
+}
+
+float smith_g1(float cos_n, float alpha) {
+  const float c = std::abs(cos_n);
+  const float a2 = alpha * alpha;
+  const float d = c + std::sqrt(a2 + (1.0f - a2) * c * c);
+  return d > 0.0f ? 2.0f * c / d : 0.0f;
+}
+
+glm::vec3 sample_ggx_visible_normal(const glm::vec3& v_local, float alpha, glm::vec2 u) {
+  alpha = std::max(alpha, kMinAlpha);
+  // Stretch the view to the hemisphere configuration, sample the projected disc of visible
+  // normals (denser on its side facing v), unstretch (Heitz 2018, "Sampling the GGX
+  // Distribution of Visible Normals").
+  const glm::vec3 vh = glm::normalize(glm::vec3(alpha * v_local.x, alpha * v_local.y, v_local.z));
+  const float len2 = vh.x * vh.x + vh.y * vh.y;
+  const glm::vec3 t1 = len2 > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : glm::vec3(1.0f, 0.0f, 0.0f);
+  const glm::vec3 t2 = glm::cross(vh, t1);
+  const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+  const float p1 = r * std::cos(phi);
+  const float s = 0.5f * (1.0f + vh.z);
+  const float p2 = (1.0f - s) * std::sqrt(std::max(1.0f - p1 * p1, 0.0f)) + s * r * std::sin(phi);
+  const glm::vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+  return glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(nh.z, 0.0f)));
+}
+
+float ggx_sample_weight(float cos_nl, float cos_nv, float alpha) {
+  if (cos_nl <= 0.0f || cos_nv <= 0.0f) return 0.0f;
+  alpha = std::max(alpha, kMinAlpha);
+  const float g2 = 4.0f * cos_nl * cos_nv * smith_visibility_height_correlated(cos_nl, cos_nv, alpha);
+  const float g1 = smith_g1(cos_nv, alpha);
+  return g1 > 0.0f ? g2 / g1 : 0.0f;
+}
 
 float ggx_distribution(float cos_nh, float alpha) {
   if (cos_nh <= 0.0f) return 0.0f;
@@ -54,9 +177,8 @@ BrdfValue gltf_brdf(const BrdfParams& p, const glm::vec3& n, const glm::vec3& l,
 
   const float metallic = std::clamp(p.metallic, 0.0f, 1.0f);
   const float alpha = std::max(p.alpha, kMinAlpha);
-  const float fresnel_dielectric_vh = fresnel_schlick(cos_vh, p.dielectric_f0);
   out.diffuse = p.base_color * ((1.0f - metallic) * (1.0f - std::clamp(p.transmission, 0.0f, 1.0f)) *
-                                (1.0f - fresnel_dielectric_vh) / kPi);
+                                coupled_diffuse_weight(cos_nl, cos_nv, alpha, p.dielectric_f0) / kPi);
 
   const float cos_nh = glm::dot(n, h);
   if (cos_nh <= 0.0f) return out;

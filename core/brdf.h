@@ -7,7 +7,7 @@
 //                                                     height-correlated Smith, G/(4|N·L||N·V|)
 //   specular_brdf = V D
 //   F_x(f0) = f0 + (1 − f0)(1 − |V·H|)^5                                 Schlick (B.3.4)
-//   dielectric = fresnel_mix: (1 − F_x(f0_ior)) diffuse_base + F_x(f0_ior) specular_brdf
+//   dielectric = diffuse_base (1 − E(N·V)) (1 − E(N·L)) / (1 − E_avg) + F_x(f0_ior) specular_brdf
 //   metal      = conductor_fresnel: F_x(base_color) specular_brdf
 //   f          = mix(dielectric, metal, metallic)
 // with α = roughness², f0_ior = ((ior − 1)/(ior + 1))² (KHR_materials_ior) and
@@ -15,12 +15,19 @@
 // dielectric's Lambert lobe towards the specular BTDF, which is not a reflection and is
 // traced separately; the specular reflection layer is not scaled by transmission.
 // Because Schlick is linear in f0, the two specular terms merge exactly into
-// F_x(mix(f0_ior, base_color, metallic)) V D; the diffuse keeps the dielectric's own
-// Fresnel weight (1 − metallic)(1 − F_x(f0_ior)), the spec's exact mix (Appendix B.3.5
-// before its simplification to a single F). Every factor is symmetric in l and v, so f is
-// reciprocal.
+// F_x(mix(f0_ior, base_color, metallic)) V D.
+// The diffuse weight is not the spec's fresnel_mix (1 − F_x(V·H)): Appendix B ("Coupling
+// Diffuse and Specular Reflection") notes that weighting breaks energy conservation, and it
+// does (a white dielectric reflects 1.6× what it receives at 86° from the normal). Instead
+// the Lambert lobe is scaled by what the specular layer leaves, coupled symmetrically:
+// E(μ) = ∫ F_x(f0_ior) specular_brdf cos dω is the specular layer's directional albedo
+// (specular_albedo below) and E_avg = 2 ∫ E(μ) μ dμ its cosine-weighted mean. Integrated
+// over l, the diffuse reflects exactly base (1 − E(N·V)), so the dielectric's total albedo
+// is base (1 − E) + E ≤ 1 at every view angle. For a smooth ior-1.5 dielectric at normal
+// incidence the weight is 0.96²/(1 − E_avg) ≈ 1.05 × the spec's 0.96. Every factor is symmetric in l and v, so f is reciprocal.
 #pragma once
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace speculum {
@@ -52,5 +59,32 @@ struct BrdfValue {
   glm::vec3 total() const { return diffuse + specular; }
 };
 BrdfValue gltf_brdf(const BrdfParams& p, const glm::vec3& n, const glm::vec3& l, const glm::vec3& v);
+
+// Smith's masking of one direction for GGX, G1(μ) = 2μ / (μ + √(α² + (1 − α²) μ²)).
+float smith_g1(float cos_n, float alpha);
+
+// The specular layer's directional albedo ∫ F_x(f0) V D (N·L) dl for a viewer at N·V = μ,
+// split into the parts linear in f0 (Schlick is linear in f0): E = f0 scale + bias. Read
+// from a 32 × 32 table over (μ, √α) built once by quadrature (fixed points, so every
+// process gets the same bytes), bilinear in between; exact Schlick (scale = 1 − (1 − μ)^5,
+// bias = (1 − μ)^5) at α = 0. This is the "split-sum" scale real-time engines multiply a
+// prefiltered environment lookup by.
+struct SpecularAlbedo {
+  float scale = 1.0f;
+  float bias = 0.0f;
+  float operator()(float f0) const { return f0 * scale + bias; }
+  glm::vec3 operator()(const glm::vec3& f0) const { return f0 * scale + glm::vec3(bias); }
+};
+SpecularAlbedo specular_albedo(float cos_nv, float alpha);
+// Its cosine-weighted mean over view directions, 2 ∫ E(μ) μ dμ (same split).
+SpecularAlbedo average_specular_albedo(float alpha);
+
+// A GGX visible normal for a viewer v_local (in the frame whose +Z is the surface normal,
+// v_local.z > 0), from two uniform numbers in [0, 1): the half-vector h has pdf
+// G1(v) max(v·h, 0) D(h) / (N·V), so l = reflect(−v, h) has pdf that over 4 v·h and the
+// estimator f_spec (N·L) / pdf is F_x(v·h) G2(l, v) / G1(v) (ggx_sample_weight).
+glm::vec3 sample_ggx_visible_normal(const glm::vec3& v_local, float alpha, glm::vec2 u);
+// F_x(v·h) G2 / G1(v) without F: G2 = 4 (N·L)(N·V) V(l, v); 0 when l is below the surface.
+float ggx_sample_weight(float cos_nl, float cos_nv, float alpha);
 
 }  // namespace speculum

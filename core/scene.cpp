@@ -38,8 +38,9 @@ MaterialKind Material::kind() const {
 }
 
 float Material::phong_exponent() const {
-  const float alpha = std::max(roughness * roughness, 1e-3f);
-  return std::clamp(2.0f / (alpha * alpha) - 2.0f, 0.0f, 1e6f);
+  const float alpha = roughness * roughness;
+  if (!(alpha > 1e-3f)) return 1e6f;  // a mirror: the exponent's cap exactly
+  return std::clamp(1.0f / (alpha * alpha) - 1.0f, 0.0f, 1e6f);
 }
 
 void Bounds::grow(const glm::vec3& p) {

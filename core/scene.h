@@ -48,11 +48,13 @@ struct Material {
   TextureRef transmission_texture;        // R: transmission
 
   MaterialKind kind() const;
-  // Phong exponent n from roughness r: alpha = r^2, n = 2/alpha^2 - 2 (the usual
-  // Beckmann-to-Phong correspondence),
-  // clamped to [0, 1e6] so a perfect mirror stays finite. The one roughness -> exponent
-  // mapping: indirect glossy lobes (YU eq.4) sample/prefilter with it; direct lights use
-  // the glTF GGX BRDF instead (core/shading.h).
+  // Phong exponent n of the lobe about the mirror direction R from roughness r: α = r²,
+  // n = 1/α² − 1, clamped to [0, 1e6] so a perfect mirror stays finite. It matches the
+  // peak of the GGX BRDF's reflected lobe: near R at normal incidence GGX falls as
+  // exp(−θ² (1 − α²)/(2α²)) and cos^n θ as exp(−n θ²/2). (2/α² − 2, the half-vector
+  // Blinn-Phong correspondence, would be √2 too narrow about R.) The one roughness →
+  // lobe-width mapping: indirect glossy lobes (YU eq.4) sample and maps prefilter with
+  // it, and their samples are weighted by the GGX BRDF itself (core/shading.h).
   float phong_exponent() const;
 };
 

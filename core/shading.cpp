@@ -116,15 +116,19 @@ glm::vec3 specular_f0(const SurfaceParams& s) {
   return glm::vec3(dielectric) * (1.0f - s.metallic) + s.base_color * s.metallic;
 }
 
-glm::vec3 specular_fresnel(const SurfaceParams& s, float cos_nv) {
-  return fresnel_schlick(cos_nv, specular_f0(s));
+glm::vec3 specular_reflectance(const SurfaceParams& s, float cos_nv) {
+  cos_nv = std::clamp(cos_nv, 0.0f, 1.0f);
+  // A mirror's lobe is the delta limit α → 0, where the albedo is Schlick's F at N·V itself.
+  if (s.is_mirror_lobe()) return fresnel_schlick(cos_nv, specular_f0(s));
+  return specular_albedo(cos_nv, s.roughness * s.roughness)(specular_f0(s));
 }
 
 glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv) {
-  // The dielectric's own Fresnel weight, as in shade_light's fresnel_mix (core/brdf.h), with
-  // V·H replaced by N·V: for irradiance from many directions there is no single H.
-  const float f = fresnel_schlick(cos_nv, fresnel_f0(s.ior));
-  return s.base_color * ((1.0f - s.metallic) * (1.0f - s.transmission) * (1.0f - f) / kPi);
+  // What shade_light's coupled Lambert lobe (core/brdf.h) reflects under uniform light:
+  // base (1 − E(N·V)), E the dielectric specular layer's albedo at the same α.
+  const BrdfParams p = brdf_params_for_punctual_light(s);
+  const float e = specular_albedo(std::clamp(cos_nv, 0.0f, 1.0f), p.alpha)(p.dielectric_f0);
+  return s.base_color * ((1.0f - s.metallic) * (1.0f - s.transmission) * (1.0f - e) / kPi);
 }
 
 BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s) {

@@ -4,24 +4,32 @@
 // - Direct light (punctual lights): glTF 2.0's metallic-roughness BRDF (glTF 2.0 spec,
 //   Appendix B; formulas in core/brdf.h): GGX D with α = roughness², height-correlated
 //   Smith V, Schlick F on V·H with F0 = mix(fresnel_f0(ior) [0.04 at ior 1.5], base_color,
-//   metallic), Lambert diffuse (1 - metallic)(1 - transmission)(1 - F_dielectric) base_color/π.
-//   Reflected radiance L = f(l, v) (N·L) E. α is clamped to kMinPunctualRoughness² so the
-//   highlight of a delta light stays finite. The BRDF is smooth in l, so there is no edge
-//   anywhere on a lit surface.
+//   metallic), and a Lambert diffuse (1 - metallic)(1 - transmission) base_color/π scaled by
+//   what the dielectric's specular layer leaves, coupled symmetrically in l and v so the
+//   whole BRDF never reflects more than it receives (core/brdf.h says why not the spec's
+//   fresnel_mix). Reflected radiance L = f(l, v) (N·L) E. α is clamped to
+//   kMinPunctualRoughness² so the highlight of a delta light stays finite. The BRDF is
+//   smooth in l, so there is no edge anywhere on a lit surface.
 // - Mirror-class surfaces (r <= kMirrorRoughness) get the diffuse term but no direct
 //   highlight: in the spec's limit α → 0 the lobe is a delta, and a delta lobe's image of a
 //   point light is a point of zero solid angle — the same invisible point the camera sees
 //   when it looks at the light itself (lights are not geometry). Their reflections are
 //   traced/looked up along R = reflect(-V, N) instead, weighted by Schlick F(N·V).
-// - Indirect glossy reflection (r < kGlossyRoughness, by sampling or prefiltering) does NOT
-//   use the GGX lobe: it uses a normalized Phong lobe of exponent n =
-//   Material::phong_exponent() (the one roughness → exponent mapping, core/scene.h) about R,
-//   L_s = F(N·V) ∫ p(ω) L(ω) dω with p = (n+1)/(2π) cos^n(R,ω) (YU eq.4), so a lobe
-//   sample's weight is exactly F and the mirror limit (n → ∞) is L_s = F L(R). Directions
-//   under the surface horizon (N·ω <= 0) contribute nothing. Rougher surfaces have no
-//   indirect specular.
-// - Environment/ambient diffuse: diffuse_albedo_over_pi = the Lambert term above with
-//   F_dielectric taken at N·V, times the irradiance.
+// - Indirect glossy reflection (kMirrorRoughness < r < kGlossyRoughness) is the same GGX
+//   specular lobe integrated against incoming radiance, L_s = ∫ f_spec L cos dω:
+//   · traced with samples: each sample weighted f_spec cos / p by its own pdf (the reference
+//     samples GGX's visible normals; YU's rays sample a Phong lobe, trace/glossy_rays.h);
+//   · read from prefiltered maps (environment, distance and reflector maps): the map is
+//     prefiltered with the normalized Phong lobe of exponent Material::phong_exponent()
+//     about R — the one roughness → lobe-width mapping (core/scene.h), matched to GGX's
+//     peak — and the lookup is scaled by the lobe's directional albedo
+//     specular_reflectance(s, N·V) = E(F0) (core/brdf.h specular_albedo), the split-sum
+//     approximation ∫ f L cos ≈ E · (prefiltered L).
+//   In the mirror limit both reduce to F(N·V) L(R). Rougher surfaces have no indirect
+//   specular.
+// - Environment/ambient diffuse: diffuse_albedo_over_pi = what the coupled Lambert lobe
+//   above reflects under uniform light, base (1 − E_dielectric(N·V)) / π, times the
+//   irradiance.
 // - Refractors (transmission > 0.5): smooth dielectric, exact Fresnel (fresnel_dielectric),
 //   transmitted light tinted by base_color. KHR_materials_transmission replaces the diffuse
 //   lobe by the transmission: the direct light's diffuse is scaled by (1 - transmission)
@@ -78,9 +86,11 @@ struct LightSample {
 };
 LightSample sample_light(const Light& light, const glm::vec3& position);
 
-// F0 and the Schlick Fresnel factor for the specular lobe, cos_nv = N·V.
+// F0 of the specular lobe, and the weight of a reflection looked up or traced along R for a
+// viewer at cos_nv = N·V: the lobe's directional albedo E(F0) (glossy; the split-sum scale
+// of a prefiltered lookup) or Schlick's F(N·V) (mirror, the delta limit of E).
 glm::vec3 specular_f0(const SurfaceParams& s);
-glm::vec3 specular_fresnel(const SurfaceParams& s, float cos_nv);
+glm::vec3 specular_reflectance(const SurfaceParams& s, float cos_nv);
 
 // Radiance reflected towards V (unit, surface → viewer) from one light sample, N unit:
 // f(l, v) (N·L) E with the glTF BRDF above (no highlight on mirror-class surfaces). The
@@ -90,8 +100,8 @@ glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec
 // The BRDF inputs shade_light uses (roughness clamped to kMinPunctualRoughness).
 BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s);
 // The diffuse part alone, for irradiance from many directions (environment, ambient): the
-// weight of incident irradiance, (1 - metallic)(1 - transmission)(1 - F_dielectric(N·V))
-// base_color / π (1/sr).
+// weight of incident irradiance, (1 - metallic)(1 - transmission)(1 - E_dielectric(N·V))
+// base_color / π (1/sr), exact for uniform incident light.
 glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv);
 
 // Equirect mapping (see the header comment) and the environment radiance towards -d

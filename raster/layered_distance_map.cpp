@@ -271,7 +271,7 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
   glm::vec3 n = g.normal.pixels[i];
   if (glm::dot(n, r) > 0.0f) n = -n;
   const glm::vec3 reflected = reflect(r, n);
-  const glm::vec3 f = specular_fresnel(s, -glm::dot(n, r));
+  const glm::vec3 f = specular_reflectance(s, -glm::dot(n, r));
   const glm::vec3 incoming = depth < o.bounces
                                  ? trace_layered(map, env, map.centre + l, reflected, o, depth + 1, stats)
                                  : env.radiance(reflected, 1e6f);
@@ -295,7 +295,7 @@ ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const Layer
       glm::vec3 n = g.normal.pixels[i];
       if (glm::dot(n, v) < 0.0f) n = -n;  // refractors keep geometric normals: reflect only
       const glm::vec3 r = reflect(-v, n);
-      const glm::vec3 radiance = specular_fresnel(s, glm::dot(n, v)) *
+      const glm::vec3 radiance = specular_reflectance(s, glm::dot(n, v)) *
                                  trace_layered(map, env, g.position.pixels[i], r, options, 1, st);
       out.pixels[i] = glm::vec4(radiance, 1.0f);
     }

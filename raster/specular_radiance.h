@@ -1,7 +1,8 @@
 // The radiance a specular G-buffer sample sends towards the viewer, given a lookup of the
-// radiance arriving along a direction: mirror/glossy reflection weighted by the material's
-// Fresnel term, or a refractor's Schlick-weighted reflection + transmission (SURVEY §3.1,
-// §2.4). Shared by every raster reflection node that differs only in its lookup.
+// radiance arriving along a direction: mirror/glossy reflection weighted by the lobe's
+// directional albedo (specular_reflectance: Schlick F for a mirror, the split-sum E(F0) of
+// a prefiltered glossy lookup), or a refractor's Schlick-weighted reflection + transmission
+// (SURVEY §3.1, §2.4). Shared by every raster reflection node that differs only in its lookup.
 #pragma once
 
 #include <glm/geometric.hpp>
@@ -23,7 +24,7 @@ glm::vec3 specular_radiance(const SurfaceParams& s, glm::vec3 n, const glm::vec3
   const glm::vec3 incident = -v;
   if (!s.is_refractor()) {
     const glm::vec3 r = reflect(incident, n);
-    return specular_fresnel(s, glm::dot(n, v)) * lookup(r, s.phong_exponent);
+    return specular_reflectance(s, glm::dot(n, v)) * lookup(r, s.phong_exponent);
   }
   // Entering when the normal faces the viewer; leaving flips n and the index ratio.
   const bool entering = glm::dot(n, v) >= 0.0f;

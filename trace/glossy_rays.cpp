@@ -6,6 +6,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/brdf.h"
 #include "core/error.h"
 #include "core/optics.h"
 #include "core/ray_offset.h"
@@ -17,6 +18,11 @@ namespace speculum::trace {
 namespace {
 const Ray kUnbounded;  // a reflected ray's default t range
 }  // namespace
+
+float glossy_mixture_pdf(float cos_r, float cos_n, float exponent) {
+  return (1.0f - kDefensiveShare) * phong_lobe_pdf(cos_r, exponent) +
+         kDefensiveShare * std::max(cos_n, 0.0f) / kPi;
+}
 
 float sample_solid_angle(float cos_theta, float exponent, int n) {
   const float p = phong_lobe_pdf(cos_theta, exponent);
@@ -42,10 +48,11 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
       out.pixel.push_back(static_cast<std::uint32_t>(i));
   const std::size_t N = static_cast<std::size_t>(opt.rays_per_pixel);
   const std::size_t P = out.pixel.size();
-  out.fresnel.resize(P);
   RayStream& rs = out.rays;
   for (auto* v : {&rs.ox, &rs.oy, &rs.oz, &rs.dx, &rs.dy, &rs.dz, &rs.tmin, &rs.tmax, &out.solid_angle})
     par::resize_on_huge_pages(*v, P * N);
+  out.weight.resize(P * N);
+  out.albedo.resize(P);
   // The N Hamersley points are the same for every pixel (only the rotation differs).
   std::vector<glm::vec2> points(N);
   for (std::size_t j = 0; j < N; ++j)
@@ -62,37 +69,58 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
       glm::vec3 v = eye - p;
       const float vl = glm::length(v);
       v = vl > 0.0f ? v / vl : n;
-      const glm::vec3 r = reflect(-v, n);
-      out.fresnel[k] = specular_fresnel(s, std::max(glm::dot(n, v), 0.0f));
-      const Onb lobe(glm::normalize(r));
+      const glm::vec3 r = glm::normalize(reflect(-v, n));
+      const float cos_nv = std::max(glm::dot(n, v), 0.0f);
+      const Onb lobe(r), hemisphere(n);
       const glm::vec2 shift = random_float2(i, 0, 0, opt.seed);
       const glm::vec3 origin = offset_ray_origin(p, n);
       const float exponent = s.phong_exponent;
+      const bool mirror = s.is_mirror_lobe();
+      const float defensive = mirror ? 0.0f : kDefensiveShare;
+      BrdfParams brdf = brdf_params_for_punctual_light(s);
+      brdf.alpha = s.roughness * s.roughness;  // the lobe itself, not the punctual-light clamp
+      out.albedo[k] = specular_reflectance(s, cos_nv);
       const std::size_t first = k * N;
       // Origin and t range are per pixel: written as one run, then the per-ray directions.
       std::fill_n(rs.ox.begin() + first, N, origin.x);
       std::fill_n(rs.oy.begin() + first, N, origin.y);
       std::fill_n(rs.oz.begin() + first, N, origin.z);
       for (std::size_t j = 0; j < N; ++j) {
-        const glm::vec2 u = rotate_unit_square(points[j], shift);
-        const glm::vec3 local = sample_phong_lobe(u, exponent);
-        const glm::vec3 d = lobe.to_world(local);
+        glm::vec2 u = rotate_unit_square(points[j], shift);
+        // u.x splits the stratified set between the two lobes, each keeping its strata.
+        glm::vec3 d;
+        if (u.x < defensive) {
+          d = hemisphere.to_world(sample_cosine_hemisphere({u.x / defensive, u.y}));
+        } else {
+          u.x = (u.x - defensive) / (1.0f - defensive);
+          d = lobe.to_world(sample_phong_lobe(u, exponent));
+        }
+        const float cos_nd = glm::dot(d, n);
         const std::size_t slot = first + j;
-        if (glm::dot(d, n) <= 0.0f) {
-          // Rejected, not reflected: the shading model gives such directions zero weight,
-          // and the estimator still divides by N (as the reference tracer does).
+        const float pdf = mirror ? 0.0f : glossy_mixture_pdf(glm::dot(d, r), cos_nd, exponent);
+        if (cos_nd <= 0.0f || (!mirror && !(pdf > 0.0f))) {
+          // Rejected, not reflected: the BRDF is zero below the surface, and the estimator
+          // still divides by N (as the reference tracer does).
           ++below;
           rs.dx[slot] = rs.dy[slot] = rs.dz[slot] = 0.0f;
           rs.tmin[slot] = 1.0f;
           rs.tmax[slot] = 0.0f;
           out.solid_angle[slot] = 0.0f;
+          out.weight[slot] = glm::vec3(0.0f);
         } else {
           rs.dx[slot] = d.x;
           rs.dy[slot] = d.y;
           rs.dz[slot] = d.z;
           rs.tmin[slot] = kUnbounded.tmin;
           rs.tmax[slot] = kUnbounded.tmax;
-          out.solid_angle[slot] = sample_solid_angle(local.z, exponent, static_cast<int>(N));
+          if (mirror) {
+            // A delta lobe: every ray is (within 1e-3 rad of) R and carries F(N·V).
+            out.solid_angle[slot] = sample_solid_angle(glm::dot(d, r), exponent, static_cast<int>(N));
+            out.weight[slot] = out.albedo[k];
+          } else {
+            out.solid_angle[slot] = 1.0f / (static_cast<float>(N) * pdf);
+            out.weight[slot] = gltf_brdf(brdf, n, d, v).specular * (cos_nd / pdf);
+          }
         }
       }
     }

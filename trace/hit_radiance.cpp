@@ -129,7 +129,7 @@ glm::vec3 hit_radiance(const Scene& scene, const LodBvh& lod, const TriangleLigh
   }
   L += diffuse_albedo_over_pi(sp.s, cos_nv) * lighting.environment_irradiance[t];
   if (!sp.s.is_refractor() && (sp.s.is_mirror_lobe() || sp.s.is_glossy_lobe()))
-    L += specular_fresnel(sp.s, cos_nv) * environment_radiance(scene.environment, reflect(dir, n));
+    L += specular_reflectance(sp.s, cos_nv) * environment_radiance(scene.environment, reflect(dir, n));
   // eq.8–9: a footprint larger than the triangle blends towards its ancestors' radiance.
   const float texel = lod.triangle_area[t];
   const float level = mip_level(footprint_area(hit.t * glm::length(dir_in), solid_angle,
@@ -164,7 +164,7 @@ ImageRGBA glossy_reflection(par::Executor& ex, const Scene& scene, const LodBvh&
   ex.parallel_for("hit_radiance", P, kChunk, [&](std::size_t b, std::size_t e) {
     HitRadianceStats st;
     for (std::size_t k = b; k < e; ++k) {
-      glm::vec3 sum(0.0f);
+      glm::vec3 sum(0.0f), weight_sum(0.0f);
       for (std::size_t j = 0; j < N; ++j) {
         const std::size_t slot = k * N + j;
         const float omega = rays.solid_angle[slot];
@@ -174,9 +174,14 @@ ImageRGBA glossy_reflection(par::Executor& ex, const Scene& scene, const LodBvh&
         else if (h.proxy != kNoHit) ++st.proxy_hits;
         else ++st.triangle_hits;
         const glm::vec3 d(rays.rays.dx[slot], rays.rays.dy[slot], rays.rays.dz[slot]);
-        sum += hit_radiance(scene, lod, lighting, d, omega, h);
+        sum += rays.weight[slot] * hit_radiance(scene, lod, lighting, d, omega, h);
+        weight_sum += rays.weight[slot];
       }
-      out.pixels[rays.pixel[k]] = glm::vec4(rays.fresnel[k] * (sum / static_cast<float>(N)), 1.0f);
+      // The self-normalized estimate E Σ w L / Σ w (trace/glossy_rays.h); no active ray: 0.
+      const glm::vec3 ratio = glm::vec3(weight_sum.x > 0.0f ? sum.x / weight_sum.x : 0.0f,
+                                        weight_sum.y > 0.0f ? sum.y / weight_sum.y : 0.0f,
+                                        weight_sum.z > 0.0f ? sum.z / weight_sum.z : 0.0f);
+      out.pixels[rays.pixel[k]] = glm::vec4(rays.albedo[k] * ratio, 1.0f);
     }
     per_chunk[b / kChunk] = st;
   });

@@ -58,8 +58,9 @@ struct HitRadianceStats {
   std::uint64_t triangle_hits = 0, proxy_hits = 0, misses = 0;
 };
 
-// Kernel "hit_radiance": the specular layer, width × height: per glossy pixel F × the mean of
-// its N samples' radiance (inactive samples count as 0), zero elsewhere.
+// Kernel "hit_radiance": the specular layer, width × height: per glossy pixel the lobe's
+// albedo E × the weighted mean Σ w L / Σ w of its active samples' radiance (glossy_rays.h),
+// zero elsewhere.
 ImageRGBA glossy_reflection(par::Executor& executor, const Scene& scene, const LodBvh& lod,
                             const TriangleLighting& lighting, const GlossyRays& rays,
                             const std::vector<LodHit>& hits, HitRadianceStats* stats = nullptr);

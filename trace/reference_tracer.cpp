@@ -99,12 +99,19 @@ struct Tracer {
       if (ok && F < 1.0f) Ls += (1.0f - F) * s.base_color * trace_dir(offset_ray_origin(p, -ng), glm::normalize(tdir));
       L += s.transmission * Ls;
     } else if (s.is_mirror_lobe()) {
-      L += specular_fresnel(s, cos_nv) * trace_dir(above, reflect(dir, n));
+      L += specular_reflectance(s, cos_nv) * trace_dir(above, reflect(dir, n));
     } else if (s.is_glossy_lobe()) {
-      const glm::vec3 r = reflect(dir, n);
-      const glm::vec3 wi = Onb(r).to_world(sample_phong_lobe({rnd(depth, 2), rnd(depth, 3)}, s.phong_exponent));
-      if (glm::dot(wi, n) <= 0.0f || glm::dot(wi, ng) <= 0.0f) ++stats.below_horizon;
-      else L += specular_fresnel(s, cos_nv) * trace_dir(above, wi);
+      // The ground truth samples the GGX lobe itself (visible normals), weighted f cos / p
+      // = F(V·H) G2/G1 (core/brdf.h): the same BRDF the techniques' lobes are weighted by.
+      const float alpha = s.roughness * s.roughness;
+      const Onb frame(n);
+      const glm::vec3 v_local(glm::dot(v, frame.t), glm::dot(v, frame.b), cos_nv);
+      const glm::vec3 h = frame.to_world(sample_ggx_visible_normal(v_local, alpha, {rnd(depth, 2), rnd(depth, 3)}));
+      const float cos_vh = glm::dot(v, h);
+      const glm::vec3 wi = 2.0f * cos_vh * h - v;
+      const float w = ggx_sample_weight(glm::dot(wi, n), cos_nv, alpha);
+      if (w <= 0.0f || glm::dot(wi, ng) <= 0.0f) ++stats.below_horizon;
+      else L += fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w * trace_dir(above, glm::normalize(wi));
     }
     return L;
   }

@@ -51,7 +51,7 @@ bool continuation(const SurfaceParams& s, const glm::vec3& p, const glm::vec3& n
   }
   ray.origin = offset_ray_origin(p, ng);
   ray.direction = reflect(dir, n);
-  weight = specular_fresnel(s, cos_nv);
+  weight = specular_reflectance(s, cos_nv);
   return true;
 }
 

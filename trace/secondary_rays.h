@@ -37,8 +37,8 @@ inline bool has_secondary_ray(const SurfaceParams& s) {
 }
 
 // From G-buffer planes (object id kNoId = background): mirror/glossy pixels get the mirror
-// ray R = reflect(V, N) with weight F (Schlick, specular_fresnel); glossy surfaces trace
-// the lobe's axis only (no lobe sampling). Refractors get the refracted ray with weight
+// ray R = reflect(V, N) with weight specular_reflectance (Schlick F; a glossy lobe's albedo
+// E); glossy surfaces trace the lobe's axis only (no lobe sampling). Refractors get the refracted ray with weight
 // transmission (1 - F) base_color (exact dielectric Fresnel), or the reflected ray with
 // weight transmission on total internal reflection; their Fresnel-reflected part is not
 // traced (one ray per pixel). Kernel "secondary_rays".

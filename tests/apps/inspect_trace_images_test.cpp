@@ -118,7 +118,7 @@ TEST(InspectTraceImages, GlossyRaysAndLodHitsPerPixel) {
   trace::GlossyRays g;
   g.width = 2, g.height = 1, g.rays_per_pixel = 2;
   g.pixel = {1};
-  g.fresnel = {glm::vec3(0.04f)};
+  g.weight = {glm::vec3(0.04f), glm::vec3(0.0f)};
   g.rays.resize(2);
   g.rays.set(0, Ray{glm::vec3(0.0f), glm::vec3(0, 1, 0), 0.0f, 10.0f});
   g.rays.set(1, Ray{glm::vec3(0.0f), glm::vec3(1, 0, 0), 1.0f, 0.0f});  // below the horizon

@@ -223,7 +223,7 @@ TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
     const SurfaceParams& s = g.surface.pixels[i];
     const float cos_nv = glm::dot(g.normal.pixels[i], g.view_direction(i));
     const glm::vec3 expected =
-        (glm::vec3(1.0f) - specular_fresnel(s, cos_nv)) * glm::vec3(0.8f, 0.6f, 0.4f) * sky.constant;
+        (glm::vec3(1.0f) - specular_reflectance(s, cos_nv)) * glm::vec3(0.8f, 0.6f, 0.4f) * sky.constant;
     for (int ch = 0; ch < 3; ++ch)
       EXPECT_NEAR(direct.pixels[i][ch], expected[ch], 0.01f * expected[ch]) << i << " ch " << ch;
     ++checked;

@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/camera_rays.h"
+#include "core/sampling.h"
 #include "core/shading.h"
 #include "trace/reference_tracer.h"
 #include "tests/trace/reference_scenes.h"
@@ -75,6 +76,43 @@ TEST(ReferenceTracer, MissReturnsTheEnvironmentRadiance) {
   EXPECT_GT(hi - lo, 0.5f);  // the directions really differ
 }
 
+// A glossy plane filling the view under a uniform environment of radiance L: a metal
+// returns the specular lobe's albedo E(F0) L (core/brdf.h's table, an independent estimate
+// of the integral the tracer samples with visible normals), and a white dielectric returns
+// exactly L, its coupled diffuse taking the (1 − E) the specular layer leaves.
+TEST(ReferenceTracer, GlossyFurnaceMatchesTheLobeAlbedo) {
+  const float L = 0.7f;
+  for (float roughness : {0.1f, 0.3f, 0.5f}) {
+    for (float metallic : {1.0f, 0.0f}) {
+      Scene s;
+      const glm::vec3 base = metallic > 0.5f ? glm::vec3(0.9f, 0.6f, 0.3f) : glm::vec3(1.0f);
+      const auto m = add_material(s, base, metallic, roughness);
+      add_quad(s, {-50, 0, -50}, {-50, 0, 50}, {50, 0, 50}, {50, 0, -50}, m);
+      s.environment.constant = glm::vec3(L);
+      Camera cam;
+      cam.eye = {0, 1, 0};
+      cam.target = {0, 0, -1};  // 45° to the plane at the image centre
+      cam.vfov_degrees = 10;
+      ReferenceOptions opt;
+      opt.width = 8;
+      opt.height = 8;
+      opt.spp = 512;
+      par::Executor ex(2);
+      const ImageRGBA img = render_reference(s, cam, opt, ex);
+      glm::dvec3 sum(0.0);
+      for (const glm::vec4& p : img.pixels) sum += glm::dvec3(glm::vec3(p));
+      const glm::vec3 mean = glm::vec3(sum / double(img.pixels.size()));
+      SurfaceParams sp = surface_params(s.materials[m]);
+      const float cos_nv = std::cos(kPi / 4.0f);
+      const glm::vec3 expected =
+          metallic > 0.5f ? specular_reflectance(sp, cos_nv) * L : glm::vec3(L);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(mean[c], expected[c], 0.02f * expected[c])
+            << "roughness " << roughness << " metallic " << metallic << " channel " << c;
+    }
+  }
+}
+
 TEST(ReferenceTracer, DepthLimitBetweenFacingMirrors) {
   // Two facing emissive mirrors (z = -1 and z = 1), the camera between them looking down
   // -z with a narrow view: every camera ray bounces between them until the depth limit.
@@ -95,7 +133,7 @@ TEST(ReferenceTracer, DepthLimitBetweenFacingMirrors) {
   par::Executor ex(2);
   const std::uint64_t n = 81;
   // At normal incidence each bounce scales by F = F(cos 1): L_D = e · Σ_{k=0..D} F^k.
-  const glm::vec3 F = specular_fresnel(surface_params(s.materials[mirror]), 1.0f);
+  const glm::vec3 F = specular_reflectance(surface_params(s.materials[mirror]), 1.0f);
   ASSERT_GT(F.x, 0.1f);
   ASSERT_LT(F.x, 0.9f);
   glm::vec3 expected(0.0f), Fk(1.0f), previous(-1.0f);
