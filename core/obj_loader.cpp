@@ -304,9 +304,20 @@ Scene load_obj(const std::string& path, LoadReport& report) {
     throw InputError(path, errors.empty() ? "tinyobjloader could not read the file" : errors.front());
   }
   for (const std::string& p : reader.problems()) report.substitute(path, p);
-  for (const std::string& w : lines_of(warn))
-    if (w.find("Material file") == std::string::npos && w.find("Failed to load material file") == std::string::npos)
-      report.warn(w);
+  // tinyobjloader's own warnings; a usemtl naming no material is reported in our words,
+  // and not at all when the library itself is missing (that warning says it already).
+  for (const std::string& w : lines_of(warn)) {
+    if (w.find("Material file") != std::string::npos || w.find("Failed to load material file") != std::string::npos)
+      continue;
+    const std::size_t open = w.find("[ '"), close = w.find("' ] not found in .mtl");
+    if (open != std::string::npos && close != std::string::npos && close > open) {
+      if (reader.problems().empty())
+        report.warn("usemtl '" + w.substr(open + 3, close - open - 3) +
+                    "' names no material of the .mtl: default material used");
+      continue;
+    }
+    report.warn(w);
+  }
 
   Scene scene;
   scene.name = path;
@@ -344,7 +355,7 @@ Scene load_obj(const std::string& path, LoadReport& report) {
   std::unordered_map<std::tuple<int, int, int>, std::uint32_t, CornerHash> corners;
   std::vector<std::uint32_t> position_of;  // per scene vertex: its OBJ position
   std::vector<std::uint32_t> position_indices;
-  bool all_normals = nn > 0;
+  std::vector<bool> has_normal;             // per scene vertex: the file gave a normal
   const std::string stem = fs::path(path).stem().string();
   for (const tinyobj::shape_t& shape : shapes) {
     const auto& idx = shape.mesh.indices;
@@ -372,7 +383,6 @@ Scene load_obj(const std::string& path, LoadReport& report) {
         if (c.texcoord_index >= 0 && static_cast<std::size_t>(c.texcoord_index) >= nt)
           throw InputError(path, "a face indexes texture coordinate " +
                                      std::to_string(c.texcoord_index + 1) + " of " + std::to_string(nt));
-        if (c.normal_index < 0) all_normals = false;
         const auto key = std::make_tuple(c.vertex_index, c.normal_index, c.texcoord_index);
         auto [it, added] = corners.try_emplace(key, static_cast<std::uint32_t>(mesh.positions.size()));
         if (added) {
@@ -391,6 +401,7 @@ Scene load_obj(const std::string& path, LoadReport& report) {
             normal = glm::vec3(attrib.normals[3 * q], attrib.normals[3 * q + 1], attrib.normals[3 * q + 2]);
           }
           mesh.normals.push_back(normal);
+          has_normal.push_back(c.normal_index >= 0);
           position_of.push_back(static_cast<std::uint32_t>(v));
         }
         mesh.indices.push_back(it->second);
@@ -408,23 +419,27 @@ Scene load_obj(const std::string& path, LoadReport& report) {
   }
   if (mesh.indices.empty()) throw InputError(path, "contains no faces");
 
-  // Normals: the file's when every corner has a sane one, else area-weighted over the OBJ's
+  // Normals: the file's where a corner has a sane one; elsewhere area-weighted over the OBJ's
   // positions (so corners split only by their uvs stay smooth).
-  bool file_normals = all_normals;
-  for (glm::vec3& n : mesh.normals) {
-    if (!file_normals) break;
+  std::vector<glm::vec3> smooth;
+  std::size_t bad = 0;
+  for (std::size_t i = 0; i < mesh.normals.size(); ++i) {
+    glm::vec3& n = mesh.normals[i];
     const float len = glm::length(n);
-    if (!(len > 1e-6f) || !std::isfinite(len)) file_normals = false;
-    else n /= len;
+    if (len > 1e-6f && std::isfinite(len)) {
+      n /= len;
+      continue;
+    }
+    if (has_normal[i]) ++bad;
+    if (smooth.empty()) {
+      std::vector<glm::vec3> obj_positions(np);
+      for (std::size_t v = 0; v < np; ++v)
+        obj_positions[v] = glm::vec3(attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]);
+      smooth = area_weighted_normals(obj_positions, position_indices);
+    }
+    n = smooth[position_of[i]];
   }
-  if (all_normals && !file_normals) report.warn("bad normals in file, recomputed");
-  if (!file_normals) {
-    std::vector<glm::vec3> obj_positions(np);
-    for (std::size_t v = 0; v < np; ++v)
-      obj_positions[v] = glm::vec3(attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]);
-    const std::vector<glm::vec3> smooth = area_weighted_normals(obj_positions, position_indices);
-    for (std::size_t i = 0; i < mesh.normals.size(); ++i) mesh.normals[i] = smooth[position_of[i]];
-  }
+  if (bad) report.warn(std::to_string(bad) + " zero or non-finite normals, recomputed");
   return scene;
 }
 
