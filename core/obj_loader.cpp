@@ -312,8 +312,9 @@ Scene load_obj(const std::string& path, LoadReport& report) {
     const std::size_t open = w.find("[ '"), close = w.find("' ] not found in .mtl");
     if (open != std::string::npos && close != std::string::npos && close > open) {
       if (reader.problems().empty())
-        report.warn("usemtl '" + w.substr(open + 3, close - open - 3) +
-                    "' names no material of the .mtl: default material used");
+        report.warn("usemtl '" + w.substr(open + 3, close - open - 3) + "' names no material" +
+                    (materials.empty() ? " (the file has no mtllib)" : " of the .mtl") +
+                    ": default material used");
       continue;
     }
     report.warn(w);
