@@ -540,6 +540,18 @@ void check_version_and_required_extensions(const std::string& path, const char* 
   if (count > 1) throw InputError(path, "extensions " + missing + " are not supported");
 }
 
+// tinygltf's own image decoder, except that an image it cannot decode is kept empty instead
+// of failing the whole file: MaterialTable then names it and leaves the texture out (or
+// fails under --strict), as for a missing image file.
+bool tolerant_image_loader(tinygltf::Image* image, const int index, std::string*, std::string* warn,
+                           int width, int height, const unsigned char* bytes, int size, void* user) {
+  std::string err;
+  if (tinygltf::LoadImageData(image, index, &err, warn, width, height, bytes, size, user)) return true;
+  image->image.clear();
+  image->width = image->height = 0;
+  return true;
+}
+
 // Reads and parses the file (JSON .gltf or binary .glb) and rejects glTF 1.0 and required
 // extensions the loader does not implement.
 tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
@@ -551,6 +563,8 @@ tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
   else check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()), bytes.size());
 
   tinygltf::TinyGLTF parser;
+  // No user data: tinygltf's decoder then uses its default options, as without a loader.
+  parser.SetImageLoader(tolerant_image_loader, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   const std::string base_dir = std::filesystem::path(path).parent_path().string();

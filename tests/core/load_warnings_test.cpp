@@ -66,6 +66,10 @@ TEST(LoadWarnings, EachNamesWhatIsMissingAndTheFallback) {
   ASSERT_EQ(gltf.scene.materials.size(), 1u);
   EXPECT_FALSE(gltf.scene.materials[0].base_color_texture.valid());  // factors alone
 
+  const Loaded junk = load_with_report(kWarn + "undecodable_texture.gltf");
+  ASSERT_EQ(junk.warnings.size(), 1u);
+  EXPECT_EQ(junk.warnings[0], "texture image 'not_an_image.png' is missing or could not be decoded: drawn without it");
+
   const Loaded mtl = load_with_report(kWarn + "missing_mtl.obj");
   ASSERT_EQ(mtl.warnings.size(), 1u);
   EXPECT_EQ(mtl.warnings[0], "material library 'no_such_library.mtl' not found: default material used");

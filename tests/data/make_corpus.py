@@ -126,6 +126,11 @@ def main():
         d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
     write_gltf(WARN, "missing_texture.gltf", gltf_doc(pos, idx, extra=add_texture), buf)
 
+    def add_undecodable_texture(d):
+        add_texture(d)
+        d["images"] = [{"uri": "not_an_image.png"}]
+    write_gltf(WARN, "undecodable_texture.gltf", gltf_doc(pos, idx, extra=add_undecodable_texture), buf)
+
     def require_draco(d):
         d["extensionsUsed"] = ["KHR_draco_mesh_compression"]
         d["extensionsRequired"] = ["KHR_draco_mesh_compression"]
