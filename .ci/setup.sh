@@ -8,7 +8,7 @@ $SUDO apt-get update -q
 $SUDO apt-get install -y -q --no-install-recommends \
   g++ cmake ninja-build pkg-config \
   libglm-dev libopenimageio-dev openimageio-tools \
-  libtinygltf-dev nlohmann-json3-dev libstb-dev \
+  libtinygltf-dev nlohmann-json3-dev libstb-dev libtinyobjloader-dev \
   libopenmesh-dev libtbb-dev \
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev \
   assimp-testmodels graphviz libembree-dev \

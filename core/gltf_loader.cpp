@@ -16,6 +16,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/trigonometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "core/gltf_accessors.h"
@@ -63,6 +64,7 @@ std::uint32_t le32(const unsigned char* p) {
 void check_glb_container(const std::string& path, const std::vector<unsigned char>& b) {
   if (b.size() < 20) throw InputError(path, "truncated .glb: shorter than its 20-byte header");
   if (le32(&b[0]) != 0x46546C67u) throw InputError(path, "not a .glb file (bad magic)");
+  if (le32(&b[4]) == 1) throw InputError(path, "glTF 1.0 is not supported, 2.0 is");
   if (le32(&b[4]) != 2) throw InputError(path, "unsupported .glb version " + std::to_string(le32(&b[4])));
   const std::uint64_t total = le32(&b[8]);
   if (total > b.size())
@@ -509,15 +511,60 @@ struct Loader {
   }
 };
 
-// Reads and parses the file (JSON .gltf or binary .glb) and rejects required extensions
-// the loader does not implement.
+// Content this loader cannot read, named before tinygltf parses the file: otherwise a
+// glTF 1.0 file (id-keyed objects where 2.0 has arrays) fails with "no triangles" or a
+// schema complaint, and a Draco or meshopt-compressed one with "invalid bufferView".
+// JSON that does not parse is left to tinygltf, which says where it breaks.
+void check_version_and_required_extensions(const std::string& path, const char* json, std::size_t size) {
+  const nlohmann::json doc = nlohmann::json::parse(json, json + size, nullptr, false);
+  if (!doc.is_object()) return;
+  bool version1 = false;
+  if (const auto asset = doc.find("asset"); asset != doc.end() && asset->is_object()) {
+    if (const auto v = asset->find("version"); v != asset->end()) {
+      if (v->is_number()) version1 = v->get<double>() < 2.0;
+      else if (v->is_string()) version1 = v->get<std::string>().rfind("1", 0) == 0;
+    }
+  }
+  // glTF 1.0 keeps its top-level collections in objects keyed by id (glTF 1.0 §5).
+  for (const char* key : {"meshes", "accessors", "nodes", "bufferViews", "materials"})
+    if (const auto c = doc.find(key); c != doc.end() && c->is_object() && !c->empty()) version1 = true;
+  if (version1) throw InputError(path, "glTF 1.0 is not supported, 2.0 is");
+  const auto required = doc.find("extensionsRequired");
+  if (required == doc.end() || !required->is_array()) return;
+  std::string missing;
+  int count = 0;
+  for (const auto& e : *required)
+    if (e.is_string() && !gltf::extension_supported(e.get<std::string>()))
+      missing += (count++ ? ", " : "") + e.get<std::string>();
+  if (count == 1) throw InputError(path, "extension " + missing + " is not supported");
+  if (count > 1) throw InputError(path, "extensions " + missing + " are not supported");
+}
+
+// tinygltf's own image decoder, except that an image it cannot decode is kept empty instead
+// of failing the whole file: MaterialTable then names it and leaves the texture out (or
+// fails under --strict), as for a missing image file.
+bool tolerant_image_loader(tinygltf::Image* image, const int index, std::string*, std::string* warn,
+                           int width, int height, const unsigned char* bytes, int size, void* user) {
+  std::string err;
+  if (tinygltf::LoadImageData(image, index, &err, warn, width, height, bytes, size, user)) return true;
+  image->image.clear();
+  image->width = image->height = 0;
+  return true;
+}
+
+// Reads and parses the file (JSON .gltf or binary .glb) and rejects glTF 1.0 and required
+// extensions the loader does not implement.
 tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
   const bool is_glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".glb" || ext == ".GLB" || is_glb) check_glb_container(path, bytes);
+  if (is_glb) check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()) + 20, le32(&bytes[12]));
+  else check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()), bytes.size());
 
   tinygltf::TinyGLTF parser;
+  // No user data: tinygltf's decoder then uses its default options, as without a loader.
+  parser.SetImageLoader(tolerant_image_loader, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   const std::string base_dir = std::filesystem::path(path).parent_path().string();
@@ -528,11 +575,24 @@ tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
                                           reinterpret_cast<const char*>(bytes.data()),
                                           static_cast<unsigned>(bytes.size()), base_dir);
   if (!ok) throw InputError(path, one_line(err.empty() ? "tinygltf could not parse the file" : err));
-  if (report && !warn.empty()) report->warn(one_line(warn));
+  // tinygltf's warnings, one per line; those about images it could not load are left to
+  // MaterialTable, which names the texture once and only when a material uses it.
+  if (report) {
+    std::size_t at = 0;
+    while (at < warn.size()) {
+      std::size_t end = warn.find('\n', at);
+      if (end == std::string::npos) end = warn.size();
+      const std::string line = one_line(warn.substr(at, end - at));
+      at = end + 1;
+      if (line.empty() || line.rfind("File not found", 0) == 0 ||
+          line.find("Failed to load external 'uri' for image") != std::string::npos)
+        continue;
+      report->warn(line);
+    }
+  }
 
   for (const std::string& e : model.extensionsRequired)
-    if (!gltf::extension_supported(e))
-      throw InputError(path, "requires unsupported extension " + e);
+    if (!gltf::extension_supported(e)) throw InputError(path, "extension " + e + " is not supported");
   return model;
 }
 
@@ -640,11 +700,13 @@ void read_environment(const std::string& path, const tinygltf::Model& model, Sce
 
 }  // namespace
 
-Scene load_gltf(const std::string& path, LoadReport* report) {
+Scene load_gltf(const std::string& path, LoadReport* report_or_null) {
+  LoadReport local;
+  LoadReport* report = report_or_null ? report_or_null : &local;
   const tinygltf::Model model = parse_model(path, report);
   Scene scene;
   scene.name = path;
-  Loader loader{path, model, scene, report, gltf::MaterialTable(path, model, scene), {}, {}, 0};
+  Loader loader{path, model, scene, report, gltf::MaterialTable(path, model, scene, *report), {}, {}, 0};
 
   // Materials in file order (not order of use), so indices match the file's.
   for (std::size_t i = 0; i < model.materials.size(); ++i) loader.materials.scene_material(static_cast<int>(i));

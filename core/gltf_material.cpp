@@ -23,7 +23,14 @@ const tinygltf::Value* extension(const tinygltf::ExtensionMap& ext, const char* 
   return it == ext.end() || !it->second.IsObject() ? nullptr : &it->second;
 }
 
-// uv' = T * R * S * (u, v, 1) (KHR_texture_transform, column-major as in its GLSL).
+}  // namespace
+
+// uv' = T * R * S * (u, v, 1) (KHR_texture_transform). R turns the uvs counter-clockwise by
+// `rotation` (the image appears turned clockwise, v pointing down): u' = cos·u + sin·v,
+// v' = -sin·u + cos·v, the rotation the extension's own example needs to select the lower
+// left quadrant (offset [0, 1], rotation π/2, scale 0.5). The extension's GLSL listing
+// writes the transpose into a column-major mat3, which turns the other way and points
+// TextureTransformTest's arrow at the red marker. glm is column-major: columns below.
 glm::mat3 texture_transform(const tinygltf::Value& t) {
   float ox = 0, oy = 0, sx = 1, sy = 1;
   if (t.Has("offset") && t.Get("offset").IsArray() && t.Get("offset").ArrayLen() == 2) {
@@ -37,10 +44,12 @@ glm::mat3 texture_transform(const tinygltf::Value& t) {
   const float r = number(t, "rotation", 0.0f);
   const float c = std::cos(r), s = std::sin(r);
   const glm::mat3 translation(1, 0, 0, 0, 1, 0, ox, oy, 1);
-  const glm::mat3 rotation(c, s, 0, -s, c, 0, 0, 0, 1);
+  const glm::mat3 rotation(c, -s, 0, s, c, 0, 0, 0, 1);
   const glm::mat3 scale(sx, 0, 0, 0, sy, 0, 0, 0, 1);
   return translation * rotation * scale;
 }
+
+namespace {
 
 bool finite(float x) { return std::isfinite(x); }
 
@@ -54,8 +63,10 @@ bool extension_supported(const std::string& name) {
                      [&](const char* s) { return name == s; });
 }
 
-MaterialTable::MaterialTable(const std::string& path, const tinygltf::Model& model, Scene& scene)
-    : path_(path), model_(model), scene_(scene), material_map_(model.materials.size(), -1) {}
+MaterialTable::MaterialTable(const std::string& path, const tinygltf::Model& model, Scene& scene,
+                             LoadReport& report)
+    : path_(path), model_(model), scene_(scene), report_(report),
+      material_map_(model.materials.size(), -1) {}
 
 std::uint32_t MaterialTable::scene_material(int index) {
   if (index < 0) {
@@ -174,16 +185,22 @@ int MaterialTable::scene_texture(int texture, bool srgb, const std::string& what
   const std::string name = !img.uri.empty() && img.uri.rfind("data:", 0) != 0
                                ? "'" + img.uri + "'"
                                : "image " + std::to_string(t.source);
+  // A texture that cannot be had is left out (the material's factors alone, as if the
+  // texture were white) with one warning per image, or an error under --strict.
+  auto unusable = [&](const std::string& problem) {
+    report_.substitute(path_, "texture image " + name + " " + problem + ": drawn without it");
+    texture_map_[key] = -1;
+    return -1;
+  };
   if (img.image.empty() || img.width <= 0 || img.height <= 0)
-    throw InputError(path_, what + ": texture image " + name + " is missing or could not be decoded");
+    return unusable("is missing or could not be decoded");
   const int nc = img.component;
   const int bytes = img.bits == 16 ? 2 : img.bits == 8 ? 1 : 0;
-  if (nc < 1 || nc > 4 || bytes == 0)
-    throw InputError(path_, what + ": texture image " + name + " has an unsupported pixel format");
+  if (nc < 1 || nc > 4 || bytes == 0) return unusable("has an unsupported pixel format");
   const std::int64_t pixels = std::int64_t{img.width} * img.height;
   if (pixels > kMaxTexturePixels ||
       img.image.size() != static_cast<std::size_t>(pixels) * static_cast<std::size_t>(nc * bytes))
-    throw InputError(path_, what + ": texture image " + name + " has an inconsistent size");
+    return unusable("has an inconsistent size");
 
   ImageRGBA out(img.width, img.height, glm::vec4(0, 0, 0, 1));
   const float scale = bytes == 2 ? 1.0f / 65535.0f : 1.0f / 255.0f;

@@ -94,10 +94,10 @@ struct Writer {
   void set_transform_ext(const TextureRef& ref, tinygltf::ExtensionMap& ext) {
     const glm::mat3& m = ref.uv_transform;
     if (m == glm::mat3(1.0f)) return;
-    // uv_transform = T R S: column 0 = sx (cos, sin), column 1 = sy (-sin, cos).
+    // uv_transform = T R S (gltf_material.h): column 0 = sx (cos, -sin), column 1 = sy (sin, cos).
     Value::Object t;
     t["offset"] = Value(Value::Array{Value(double(m[2][0])), Value(double(m[2][1]))});
-    t["rotation"] = Value(double(std::atan2(m[0][1], m[0][0])));
+    t["rotation"] = Value(double(std::atan2(-m[0][1], m[0][0])));
     t["scale"] = Value(Value::Array{Value(double(glm::length(glm::vec2(m[0])))),
                                     Value(double(glm::length(glm::vec2(m[1]))))});
     put_extension(ext, "KHR_texture_transform", std::move(t));

@@ -1,4 +1,4 @@
-// OBJ/PLY/OFF/STL through OpenMesh (see mesh_loader.h). Headers with element counts are
+// PLY/OFF/STL through OpenMesh, OBJ through core/obj_loader.h (see mesh_loader.h). Headers with element counts are
 // checked against the file size first, so an absurd count cannot make OpenMesh reserve
 // gigabytes; OpenMesh's own stream logging is silenced (the CLI prints one line).
 #include "core/mesh_loader.h"
@@ -20,6 +20,7 @@
 
 #include "core/error.h"
 #include "core/mesh_normals.h"
+#include "core/obj_loader.h"
 
 namespace speculum {
 namespace {
@@ -216,7 +217,7 @@ void copy_or_compute_normals(const std::string& path, const OmMesh& om, const Op
       }
       mesh.normals.push_back(q / len);
     }
-    if (!file_normals && report) report->warn(path + ": bad normals in file, recomputed");
+    if (!file_normals && report) report->warn("bad normals in file, recomputed");
   }
   if (!file_normals) mesh.normals = area_weighted_normals(mesh.positions, mesh.indices);
 }
@@ -255,6 +256,12 @@ void add_single_object(const std::string& path, Scene& scene) {
 }  // namespace
 
 Scene load_mesh_file(const std::string& path, LoadReport* report) {
+  if (lower_ext(path) == ".obj") {  // OBJ carries materials: tinyobjloader reads it
+    LoadReport local;
+    Scene scene = load_obj(path, report ? *report : local);
+    finish_scene(scene);
+    return scene;
+  }
   static const SilenceOpenMesh silence;
   const std::uintmax_t size = checked_file_size(path);
   check_declared_counts(path, lower_ext(path), size);

@@ -1,5 +1,6 @@
-// OBJ / PLY / OFF / STL meshes through OpenMesh: one object, one default material,
-// normals from the file or computed (OpenMesh face/vertex normals).
+// PLY / OFF / STL meshes through OpenMesh: one object, one default material, normals from
+// the file or computed (area-weighted). OBJ, which carries materials, goes to load_obj
+// (core/obj_loader.h).
 #pragma once
 
 #include <string>

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/gltf_loader.h"
 #include "core/mesh_loader.h"
+#include "core/obj_loader.h"
 #include "core/procedural_scenes.h"
 
 namespace speculum {
@@ -84,6 +85,16 @@ Scene build_builtin(const std::string& spec, const SceneOptions& options) {
 
 }  // namespace
 
+void LoadReport::warn(std::string message) {
+  if (std::find(warnings.begin(), warnings.end(), message) == warnings.end())
+    warnings.push_back(std::move(message));
+}
+
+void LoadReport::substitute(const std::string& source, std::string message) {
+  if (strict) throw InputError(source, message + " (--strict)");
+  warn(std::move(message));
+}
+
 const char* default_scene_name() { return "sphere-in-room"; }
 
 bool is_builtin_scene_name(const std::string& file_or_name) {
@@ -106,11 +117,17 @@ void finish_scene(Scene& scene) {
 Scene load_scene(const std::string& file_or_name, const SceneOptions& options) {
   if (file_or_name.empty()) throw InputError("(empty)", "no scene file or name given");
   const std::string ext = lower_extension(file_or_name);
+  // Loaders always get a report, so --strict holds even when the caller keeps no warnings.
+  LoadReport local;
+  LoadReport* report = options.report ? options.report : &local;
+  report->strict = report->strict || options.strict;
   Scene scene;
   if (ext == ".gltf" || ext == ".glb") {
-    scene = load_gltf(file_or_name, options.report);
-  } else if (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl") {
-    scene = load_mesh_file(file_or_name, options.report);
+    scene = load_gltf(file_or_name, report);
+  } else if (ext == ".obj") {
+    scene = load_obj(file_or_name, *report);
+  } else if (ext == ".ply" || ext == ".off" || ext == ".stl") {
+    scene = load_mesh_file(file_or_name, report);
   } else if (is_builtin_scene_name(file_or_name)) {
     scene = build_builtin(file_or_name, options);
   } else {

@@ -11,10 +11,17 @@
 namespace speculum {
 
 // What a loader skipped or repaired; never fatal (fatal problems throw InputError).
+// Messages do not repeat the file name (the caller prefixes it) and each is kept once.
 struct LoadReport {
   std::vector<std::string> warnings;
   std::uint64_t skipped_primitives = 0;  // points/lines/unsupported primitives
-  void warn(std::string message) { warnings.push_back(std::move(message)); }
+  // --strict: content the loader would replace by a fallback (a missing or undecodable
+  // texture, a missing .mtl file) is an InputError instead of a warning.
+  bool strict = false;
+  void warn(std::string message);
+  // A missing or unreadable part of `source` replaced by a documented fallback: a warning,
+  // or InputError(source, message) when strict.
+  void substitute(const std::string& source, std::string message);
 };
 
 struct SceneOptions {
@@ -22,6 +29,7 @@ struct SceneOptions {
   // the name ("bowl:size=20000") wins over this field. Ignored for files.
   std::uint64_t size = 0;
   LoadReport* report = nullptr;  // optional: receives warnings
+  bool strict = false;           // see LoadReport::strict (sets report->strict too)
 };
 
 // Loads `file_or_name`: a path ending in .gltf/.glb/.obj/.ply/.off/.stl, or a built-in

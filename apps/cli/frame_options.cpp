@@ -2,9 +2,11 @@
 #include "apps/cli/frame_options.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "core/error.h"
+#include "core/scene_loader.h"
 
 namespace speculum::pipeline {
 
@@ -31,11 +33,27 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
   cmd.add_option("--shadow-size", o.shadow_map_size, "Side of the shadow maps")
       ->check(CLI::Range(1, 8192))->capture_default_str();
   add_camera_options(cmd, o.camera);
+  cmd.add_flag("--strict", o.strict,
+               "A missing or undecodable texture, or a missing .mtl file, is an error (exit 2)\n"
+               "instead of a warning with the texture or material left out");
   // The technique parameters, from the technique table (after the command's own footer).
   std::string params = "\n\nTechnique parameters (--param name=value; default, [valid range]):";
   for (const Technique& t : techniques())
     if (!t.params.empty()) params += "\n  " + t.name + "\n" + t.describe_params("    ");
   cmd.footer(cmd.get_footer() + params);
+}
+
+Scene load_frame_scene(const FrameOptions& o, bool quiet) {
+  const std::string name = o.scene.empty() ? default_scene_name() : o.scene;
+  LoadReport report;
+  SceneOptions so;
+  so.report = &report;
+  so.strict = o.strict;
+  Scene scene = load_scene(name, so);
+  if (!quiet)
+    for (const std::string& w : report.warnings)
+      std::fprintf(stderr, "speculum: warning: %s: %s\n", name.c_str(), w.c_str());
+  return scene;
 }
 
 FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {

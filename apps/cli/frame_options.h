@@ -27,9 +27,14 @@ struct FrameOptions {
   int cube_map_size = 256;
   int shadow_map_size = 512;
   CameraOverrides camera;
+  bool strict = false;  // --strict: a missing texture or .mtl is an error, not a warning
 };
 
 void add_frame_options(CLI::App& cmd, FrameOptions& options);
+
+// Loads the frame's scene (the default built-in one when none is given) and prints each
+// loader warning once on stderr as `speculum: warning: FILE: message`, unless `quiet`.
+Scene load_frame_scene(const FrameOptions& options, bool quiet);
 
 // Validates (InputError on bad values) and resolves the camera. A square spp is k×k
 // supersampling; other counts reach only sample-based techniques through FrameSettings::spp.

@@ -34,7 +34,7 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
                                   std::to_string(o.spp));
   if (!ends_with(opts.output, ".png") && !ends_with(opts.output, ".exr"))
     throw InputError(opts.output, "output must end in .png or .exr");
-  const Scene scene = load_scene(o.scene.empty() ? default_scene_name() : o.scene);
+  const Scene scene = pipeline::load_frame_scene(o, global.quiet);
   const pipeline::FrameSettings f = pipeline::make_frame_settings(o, scene);
   par::Executor executor(global.threads, global.lanes);
   par::Graph graph;

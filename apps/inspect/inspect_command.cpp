@@ -52,7 +52,7 @@ bool have_graphviz() { return std::system("command -v dot >/dev/null 2>&1") == 0
 
 void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
-  const Scene scene = load_scene(o.frame.scene.empty() ? default_scene_name() : o.frame.scene);
+  const Scene scene = pipeline::load_frame_scene(o.frame, global.quiet);
   const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
   const fs::path dir = o.output;
   std::error_code ec;

@@ -47,7 +47,7 @@ void write_text(const fs::path& path, const std::string& text) {
 
 void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
   const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
-  const Scene scene = load_scene(o.frame.scene.empty() ? default_scene_name() : o.frame.scene);
+  const Scene scene = pipeline::load_frame_scene(o.frame, global.quiet);
   const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
   if (!o.output.empty()) {
     std::error_code ec;

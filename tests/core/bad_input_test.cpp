@@ -1,5 +1,6 @@
 // The bad-input corpus (tests/data/bad, made by tests/data/make_corpus.py): every file must
 // be rejected with InputError naming the file — never a crash or another exception.
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -26,8 +27,9 @@ TEST(BadInput, CorpusIsComplete) {
   EXPECT_GE(files.size(), 40u);
   for (const char* needed :
        {"empty.gltf", "truncated.glb", "invalid_json.gltf", "missing_bin.gltf",
-        "index_out_of_range.gltf", "nan_position.gltf", "inf_position.glb", "missing_texture.gltf",
-        "unsupported_extension.gltf", "unsupported_file_type.xyz", "node_cycle.gltf",
+        "index_out_of_range.gltf", "nan_position.gltf", "inf_position.glb",
+        "unsupported_extension.gltf", "draco_required.gltf", "meshopt_required.gltf",
+        "gltf_1_0.gltf", "gltf_1_0.glb", "gltf_1_0_no_asset.gltf", "unsupported_file_type.xyz", "node_cycle.gltf",
         "absurd_count.gltf", "absurd_count.ply", "absurd_count.off", "absurd_count.stl",
         "index_out_of_range.obj", "truncated.stl"})
     EXPECT_TRUE(std::filesystem::exists(std::string(SPECULUM_TEST_DATA "/bad/") + needed)) << needed;
@@ -63,11 +65,41 @@ TEST(BadInput, SpecificProblemsAreNamed) {
   EXPECT_NE(problem("index_out_of_range.gltf").find("out of range"), std::string::npos);
   EXPECT_NE(problem("nan_position.gltf").find("NaN or infinite"), std::string::npos);
   EXPECT_NE(problem("truncated.glb").find("truncated"), std::string::npos);
-  EXPECT_NE(problem("missing_texture.gltf").find("no_such_texture.png"), std::string::npos);
   EXPECT_NE(problem("unsupported_extension.gltf").find("KHR_draco_mesh_compression"), std::string::npos);
+  // Unsupported content names itself, not the symptom (an invalid bufferView, no triangles).
+  EXPECT_EQ(problem("draco_required.gltf"), "extension KHR_draco_mesh_compression is not supported");
+  EXPECT_EQ(problem("meshopt_required.gltf"), "extension EXT_meshopt_compression is not supported");
+  EXPECT_EQ(problem("two_unsupported_extensions.gltf"),
+            "extensions KHR_draco_mesh_compression, EXT_meshopt_compression are not supported");
+  for (const char* v1 : {"gltf_1_0.gltf", "gltf_1_0.glb", "gltf_1_0_no_asset.gltf"})
+    EXPECT_EQ(problem(v1), "glTF 1.0 is not supported, 2.0 is") << v1;
   EXPECT_NE(problem("absurd_count.gltf").find("absurd"), std::string::npos);
   EXPECT_NE(problem("empty.glb").find("empty"), std::string::npos);
   EXPECT_NE(problem("point_cloud.ply").find("no faces"), std::string::npos);
+}
+
+TEST(BadInput, AssimpGltf1AndDracoFilesNameTheUnsupportedContent) {
+  const std::string models = "/usr/share/assimp/models/";
+  if (!std::filesystem::exists(models + "glTF")) GTEST_SKIP() << "assimp-testmodels not installed";
+  auto problem = [](const std::string& file) {
+    try {
+      (void)load_scene(file);
+    } catch (const InputError& e) {
+      return e.problem();
+    }
+    return std::string("(no error)");
+  };
+  std::size_t v1 = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(models + "glTF")) {
+    const std::string ext = e.path().extension().string();
+    if (ext != ".gltf" && ext != ".glb") continue;
+    SCOPED_TRACE(e.path().string());
+    EXPECT_EQ(problem(e.path().string()), "glTF 1.0 is not supported, 2.0 is");
+    ++v1;
+  }
+  EXPECT_GE(v1, 7u);
+  EXPECT_EQ(problem(models + "glTF2/draco/2CylinderEngine.gltf"),
+            "extension KHR_draco_mesh_compression is not supported");
 }
 
 TEST(BadInput, MissingFileAndUnknownName) {

@@ -222,10 +222,11 @@ TEST(GltfExportEnvironment, MalformedEnvironmentExtrasAreInputErrorNamingTheFile
   std::filesystem::remove_all(dir);
 }
 
-// uv' = T R S (u, v, 1), as KHR_texture_transform composes offset, rotation and scale.
+// uv' = T R S (u, v, 1), as KHR_texture_transform composes offset, rotation and scale;
+// R = [[cos, sin], [-sin, cos]] (rows), written by columns for glm.
 glm::mat3 uv_transform(glm::vec2 offset, float rotation, glm::vec2 scale) {
   const float c = std::cos(rotation), s = std::sin(rotation);
-  return glm::mat3(1, 0, 0, 0, 1, 0, offset.x, offset.y, 1) * glm::mat3(c, s, 0, -s, c, 0, 0, 0, 1) *
+  return glm::mat3(1, 0, 0, 0, 1, 0, offset.x, offset.y, 1) * glm::mat3(c, -s, 0, s, c, 0, 0, 0, 1) *
          glm::mat3(scale.x, 0, 0, 0, scale.y, 0, 0, 0, 1);
 }
 

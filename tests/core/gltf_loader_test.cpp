@@ -179,10 +179,10 @@ TEST(GltfLoader, MaterialsLightsCamerasAndExtensions) {
   EXPECT_EQ(m.emissive, glm::vec3(4.0f, 2.0f, 0.0f));
   EXPECT_FLOAT_EQ(m.normal_scale, 0.5f);
   ASSERT_TRUE(m.normal_texture.valid());
-  // T R S applied to uv (1,0): S → (2,0), R(90°) → (0,2), T → (0.5,2).
+  // T R S applied to uv (1,0): S → (2,0), R(90°) = [[0, 1], [-1, 0]] → (0,-2), T → (0.5,-2).
   const glm::vec3 uv = m.normal_texture.uv_transform * glm::vec3(1, 0, 1);
   EXPECT_NEAR(uv.x, 0.5f, 1e-5f);
-  EXPECT_NEAR(uv.y, 2.0f, 1e-5f);
+  EXPECT_NEAR(uv.y, -2.0f, 1e-5f);
   // Normal map → tangents computed: unit, orthogonal to n, along dP/du = +x; the quad's v
   // runs down the image while y goes up, so the image's up is +y = cross(n, t): the map is
   // not mirrored and the handedness is +1.
@@ -219,6 +219,74 @@ TEST(GltfLoader, AssimpCamerasFileGivesPerspectiveCamera) {
     EXPECT_GT(c.vfov_degrees, 0.0f);
     EXPECT_LT(c.vfov_degrees, 180.0f);
   }
+}
+
+// uv' = T·R·S·uv with R = [[cos, sin], [-sin, cos]] (KHR_texture_transform; uvs turn
+// counter-clockwise, the image clockwise as v points down).
+glm::vec2 apply(const TextureRef& ref, glm::vec2 uv) {
+  return glm::vec2(ref.uv_transform * glm::vec3(uv, 1.0f));
+}
+
+TEST(KhrTextureTransform, SpecExampleSelectsTheLowerLeftQuadrant) {
+  // The extension's example: offset [0, 1], rotation π/2, scale 0.5 "utilizes only the
+  // lower left quadrant of the source image, rotated clockwise 90°": the unit square maps
+  // to u in [0, 0.5], v in [0.5, 1] (v down), (0,0) to the image's bottom-left corner.
+  const auto dir = temp_dir("khr_tt_example");
+  const std::string common = write_quad(dir);
+  write_image((dir / "base.png").string(), ImageRGBA(2, 2, glm::vec4(1.0f)));
+  write_text(dir / "t.gltf", R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "extensionsUsed": ["KHR_texture_transform"], "images": [{"uri": "base.png"}], "textures": [{"source": 0}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
+      "extensions": {"KHR_texture_transform": {"offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5]}}}}}], )" +
+                                 common + "}");
+  const Scene s = load_scene((dir / "t.gltf").string());
+  const TextureRef& ref = s.materials[0].base_color_texture;
+  ASSERT_TRUE(ref.valid());
+  const glm::vec2 corners[4][2] = {{{0, 0}, {0, 1}}, {{1, 0}, {0, 0.5f}}, {{1, 1}, {0.5f, 0.5f}}, {{0, 1}, {0.5f, 1}}};
+  for (const auto& [in, out] : corners) {
+    SCOPED_TRACE(::testing::Message() << in.x << "," << in.y);
+    EXPECT_NEAR(apply(ref, in).x, out.x, 1e-6f);
+    EXPECT_NEAR(apply(ref, in).y, out.y, 1e-6f);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(KhrTextureTransform, KhronosTextureTransformTestUvs) {
+  // Khronos' TextureTransformTest: the arrow of "Rotation" and "All" must point at the
+  // green marker, which needs the spec's rotation direction. Expected values by hand.
+  const std::string file = kAssimp + "textureTransform/TextureTransformTest.gltf";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "assimp-testmodels not installed";
+  const Scene s = load_scene(file);
+  auto material = [&](const std::string& name) -> const Material& {
+    for (const Material& m : s.materials)
+      if (m.name == name) return m;
+    ADD_FAILURE() << "no material " << name;
+    return s.materials[0];
+  };
+  auto expect_uv = [](const TextureRef& ref, glm::vec2 in, glm::vec2 out) {
+    SCOPED_TRACE(::testing::Message() << "uv " << in.x << "," << in.y);
+    ASSERT_TRUE(ref.valid());
+    EXPECT_NEAR(apply(ref, in).x, out.x, 1e-5f);
+    EXPECT_NEAR(apply(ref, in).y, out.y, 1e-5f);
+  };
+  // Offsets move the origin.
+  expect_uv(material("Offset U").base_color_texture, {0, 0}, {0.5f, 0});
+  expect_uv(material("Offset V").base_color_texture, {0.25f, 0.25f}, {0.25f, 0.75f});
+  expect_uv(material("Offset UV").base_color_texture, {0.5f, 0.5f}, {1, 1});
+  // Rotation 22.5°: (1,0) → (cos, -sin) = (0.9238795, -0.3826834); (0,1) → (sin, cos).
+  const TextureRef& rotation = material("Rotation").base_color_texture;
+  expect_uv(rotation, {1, 0}, {0.9238795f, -0.3826834f});
+  expect_uv(rotation, {0, 1}, {0.3826834f, 0.9238795f});
+  expect_uv(rotation, {0, 0}, {0, 0});
+  // Scale 1.5.
+  expect_uv(material("Scale").base_color_texture, {1, 1}, {1.5f, 1.5f});
+  // All: S = 1.5, R = 0.3 rad (cos 0.9553365, sin 0.2955202), T = (-0.2, -0.1).
+  // (1,0) → (1.5, 0) → (1.4330048, -0.4432803) → (1.2330048, -0.5432803);
+  // (0,1) → (0, 1.5) → (0.4432803, 1.4330048) → (0.2432803, 1.3330048).
+  const TextureRef& all = material("All").base_color_texture;
+  expect_uv(all, {1, 0}, {1.2330048f, -0.5432803f});
+  expect_uv(all, {0, 1}, {0.2432803f, 1.3330048f});
+  expect_uv(all, {0, 0}, {-0.2f, -0.1f});
 }
 
 }  // namespace

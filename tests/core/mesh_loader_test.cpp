@@ -1,4 +1,4 @@
-// OBJ/PLY/OFF/STL through OpenMesh: the same tetrahedron in four formats loads to the same
+// OBJ (tinyobjloader) and PLY/OFF/STL (OpenMesh): the same tetrahedron in four formats loads to the same
 // geometry, with area-weighted normals matching a hand-computed oracle.
 #include <algorithm>
 #include <cmath>

@@ -1,13 +1,24 @@
 #!/usr/bin/env python3
-"""Regenerates tests/data/good and tests/data/bad: tiny hand-made scene files.
+"""Regenerates tests/data/good, tests/data/bad and tests/data/warn: tiny hand-made scene files.
 
 Each bad file has exactly one defect, named by the file; the core test expects
-InputError naming the file for every file in bad/.
+InputError naming the file for every file in bad/. Each warn file lacks one part (a
+texture, a .mtl) that the loader replaces by a fallback with a warning, or rejects with
+--strict.
 """
-import base64, json, math, os, struct
+import base64, json, math, os, struct, zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-GOOD, BAD = os.path.join(HERE, "good"), os.path.join(HERE, "bad")
+GOOD, BAD, WARN = os.path.join(HERE, "good"), os.path.join(HERE, "bad"), os.path.join(HERE, "warn")
+
+
+def png_rgb8(width, height, pixels):
+    """A minimal 8-bit RGB PNG (no filter) of `pixels`, rows top to bottom."""
+    raw = b"".join(b"\0" + bytes(c for p in pixels[y * width:(y + 1) * width] for c in p) for y in range(height))
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
 
 
 def tri_buffer(positions=None, indices=(0, 1, 2)):
@@ -71,6 +82,7 @@ def write(folder, name, data, mode="wb"):
 def main():
     os.makedirs(GOOD, exist_ok=True)
     os.makedirs(BAD, exist_ok=True)
+    os.makedirs(WARN, exist_ok=True)
     pos, idx = tri_buffer()
     buf = pos + idx
 
@@ -112,13 +124,60 @@ def main():
         d["images"] = [{"uri": "no_such_texture.png"}]
         d["textures"] = [{"source": 0}]
         d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
-    write_gltf(BAD, "missing_texture.gltf", gltf_doc(pos, idx, extra=add_texture), buf)
+    write_gltf(WARN, "missing_texture.gltf", gltf_doc(pos, idx, extra=add_texture), buf)
+
+    def add_undecodable_texture(d):
+        add_texture(d)
+        d["images"] = [{"uri": "not_an_image.png"}]
+    write_gltf(WARN, "undecodable_texture.gltf", gltf_doc(pos, idx, extra=add_undecodable_texture), buf)
 
     def require_draco(d):
         d["extensionsUsed"] = ["KHR_draco_mesh_compression"]
         d["extensionsRequired"] = ["KHR_draco_mesh_compression"]
     write_gltf(BAD, "unsupported_extension.gltf", gltf_doc(pos, idx, extra=require_draco), buf)
     write(BAD, "unsupported_file_type.xyz", "not a scene\n", "w")
+
+    def require_meshopt(d):
+        # As a meshopt-compressed file has it: the view holds compressed bytes in the
+        # extension, and a fallback buffer without a uri.
+        d["extensionsUsed"] = ["EXT_meshopt_compression"]
+        d["extensionsRequired"] = ["EXT_meshopt_compression"]
+        d["bufferViews"][0]["extensions"] = {"EXT_meshopt_compression": {
+            "buffer": 0, "byteLength": 36, "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}}
+    write_gltf(BAD, "meshopt_required.gltf", gltf_doc(pos, idx, extra=require_meshopt), buf)
+
+    def draco_primitive(d):
+        # As a Draco file has it: accessors without bufferViews, the mesh in the extension.
+        require_draco(d)
+        for a in d["accessors"]:
+            del a["bufferView"]
+        d["meshes"][0]["primitives"][0]["extensions"] = {
+            "KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}}
+    write_gltf(BAD, "draco_required.gltf", gltf_doc(pos, idx, extra=draco_primitive), buf)
+
+    def two_unsupported(d):
+        d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression"]
+    write_gltf(BAD, "two_unsupported_extensions.gltf", gltf_doc(pos, idx, extra=two_unsupported), buf)
+
+    # glTF 1.0: objects keyed by id, asset.version "1.0" (and a version-1 binary container).
+    gltf1 = {
+        "asset": {"version": "1.0"},
+        "scene": "defaultScene",
+        "scenes": {"defaultScene": {"nodes": ["node_0"]}},
+        "nodes": {"node_0": {"meshes": ["mesh_0"]}},
+        "meshes": {"mesh_0": {"primitives": [{"attributes": {"POSITION": "accessor_0"}, "mode": 4}]}},
+        "accessors": {"accessor_0": {"bufferView": "bufferView_0", "byteOffset": 0, "componentType": 5126,
+                                     "count": 3, "type": "VEC3"}},
+        "bufferViews": {"bufferView_0": {"buffer": "buffer_0", "byteLength": len(pos), "byteOffset": 0}},
+        "buffers": {"buffer_0": {"byteLength": len(pos), "uri": data_uri(pos)}},
+    }
+    write(BAD, "gltf_1_0.gltf", json.dumps(gltf1, indent=1), "w")
+    js1 = json.dumps(gltf1).encode()
+    js1 += b" " * (-len(js1) % 4)
+    write(BAD, "gltf_1_0.glb", struct.pack("<IIIII", 0x46546C67, 1, 20 + len(js1), len(js1), 0) + js1)
+    no_asset = dict(gltf1)
+    del no_asset["asset"]
+    write(BAD, "gltf_1_0_no_asset.gltf", json.dumps(no_asset, indent=1), "w")
 
     def cycle(d):
         d["nodes"] = [{"mesh": 0, "children": [1]}, {"children": [2]}, {"children": [1]}]
@@ -193,6 +252,30 @@ def main():
     write(BAD, "truncated.stl", stl[:84 + 50 + 10])
     absurd_stl = bytearray(stl); struct.pack_into("<I", absurd_stl, 80, 0xFFFFFFFF)
     write(BAD, "absurd_count.stl", bytes(absurd_stl))
+
+    # ---- OBJ with materials (good) and with missing parts (warn) --------------------
+    # A unit quad in z=0 with uvs, two materials: "painted" (textured, Ns 98, emissive)
+    # and "glass" (d 0.25, Ni 1.33, Pr 0.1, Pm 0.5). checker.png is 2x2: red, green /
+    # blue, grey 128 (rows top to bottom).
+    write(GOOD, "checker.png", png_rgb8(2, 2, [(255, 0, 0), (0, 255, 0), (0, 0, 255), (128, 128, 128)]))
+    quad = ("mtllib quad.mtl\n"
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
+            "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+            "vn 0 0 1\n"
+            "o quad\nusemtl painted\nf 1/1/1 2/2/1 3/3/1 4/4/1\n"
+            "o sliver\nusemtl glass\nf 1 2 5\n")
+    write(GOOD, "quad.obj", quad, "w")
+    write(GOOD, "quad.mtl",
+          "newmtl painted\nKa 0 0 0\nKd 0.5 0.25 1.0\nKs 0.1 0.1 0.1\nNs 98\nKe 0.5 0 2\nillum 2\nmap_Kd checker.png\n\n"
+          "newmtl glass\nKd 1 1 1\nd 0.25\nNi 1.33\nPr 0.1\nPm 0.5\n", "w")
+    write(WARN, "missing_mtl.obj", quad.replace("quad.mtl", "no_such_library.mtl"), "w")
+    write(WARN, "missing_map.obj", quad.replace("quad.mtl", "missing_map.mtl"), "w")
+    write(WARN, "missing_map.mtl", "newmtl painted\nKd 0.5 0.25 1.0\nmap_Kd no_such_map.png\n\nnewmtl glass\nKd 1 1 1\n", "w")
+    write(WARN, "outside_map.obj", quad.replace("quad.mtl", "outside_map.mtl"), "w")
+    write(WARN, "outside_map.mtl", "newmtl painted\nKd 0.5 0.25 1.0\nmap_Kd ../good/checker.png\n\nnewmtl glass\nKd 1 1 1\n", "w")
+    write(WARN, "undecodable_map.obj", quad.replace("quad.mtl", "undecodable_map.mtl"), "w")
+    write(WARN, "undecodable_map.mtl", "newmtl painted\nKd 0.5 0.25 1.0\nmap_Kd not_an_image.png\n\nnewmtl glass\nKd 1 1 1\n", "w")
+    write(WARN, "not_an_image.png", "this is not a PNG\n", "w")
 
 
 if __name__ == "__main__":
