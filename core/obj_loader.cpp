@@ -271,7 +271,7 @@ void check_vertex_lines(const std::string& path, const std::string& text) {
 
 float roughness_from_phong_exponent(float exponent) {
   if (!(exponent > 0.0f)) return 1.0f;
-  return std::clamp(std::pow(2.0f / (exponent + 2.0f), 0.25f), 0.0f, 1.0f);
+  return std::clamp(std::pow(1.0f / (exponent + 1.0f), 0.25f), 0.0f, 1.0f);
 }
 
 Scene load_obj(const std::string& path, LoadReport& report) {

@@ -24,7 +24,7 @@ namespace speculum {
 // Throws InputError(path, problem) for missing, empty or malformed files.
 Scene load_obj(const std::string& path, LoadReport& report);
 
-// Roughness whose Material::phong_exponent is `exponent` (a .mtl Ns): (2 / (n + 2))^(1/4),
+// Roughness whose Material::phong_exponent is `exponent` (a .mtl Ns): (1 / (n + 1))^(1/4),
 // clamped to [0, 1].
 float roughness_from_phong_exponent(float exponent);
 

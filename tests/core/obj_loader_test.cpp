@@ -26,7 +26,7 @@ TEST(ObjMtl, RoughnessFromNsInvertsThePhongExponent) {
     EXPECT_NEAR(m.phong_exponent(), n, n * 1e-4f) << n;
   }
   EXPECT_FLOAT_EQ(roughness_from_phong_exponent(0.0f), 1.0f);  // Ns 0: fully rough
-  EXPECT_NEAR(roughness_from_phong_exponent(98.0f), std::pow(0.02f, 0.25f), 1e-6f);
+  EXPECT_NEAR(roughness_from_phong_exponent(98.0f), std::pow(1.0f / 99.0f, 0.25f), 1e-6f);
 }
 
 TEST(ObjMtl, QuadMaterialsTextureAndUvs) {
