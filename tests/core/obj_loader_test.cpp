@@ -46,7 +46,7 @@ TEST(ObjMtl, QuadMaterialsTextureAndUvs) {
   const Material* painted = find_material(s, "painted");
   ASSERT_NE(painted, nullptr);
   EXPECT_EQ(painted->base_color, glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));  // Kd
-  EXPECT_NEAR(painted->roughness, std::pow(2.0f / 100.0f, 0.25f), 1e-6f);  // Ns 98
+  EXPECT_NEAR(painted->roughness, std::pow(1.0f / 99.0f, 0.25f), 1e-6f);  // Ns 98
   EXPECT_EQ(painted->metallic, 0.0f);
   EXPECT_EQ(painted->emissive, glm::vec3(0.5f, 0.0f, 2.0f));  // Ke
   EXPECT_EQ(painted->transmission, 0.0f);
