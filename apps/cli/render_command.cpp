@@ -73,7 +73,8 @@ void add_render_command(CLI::App& app, GlobalOptions& global) {
   auto* cmd = app.add_subcommand("render", "Render a scene with one technique to PNG or EXR");
   cmd->footer(
       "Example: speculum render glossy-plane --technique envmap --width 800 --height 600 --spp 4 -o out.png\n"
-      "         speculum render sphere-in-room --technique reference --spp 64 -o ref.exr");
+      "         speculum render sphere-in-room --technique reference --spp 64 -o ref.exr\n"
+      "         speculum render model.glb --env sky --view three-quarter -o model.png");
   opts->frame.width = 640;  // render's defaults; inspect and profile use smaller frames
   opts->frame.height = 480;
   opts->frame.exposure = "auto";  // a user's own scene in any units; comparisons pass 1

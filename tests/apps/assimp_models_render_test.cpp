@@ -4,6 +4,7 @@
 // not load fail with one InputError naming the file, never another exception or a crash.
 // In-process (one executor, 64×48 envmap frames), so the whole sweep takes seconds.
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>

@@ -3,6 +3,7 @@
 // of the bounds projects inside the image, each view looks from its axis, bad fields of
 // view are refused.
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>

@@ -2,8 +2,10 @@
 // (apps/cli/frame_options.h apply_light_options): each lights a bare model (non-black image),
 // the same bytes for 1 and 2 threads; a lit scene is left alone; bad values are one line and
 // exit 2.
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include <OpenImageIO/imageio.h>
@@ -12,6 +14,7 @@
 #include "apps/cli/frame_options.h"
 #include "apps/techniques/render_frame.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "core/lighting_presets.h"
 #include "core/scene_loader.h"
 #include "speculum_run.h"
