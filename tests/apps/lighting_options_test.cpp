@@ -118,6 +118,18 @@ TEST(LightingOptions, NoDefaultLightKeepsTheBlackAndLitScenesAreLeftAlone) {
   EXPECT_EQ(lit.scene.lights.size(), plain.lights.size());
   EXPECT_EQ(lit.scene.environment.constant, plain.environment.constant);
   EXPECT_EQ(lit.scene.environment.intensity, plain.environment.intensity);
+  // And the frame through the options at exposure 1 is, byte for byte, the frame of the
+  // scene as built with the settings a recipe gets by default.
+  pipeline::FrameOptions fixed;
+  fixed.exposure = "1";
+  const Rendered via_options = render("sphere-in-room:size=2000", fixed, 2);
+  pipeline::FrameSettings f;
+  f.width = 48;
+  f.height = 36;
+  f.camera = plain.cameras.front();
+  par::Executor ex(2);
+  const ImageRGBA direct = pipeline::render_frame(plain, pipeline::find_technique("envmap"), f, ex).display;
+  EXPECT_TRUE(same_bytes(via_options.display, direct));
 }
 
 TEST(LightingOptions, IntensityScalesAndRotationTurnsTheSceneEnvironment) {
