@@ -13,6 +13,8 @@
 #include "apps/cli/camera_options.h"
 #include "apps/cli/frame_options.h"
 #include "core/error.h"
+#include "core/gltf_writer.h"
+#include "core/image.h"
 #include "core/scene_loader.h"
 #include "speculum_run.h"
 
@@ -140,9 +142,15 @@ TEST(CameraFraming, CommandLineRejectsBadFieldsOfViewAndViews) {
 }
 
 TEST(CameraFraming, AFileCameraAspectRatioSetsTheHeightWhenNoSizeIsGiven) {
-  Scene s = load_scene(SPECULUM_TEST_DATA "/good/tetra.obj");
-  s.cameras[0].framed = false;
-  s.cameras[0].aspect = 2.0f;
+  // A glTF camera with aspectRatio 2 (written by the exporter, read by the loader).
+  Scene mesh = load_scene(SPECULUM_TEST_DATA "/good/tetra.obj");
+  mesh.cameras[0].aspect = 2.0f;
+  const std::filesystem::path dir = test::scratch_dir();
+  write_gltf(mesh, (dir / "wide.gltf").string());
+  const Scene s = load_scene((dir / "wide.gltf").string());
+  ASSERT_EQ(s.cameras.size(), 1u);
+  EXPECT_EQ(s.cameras[0].aspect, 2.0f);
+  EXPECT_FALSE(s.cameras[0].framed);
   pipeline::FrameOptions o;
   o.width = 640;
   o.height = 480;
@@ -163,6 +171,14 @@ TEST(CameraFraming, AFileCameraAspectRatioSetsTheHeightWhenNoSizeIsGiven) {
   f = pipeline::make_frame_settings(given, s);
   EXPECT_EQ(f.width, 64);
   EXPECT_EQ(f.height, 50);
+  // `render` without a size: the default width, the camera's shape.
+  const test::CommandResult r = test::run_speculum(
+      "-q render " + test::sh_quote((dir / "wide.gltf").string()) + " --spp 1 -t envmap --cube-size 8 " +
+          "--shadow-size 16 -o " + test::sh_quote((dir / "wide.png").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const ImageRGBA wide = read_image((dir / "wide.png").string());
+  EXPECT_EQ(wide.width, 640);
+  EXPECT_EQ(wide.height, 320);
 }
 
 }  // namespace
