@@ -28,7 +28,7 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
       ->check(CLI::Range(1, 65536))->capture_default_str();
   cmd.add_option("--seed", o.seed, "Random seed")->capture_default_str();
   cmd.add_option("--exposure", o.exposure,
-                 "Exposure before tone mapping: a multiplier > 0, or auto (meters the frame's "
+                 "Exposure before tone mapping: a multiplier > 0 (1: the radiance unscaled), or auto (meters the frame's "
                  "log-average luminance to middle grey 0.18 and prints the value)")
       ->capture_default_str();
   cmd.add_option("--env", o.env,
