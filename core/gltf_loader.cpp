@@ -474,6 +474,8 @@ struct Loader {
       cam.vfov_degrees = static_cast<float>(glm::degrees(gc.perspective.yfov));
       cam.znear = static_cast<float>(gc.perspective.znear);
       cam.zfar = static_cast<float>(gc.perspective.zfar);
+      if (gc.perspective.aspectRatio > 0.0 && std::isfinite(gc.perspective.aspectRatio))
+        cam.aspect = static_cast<float>(gc.perspective.aspectRatio);
       if (!(cam.zfar > cam.znear)) {
         // Infinite far plane: reach past everything in the scene.
         const Bounds b = scene.bounds();

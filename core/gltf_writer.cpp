@@ -232,6 +232,7 @@ struct Writer {
     g.perspective.yfov = glm::radians(static_cast<double>(c.vfov_degrees));
     g.perspective.znear = c.znear;
     g.perspective.zfar = c.zfar;
+    if (c.aspect > 0.0f) g.perspective.aspectRatio = c.aspect;
     model.cameras.push_back(g);
     tinygltf::Node node;
     node.name = c.name;

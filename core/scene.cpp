@@ -93,14 +93,61 @@ void Scene::validate() const {
   }
 }
 
-Camera framing_camera(const Bounds& bounds) {
+const char* to_string(View view) {
+  switch (view) {
+    case View::Front: return "front";
+    case View::Back: return "back";
+    case View::Left: return "left";
+    case View::Right: return "right";
+    case View::Top: return "top";
+    case View::ThreeQuarter: return "three-quarter";
+  }
+  return "?";
+}
+
+namespace {
+
+// Distance from the centre at which a sphere of `radius` fills the narrower of the two
+// fields of view: the cone of half-angle h holds the sphere iff distance · sin h >= r.
+float fitting_distance(float radius, float vfov_degrees, float aspect) {
+  const float half_v = glm::radians(vfov_degrees) * 0.5f;
+  const float half_h = std::atan(std::max(aspect, 1e-6f) * std::tan(half_v));
+  return radius / std::sin(std::min(half_v, half_h));
+}
+
+}  // namespace
+
+Camera framing_camera(const Bounds& bounds, View view, float aspect, float vfov_degrees) {
   Camera cam;
+  cam.framed = true;
+  cam.vfov_degrees = vfov_degrees;
+  glm::vec3 from(0, 0, 1);
+  switch (view) {
+    case View::Front: from = {0, 0, 1}; break;
+    case View::Back: from = {0, 0, -1}; break;
+    case View::Left: from = {-1, 0, 0}; break;
+    case View::Right: from = {1, 0, 0}; break;
+    case View::Top: from = {0, 1, 0}, cam.up = {0, 0, -1}; break;
+    case View::ThreeQuarter: {
+      const float e = glm::radians(30.0f);
+      from = {std::cos(e) * std::sqrt(0.5f), std::sin(e), std::cos(e) * std::sqrt(0.5f)};
+      break;
+    }
+  }
+  cam.target = glm::vec3(0.0f);
+  cam.eye = from * 5.0f;
   if (!bounds.valid()) return cam;
+  return fit_camera(cam, bounds, aspect);
+}
+
+Camera fit_camera(Camera cam, const Bounds& bounds, float aspect) {
+  if (!bounds.valid() || cam.eye == cam.target) return cam;
+  const glm::vec3 back = glm::normalize(cam.eye - cam.target);
   const glm::vec3 c = bounds.center();
   const float radius = std::max(0.5f * glm::length(bounds.extent()), 1e-3f);
-  const float dist = radius / std::tan(glm::radians(cam.vfov_degrees) * 0.5f) * 1.1f;
+  const float dist = fitting_distance(radius, cam.vfov_degrees, aspect);
   cam.target = c;
-  cam.eye = c + glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)) * dist;
+  cam.eye = c + back * dist;
   const ClipPlanes planes = sphere_clip_planes(dist, radius);
   cam.znear = planes.znear;
   cam.zfar = planes.zfar;

@@ -95,6 +95,8 @@ struct Camera {
   float vfov_degrees = 45.0f;
   float znear = 0.01f;
   float zfar = 1000.0f;
+  float aspect = 0.0f;   // width / height the file asks for (glTF aspectRatio); 0: none
+  bool framed = false;   // made by framing_camera, not read from the file
 };
 
 enum class LightType : std::uint8_t { Point, Spot, Directional };
@@ -148,8 +150,22 @@ struct Scene {
   void validate() const;
 };
 
-// A camera that frames the scene's bounds from the +Z side, slightly above.
-Camera framing_camera(const Bounds& bounds);
+// The directions framing_camera looks from (towards the bounds' centre): front from +Z,
+// back from −Z, left from −X, right from +X, top from +Y (image up −Z), three-quarter from
+// azimuth 45° between +Z and +X at elevation 30°.
+enum class View : std::uint8_t { Front, Back, Left, Right, Top, ThreeQuarter };
+const char* to_string(View view);
+
+// A camera looking at the bounds' centre from `view` whose view cone holds the bounds'
+// bounding sphere (radius r = half the diagonal) for an image of `aspect` = width/height:
+// distance r / sin(min(vfov, hfov)/2), so every corner of the bounds projects inside the
+// image. Clip planes by sphere_clip_planes.
+Camera framing_camera(const Bounds& bounds, View view = View::ThreeQuarter, float aspect = 1.0f,
+                      float vfov_degrees = 45.0f);
+
+// `camera` moved along its own view axis and re-aimed at the bounds' centre so that the
+// bounding sphere fits as in framing_camera (fov, up and direction kept).
+Camera fit_camera(Camera camera, const Bounds& bounds, float aspect);
 
 // Near and far planes around a bounding sphere of radius `radius` whose centre lies
 // `centre_depth` ahead of the eye along the view axis (negative: behind): far = depth + 2r,

@@ -2,6 +2,7 @@
 #include "raster/composite.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
@@ -31,6 +32,29 @@ ImageRGBA resolve_supersamples(par::Executor& executor, const ImageRGBA& samples
     }
   });
   return out;
+}
+
+float meter_exposure(par::Executor& executor, const ImageRGBA& radiance) {
+  struct Sum {
+    double log_sum = 0.0;
+    std::size_t count = 0;
+  };
+  const Sum total = executor.parallel_reduce(
+      "tonemap.meter", radiance.size(), 8192, Sum{},
+      [&](std::size_t begin, std::size_t end) {
+        Sum s;
+        for (std::size_t i = begin; i < end; ++i) {
+          const glm::vec4& p = radiance.pixels[i];
+          const double y = 0.2126 * p.x + 0.7152 * p.y + 0.0722 * p.z;
+          if (std::isfinite(y) && y > 0.0) s.log_sum += std::log(y), ++s.count;
+        }
+        return s;
+      },
+      [](Sum a, const Sum& b) { return Sum{a.log_sum + b.log_sum, a.count + b.count}; });
+  if (total.count == 0) return 1.0f;
+  const double exposure = 0.18 / std::exp(total.log_sum / double(total.count));
+  // A frame of luminance ~1e-38 would overflow the float; keep the value representable.
+  return float(std::clamp(exposure, 1e-30, 1e30));
 }
 
 ImageRGBA tonemap(par::Executor& executor, const ImageRGBA& hdr, float exposure) {

@@ -20,6 +20,14 @@ ImageRGBA resolve_supersamples(par::Executor& executor, const ImageRGBA& samples
 // [0, 1] (1 once exposure × value ≳ 7.24) — the PNG writer applies the sRGB curve.
 ImageRGBA tonemap(par::Executor& executor, const ImageRGBA& hdr, float exposure = 1.0f);
 
+// The automatic exposure of a frame: middle grey over the log-average luminance,
+// 0.18 / exp(mean ln Y), Y = 0.2126 R + 0.7152 G + 0.0722 B (Reinhard et al. 2002,
+// "Photographic Tone Reproduction for Digital Images", §2 eq. 1 with key a = 0.18). Pixels
+// whose Y is not finite or not positive (background against a black environment, NaNs) are
+// left out: they would drag the mean to −∞. 1 when no pixel counts. The sum runs in double
+// over fixed chunks combined in chunk order, so the value does not depend on the threads.
+float meter_exposure(par::Executor& executor, const ImageRGBA& radiance);
+
 // Pass "composite": direct + specular radiance per sample.
 struct CompositePass {
   static constexpr const char* description =
@@ -41,15 +49,23 @@ struct ResolvePass {
   }
 };
 
-// Pass "tonemap": the display image every technique ends with.
+// Pass "tonemap": the display image every technique ends with. With `automatic` the
+// exposure is meter_exposure of the radiance, recorded as the counter "exposure" (the
+// value itself: it is added once).
 struct TonemapPass {
   static constexpr const char* description =
       "Exposure, then the ACES filmic curve: the display image a PNG stores (the same for every "
       "technique, so images compare like for like).";
   float exposure = 1.0f;
-  void parameters(par::Params& p) const { p.set("exposure", exposure); }
+  bool automatic = false;
+  void parameters(par::Params& p) const {
+    if (automatic) p.set("exposure", "auto");
+    else p.set("exposure", exposure);
+  }
   ImageRGBA operator()(par::NodeContext& c, const ImageRGBA& radiance) const {
-    return tonemap(c.executor(), radiance, exposure);
+    const float e = automatic ? meter_exposure(c.executor(), radiance) : exposure;
+    if (automatic) c.count("exposure", e);
+    return tonemap(c.executor(), radiance, e);
   }
 };
 

@@ -45,7 +45,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   const Scene scene = pipeline::is_bench_workload(o.scene) ? pipeline::make_bench_workload(o.scene)
                                                            : load_scene(o.scene);
   if (!o.write_ply.empty()) pipeline::write_ply(o.write_ply, scene);
-  const Camera camera = pipeline::resolve_camera(scene, o.camera);
+  const Camera camera = pipeline::resolve_camera(scene, o.camera, float(o.width) / float(o.height));
   raster::RasterOptions raster_options;
   if (o.cull == "back") raster_options.cull = raster::CullMode::Back;
   else if (o.cull == "front") raster_options.cull = raster::CullMode::Front;

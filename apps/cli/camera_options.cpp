@@ -2,6 +2,7 @@
 #include "apps/cli/camera_options.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 #include "core/camera_rays.h"
@@ -23,11 +24,35 @@ void add_camera_options(CLI::App& cmd, CameraOverrides& o) {
   cmd.add_option("--eye", o.eye, "Camera position x,y,z (overrides the scene camera)");
   cmd.add_option("--target", o.target, "Point looked at x,y,z");
   cmd.add_option("--up", o.up, "Up vector x,y,z");
-  cmd.add_option("--fov", o.fov, "Vertical field of view in degrees");
+  cmd.add_option("--fov", o.fov_text, "Vertical field of view in degrees, in (0, 180)");
+  cmd.add_option("--view", o.view,
+                 "Reframe the scene's bounds from front|back|left|right|top|three-quarter "
+                 "(without a camera in the file: three-quarter)");
+  cmd.add_flag("--fit", o.fit, "Move the camera along its view axis until the scene's bounds fit");
 }
 
-Camera resolve_camera(const Scene& scene, const CameraOverrides& o) {
-  Camera cam = scene.cameras.empty() ? framing_camera(scene.bounds()) : scene.cameras.front();
+View parse_view(const std::string& text) {
+  for (View v : {View::Front, View::Back, View::Left, View::Right, View::Top, View::ThreeQuarter})
+    if (text == to_string(v)) return v;
+  throw InputError("--view", "expected front, back, left, right, top or three-quarter, got '" +
+                                 text + "'");
+}
+
+namespace {
+
+float parse_fov(const std::string& text) {
+  char* end = nullptr;
+  const float v = std::strtof(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !(v > 0.0f && v < 180.0f))
+    throw InputError("--fov", "expected degrees in (0, 180), got '" + text + "'");
+  return v;
+}
+
+}  // namespace
+
+Camera resolve_camera(const Scene& scene, const CameraOverrides& o, float aspect) {
+  const Bounds bounds = scene.bounds();
+  Camera cam = scene.cameras.empty() ? framing_camera(bounds) : scene.cameras.front();
   if (!o.camera.empty()) {
     bool found = false;
     for (const Camera& c : scene.cameras)
@@ -45,9 +70,19 @@ Camera resolve_camera(const Scene& scene, const CameraOverrides& o) {
   if (!o.target.empty()) cam.target = parse_vec3("--target", o.target);
   if (!o.up.empty()) cam.up = parse_vec3("--up", o.up);
   if (o.fov != 0.0f) cam.vfov_degrees = o.fov;
-  // The scene's near/far planes suit where the scene put its camera (a mesh file's framing
-  // camera has them tight around the bounds): a moved or re-aimed camera gets its own.
-  if (!o.eye.empty() || !o.target.empty()) cam = fit_clip_planes(cam, scene.bounds());
+  if (!o.fov_text.empty()) cam.vfov_degrees = parse_fov(o.fov_text);
+  const bool moved = !o.eye.empty() || !o.target.empty();
+  if (!o.view.empty()) {
+    cam = framing_camera(bounds, parse_view(o.view), aspect, cam.vfov_degrees);
+  } else if (o.fit || (cam.framed && !moved)) {
+    // The loader's framing camera assumed a square image; refit it to the real one.
+    validate_camera(cam, "camera options");
+    cam = fit_camera(cam, bounds, aspect);
+  } else if (moved) {
+    // The scene's near/far planes suit where the scene put its camera (a mesh file's framing
+    // camera has them tight around the bounds): a moved or re-aimed camera gets its own.
+    cam = fit_clip_planes(cam, bounds);
+  }
   validate_camera(cam, "camera options");
   return cam;
 }

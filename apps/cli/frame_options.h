@@ -1,5 +1,6 @@
 // The frame options `render`, `inspect` and `profile` share (scene, technique, size, spp,
-// technique parameters, map sizes, camera) and the FrameSettings they make.
+// technique parameters, map sizes, camera, exposure, environment and default light) and the
+// FrameSettings they make.
 #pragma once
 
 #include <string>
@@ -20,7 +21,11 @@ struct FrameOptions {
   int height = 240;
   int spp = 1;
   std::uint32_t seed = 0;
-  float exposure = 1.0f;
+  std::string exposure = "1";  // a multiplier > 0, or "auto" (render's default)
+  std::string env;             // --env FILE|sky|COLOR; empty: the scene's own environment
+  float env_intensity = 1.0f;
+  float env_rotate = 0.0f;     // degrees about +Y
+  bool no_default_light = false;
   float alpha = 0.0f;
   int bounces = 1;
   std::vector<std::string> params;
@@ -28,6 +33,10 @@ struct FrameOptions {
   int shadow_map_size = 512;
   CameraOverrides camera;
   bool strict = false;  // --strict: a missing texture or .mtl is an error, not a warning
+  // Set by add_frame_options: whether --width/--height were given (a file camera's aspect
+  // ratio decides the other side otherwise).
+  const CLI::Option* width_option = nullptr;
+  const CLI::Option* height_option = nullptr;
 };
 
 void add_frame_options(CLI::App& cmd, FrameOptions& options);
@@ -38,6 +47,28 @@ Scene load_frame_scene(const FrameOptions& options, bool quiet);
 
 // Validates (InputError on bad values) and resolves the camera. A square spp is k×k
 // supersampling; other counts reach only sample-based techniques through FrameSettings::spp.
+// Without --width/--height, a file camera's aspect ratio sets the height from the width.
 FrameSettings make_frame_settings(const FrameOptions& options, const Scene& scene);
+
+// --exposure: "auto" (metered by the tonemap pass, raster/composite.h) or a multiplier, finite
+// and > 0. InputError naming --exposure otherwise.
+struct Exposure {
+  bool automatic = false;
+  float value = 1.0f;
+};
+Exposure parse_exposure(const std::string& text);
+
+// --env: "sky" (core/lighting_presets.h clear sky, its sun turned by `rotate_degrees`), a
+// colour "r,g,b" or a grey "v" (linear radiance, finite, >= 0), or an equirect image file
+// (EXR/HDR/PNG/... through OpenImageIO; non-finite pixels rejected, negative ones clamped to
+// 0). Images are turned by `rotate_degrees` about +Y. InputError naming --env or the file.
+Environment parse_environment(const std::string& text, float rotate_degrees = 0.0f);
+
+// Applies --env, --env-intensity and --env-rotate to `scene`, then, when the scene has no
+// light and a black environment and --no-default-light is not given, adds the default
+// studio light (core/lighting_presets.h) placed for `camera`. Returns the warning lines to
+// print ("speculum: warning: SCENE: ..."), empty when nothing was substituted.
+std::vector<std::string> apply_light_options(const FrameOptions& options, Scene& scene,
+                                             const Camera& camera);
 
 }  // namespace speculum::pipeline

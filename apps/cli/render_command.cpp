@@ -34,8 +34,10 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
                                   std::to_string(o.spp));
   if (!ends_with(opts.output, ".png") && !ends_with(opts.output, ".exr"))
     throw InputError(opts.output, "output must end in .png or .exr");
-  const Scene scene = pipeline::load_frame_scene(o, global.quiet);
+  Scene scene = pipeline::load_frame_scene(o, global.quiet);
   const pipeline::FrameSettings f = pipeline::make_frame_settings(o, scene);
+  for (const std::string& warning : pipeline::apply_light_options(o, scene, f.camera))
+    std::fprintf(stderr, "%s\n", warning.c_str());
   par::Executor executor(global.threads, global.lanes);
   par::Graph graph;
   const pipeline::FrameOutputs outputs = technique.add_passes(graph, &scene, f);
@@ -51,9 +53,13 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
   });
   progress.finish();
   write_image(opts.output, graph.get(image));
+  // The metered exposure (the tonemap pass records it; an EXR skips that pass).
+  for (const auto& node : report.nodes)
+    if (const auto it = node.counters.find("exposure"); f.auto_exposure && it != node.counters.end())
+      std::fprintf(stderr, "speculum: exposure auto: %.6g\n", it->second);
   if (!global.quiet)
     std::fprintf(stderr, "speculum: %s %s %dx%d spp %d in %.1f ms\n", technique.name.c_str(),
-                 scene.name.c_str(), o.width, o.height, o.spp, report.duration_ns * 1e-6);
+                 scene.name.c_str(), f.width, f.height, o.spp, report.duration_ns * 1e-6);
   if (opts.timings)
     for (const auto& node : report.nodes)
       std::fprintf(stderr, "  %-20s %9.2f ms\n", node.name.c_str(), node.duration_ns * 1e-6);
@@ -67,9 +73,11 @@ void add_render_command(CLI::App& app, GlobalOptions& global) {
   auto* cmd = app.add_subcommand("render", "Render a scene with one technique to PNG or EXR");
   cmd->footer(
       "Example: speculum render glossy-plane --technique envmap --width 800 --height 600 --spp 4 -o out.png\n"
-      "         speculum render sphere-in-room --technique reference --spp 64 -o ref.exr");
+      "         speculum render sphere-in-room --technique reference --spp 64 -o ref.exr\n"
+      "         speculum render model.glb --env sky --view three-quarter -o model.png");
   opts->frame.width = 640;  // render's defaults; inspect and profile use smaller frames
   opts->frame.height = 480;
+  opts->frame.exposure = "auto";  // a user's own scene in any units; comparisons pass 1
   pipeline::add_frame_options(*cmd, opts->frame);
   cmd->add_option("-o,--output", opts->output, "Output image: .png (tone-mapped) or .exr (linear)")
       ->capture_default_str();

@@ -52,8 +52,10 @@ bool have_graphviz() { return std::system("command -v dot >/dev/null 2>&1") == 0
 
 void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
-  const Scene scene = pipeline::load_frame_scene(o.frame, global.quiet);
+  Scene scene = pipeline::load_frame_scene(o.frame, global.quiet);
   const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
+  for (const std::string& warning : pipeline::apply_light_options(o.frame, scene, settings.camera))
+    std::fprintf(stderr, "%s\n", warning.c_str());
   const fs::path dir = o.output;
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -77,7 +79,7 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
                      {"height", std::to_string(settings.height)},
                      {"spp", std::to_string(settings.spp)},
                      {"seed", std::to_string(settings.seed)},
-                     {"exposure", std::to_string(settings.exposure)},
+                     {"exposure", settings.auto_exposure ? std::string("auto") : std::to_string(settings.exposure)},
                      {"threads", std::to_string(global.threads)}};
   for (const auto& [k, v] : settings.params) report.settings.emplace_back("param " + k, std::to_string(v));
 

@@ -41,7 +41,7 @@ FrameOutputs add_output_passes(par::Graph& g, const FrameSettings& f,
   auto samples = g.add("composite", CompositePass{}, direct, specular);
   FrameOutputs out;
   out.radiance = g.add("resolve", ResolvePass{f.supersample}, samples);
-  out.display = g.add("tonemap", TonemapPass{f.exposure}, out.radiance);
+  out.display = g.add("tonemap", TonemapPass{f.exposure, f.auto_exposure}, out.radiance);
   return out;
 }
 

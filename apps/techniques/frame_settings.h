@@ -25,6 +25,7 @@ struct FrameSettings {
   int cube_map_size = 256;   // per-reflector dynamic environment maps
   int environment_size = 0;  // 0: from the environment image
   float exposure = 1.0f;
+  bool auto_exposure = false;  // meter the frame instead (raster/composite.h meter_exposure)
   float alpha = 0.0f;  // yu-lod: LOD threshold of YU eq.7; 0: LOD off
   int bounces = 1;     // ray-hierarchy and recursive techniques: specular bounces
   // The technique's parameters (`--param name=value`). Technique::add_passes fills in the

@@ -15,7 +15,7 @@ FrameOutputs add_reference_passes(par::Graph& g, const Scene* scene, const Frame
   o.pixel_jitter = f.spp > 1;
   FrameOutputs out;
   out.radiance = g.add("reference_trace", trace::ReferencePass{scene, f.camera, o});
-  out.display = g.add("tonemap", raster::TonemapPass{f.exposure}, out.radiance);
+  out.display = g.add("tonemap", raster::TonemapPass{f.exposure, f.auto_exposure}, out.radiance);
   return out;
 }
 

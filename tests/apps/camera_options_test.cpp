@@ -126,25 +126,37 @@ TEST_F(CameraOptions, EyeInsideTheMeshSeesItAllAround) {
 }
 
 TEST_F(CameraOptions, WithoutEyeOrTargetTheSceneCameraIsKept) {
-  for (const std::string& name : {std::string("sphere-in-room"), std::string("tetra")}) {
-    const Scene scene = name == "tetra" ? tetra_ : load_scene(name);
-    const Camera& c = scene.cameras.front();
-    for (int variant = 0; variant < 3; ++variant) {
-      pipeline::CameraOverrides o;
-      if (variant == 1) o.fov = 30.0f;
-      if (variant == 2) o.up = "0.1,1,0";
-      const Camera r = pipeline::resolve_camera(scene, o);
-      EXPECT_EQ(r.znear, c.znear) << name << " variant " << variant;
-      EXPECT_EQ(r.zfar, c.zfar) << name << " variant " << variant;
-      EXPECT_EQ(r.eye, c.eye) << name;
-    }
+  const Scene scene = load_scene("sphere-in-room");
+  const Camera& c = scene.cameras.front();
+  for (int variant = 0; variant < 3; ++variant) {
+    pipeline::CameraOverrides o;
+    if (variant == 1) o.fov = 30.0f;
+    if (variant == 2) o.up = "0.1,1,0";
+    const Camera r = pipeline::resolve_camera(scene, o);
+    EXPECT_EQ(r.znear, c.znear) << " variant " << variant;
+    EXPECT_EQ(r.zfar, c.zfar) << " variant " << variant;
+    EXPECT_EQ(r.eye, c.eye);
   }
-  // A mesh file's default camera keeps the framing rule it always had, bit for bit.
+}
+
+// A mesh file has no camera: its framing camera is refitted for the image's aspect and
+// field of view (core/scene.h framing_camera), the same for any override of fov and up.
+TEST_F(CameraOptions, AMeshFileIsFramedForTheImage) {
   const Bounds b = tetra_.bounds();
-  const float radius = std::max(0.5f * glm::length(b.extent()), 1e-3f);
-  const float dist = radius / std::tan(glm::radians(45.0f) * 0.5f) * 1.1f;
-  EXPECT_EQ(tetra_.cameras.front().znear, std::max(dist - radius * 1.5f, dist * 1e-3f));
-  EXPECT_EQ(tetra_.cameras.front().zfar, dist + radius * 2.0f);
+  EXPECT_TRUE(tetra_.cameras.front().framed);
+  for (int variant = 0; variant < 2; ++variant) {
+    pipeline::CameraOverrides o;
+    if (variant == 1) o.fov = 30.0f;
+    const Camera r = pipeline::resolve_camera(tetra_, o, 4.0f / 3.0f);
+    const Camera expected = framing_camera(b, View::ThreeQuarter, 4.0f / 3.0f, variant ? 30.0f : 45.0f);
+    EXPECT_EQ(r.eye, expected.eye) << variant;
+    EXPECT_EQ(r.znear, expected.znear) << variant;
+    EXPECT_EQ(r.zfar, expected.zfar) << variant;
+    const float radius = std::max(0.5f * glm::length(b.extent()), 1e-3f);
+    const float dist = radius / std::sin(glm::radians(variant ? 30.0f : 45.0f) * 0.5f);
+    EXPECT_NEAR(glm::length(r.eye - b.center()), dist, dist * 1e-6f);
+    EXPECT_EQ(r.zfar, dist + radius * 2.0f);
+  }
 }
 
 TEST_F(CameraOptions, FitClipPlanesUsesTheNearestBoxCornerForLongBoxes) {

@@ -120,7 +120,8 @@ TEST(Inspect, FinalImageEqualsRender) {
                             sh_quote((dir / "insp").string()),
                         dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  r = run_speculum("-q render " + std::string(kScene) + " " + size + " -o " +
+  // inspect tone-maps at exposure 1; render meters by default.
+  r = run_speculum("-q render " + std::string(kScene) + " " + size + " --exposure 1 -o " +
                        sh_quote((dir / "render.png").string()),
                    dir);
   ASSERT_EQ(r.status, 0) << r.err;
