@@ -25,8 +25,11 @@
 //     peak — and the lookup is scaled by the lobe's directional albedo
 //     specular_reflectance(s, N·V) = E(F0) (core/brdf.h specular_albedo), the split-sum
 //     approximation ∫ f L cos ≈ E · (prefiltered L).
-//   In the mirror limit both reduce to F(N·V) L(R). Rougher surfaces have no indirect
-//   specular.
+//   In the mirror limit both reduce to F(N·V) L(R). Rougher surfaces (r >= kGlossyRoughness)
+//   reflect only the environment with their specular lobe: the techniques read the
+//   prefiltered environment along R scaled by E(F0) (like their ambient diffuse, unshadowed),
+//   the reference samples the lobe with occlusion. So a white dielectric of any roughness
+//   under a uniform environment returns exactly the environment's radiance.
 // - Environment/ambient diffuse: diffuse_albedo_over_pi = what the coupled Lambert lobe
 //   above reflects under uniform light, base (1 − E_dielectric(N·V)) / π, times the
 //   irradiance.
@@ -67,6 +70,9 @@ struct SurfaceParams {
   bool is_refractor() const { return transmission > 0.5f; }
   bool is_mirror_lobe() const { return roughness <= kMirrorRoughness; }
   bool is_glossy_lobe() const { return roughness > kMirrorRoughness && roughness < kGlossyRoughness; }
+  // Too rough for a traced/looked-up reflection: its specular lobe still reflects the
+  // environment (unshadowed in the techniques, occluded in the reference).
+  bool has_rough_specular_lobe() const { return !is_refractor() && roughness >= kGlossyRoughness; }
 };
 
 // The constant factors of a material (no texture lookups).

@@ -4,6 +4,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/camera_rays.h"
+#include "core/optics.h"
 
 namespace speculum::raster {
 
@@ -32,6 +33,9 @@ ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffe
         if (lit > 0.0f) radiance += lit * shade_light(s, n, v, ls);
       }
       radiance += diffuse_albedo_over_pi(s, glm::dot(n, v)) * env.irradiance(n);
+      // The specular lobe of a surface too rough for a reflection pass (core/shading.h).
+      if (s.has_rough_specular_lobe())
+        radiance += specular_reflectance(s, glm::dot(n, v)) * env.radiance(reflect(-v, n), s.phong_exponent);
       out.pixels[i] = glm::vec4(radiance, 1.0f);
     }
   });

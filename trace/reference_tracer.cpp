@@ -23,6 +23,25 @@ namespace {
 
 constexpr std::uint32_t kDimsPerBounce = 8;  // random dimensions reserved per depth level
 
+// A direction from the GGX specular lobe of s (visible normals, α = roughness²) and its
+// weight f_spec cos / p = F(V·H) G2/G1; weight 0 when the sample leaves below the surface.
+struct LobeSample {
+  glm::vec3 direction{0.0f};
+  glm::vec3 weight{0.0f};
+};
+LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u) {
+  const float alpha = s.roughness * s.roughness;
+  const Onb frame(n);
+  const glm::vec3 v_local(glm::dot(v, frame.t), glm::dot(v, frame.b), glm::dot(v, n));
+  if (!(v_local.z > 0.0f)) return {};
+  const glm::vec3 h = frame.to_world(sample_ggx_visible_normal(v_local, alpha, u));
+  const float cos_vh = glm::dot(v, h);
+  const glm::vec3 wi = glm::normalize(2.0f * cos_vh * h - v);
+  const float w = ggx_sample_weight(glm::dot(wi, n), v_local.z, alpha);
+  if (!(w > 0.0f)) return {};
+  return {wi, fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w};
+}
+
 struct Tracer {
   const Scene& scene;
   const Bvh& bvh;
@@ -70,13 +89,21 @@ struct Tracer {
       if (c == glm::vec3(0.0f)) continue;
       if (!occluded(above, ls.direction, ls.distance)) L += c;
     }
-    // Environment light on the diffuse part: f_d L cos / (cos/π) = π f_d L.
+    // Environment light, occluded, on the lobes no specular ray follows: the diffuse lobe
+    // (cosine-sampled, weight f_d cos / (cos/π) = π f_d of the coupled BRDF) and, on rough
+    // surfaces, the specular lobe (visible normals, as the glossy branch below).
     if (opt.environment_lighting) {
-      const glm::vec3 fd = diffuse_albedo_over_pi(s, cos_nv);
-      if (fd != glm::vec3(0.0f)) {
-        const glm::vec3 wi = Onb(n).to_world(sample_cosine_hemisphere({rnd(depth, 0), rnd(depth, 1)}));
-        if (glm::dot(wi, ng) > 0.0f && !occluded(above, wi, std::numeric_limits<float>::infinity()))
-          L += kPi * fd * environment_radiance(scene.environment, wi);
+      const BrdfParams brdf = brdf_params_for_punctual_light(s);
+      const glm::vec3 wi = Onb(n).to_world(sample_cosine_hemisphere({rnd(depth, 0), rnd(depth, 1)}));
+      const glm::vec3 fd = gltf_brdf(brdf, n, wi, v).diffuse;
+      if (fd != glm::vec3(0.0f) && glm::dot(wi, ng) > 0.0f &&
+          !occluded(above, wi, std::numeric_limits<float>::infinity()))
+        L += kPi * fd * environment_radiance(scene.environment, wi);
+      if (s.has_rough_specular_lobe()) {
+        const LobeSample ls = sample_specular_lobe(s, n, v, {rnd(depth, 4), rnd(depth, 5)});
+        if (ls.weight != glm::vec3(0.0f) && glm::dot(ls.direction, ng) > 0.0f &&
+            !occluded(above, ls.direction, std::numeric_limits<float>::infinity()))
+          L += ls.weight * environment_radiance(scene.environment, ls.direction);
       }
     }
     if (depth >= opt.max_depth) {
@@ -103,15 +130,9 @@ struct Tracer {
     } else if (s.is_glossy_lobe()) {
       // The ground truth samples the GGX lobe itself (visible normals), weighted f cos / p
       // = F(V·H) G2/G1 (core/brdf.h): the same BRDF the techniques' lobes are weighted by.
-      const float alpha = s.roughness * s.roughness;
-      const Onb frame(n);
-      const glm::vec3 v_local(glm::dot(v, frame.t), glm::dot(v, frame.b), cos_nv);
-      const glm::vec3 h = frame.to_world(sample_ggx_visible_normal(v_local, alpha, {rnd(depth, 2), rnd(depth, 3)}));
-      const float cos_vh = glm::dot(v, h);
-      const glm::vec3 wi = 2.0f * cos_vh * h - v;
-      const float w = ggx_sample_weight(glm::dot(wi, n), cos_nv, alpha);
-      if (w <= 0.0f || glm::dot(wi, ng) <= 0.0f) ++stats.below_horizon;
-      else L += fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w * trace_dir(above, glm::normalize(wi));
+      const LobeSample ls = sample_specular_lobe(s, n, v, {rnd(depth, 2), rnd(depth, 3)});
+      if (ls.weight == glm::vec3(0.0f) || glm::dot(ls.direction, ng) <= 0.0f) ++stats.below_horizon;
+      else L += ls.weight * trace_dir(above, ls.direction);
     }
     return L;
   }

@@ -37,7 +37,7 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
   Scene scene = pipeline::load_frame_scene(o, global.quiet);
   const pipeline::FrameSettings f = pipeline::make_frame_settings(o, scene);
   for (const std::string& warning : pipeline::apply_light_options(o, scene, f.camera))
-    std::fprintf(stderr, "%s\n", warning.c_str());
+    if (!global.quiet) std::fprintf(stderr, "%s\n", warning.c_str());
   par::Executor executor(global.threads, global.lanes);
   par::Graph graph;
   const pipeline::FrameOutputs outputs = technique.add_passes(graph, &scene, f);
@@ -55,7 +55,8 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
   write_image(opts.output, graph.get(image));
   // The metered exposure (the tonemap pass records it; an EXR skips that pass).
   for (const auto& node : report.nodes)
-    if (const auto it = node.counters.find("exposure"); f.auto_exposure && it != node.counters.end())
+    if (const auto it = node.counters.find("exposure");
+        f.auto_exposure && !global.quiet && it != node.counters.end())
       std::fprintf(stderr, "speculum: exposure auto: %.6g\n", it->second);
   if (!global.quiet)
     std::fprintf(stderr, "speculum: %s %s %dx%d spp %d in %.1f ms\n", technique.name.c_str(),

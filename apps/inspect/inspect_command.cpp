@@ -55,7 +55,7 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   Scene scene = pipeline::load_frame_scene(o.frame, global.quiet);
   const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
   for (const std::string& warning : pipeline::apply_light_options(o.frame, scene, settings.camera))
-    std::fprintf(stderr, "%s\n", warning.c_str());
+    if (!global.quiet) std::fprintf(stderr, "%s\n", warning.c_str());
   const fs::path dir = o.output;
   std::error_code ec;
   fs::create_directories(dir, ec);

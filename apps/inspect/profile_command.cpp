@@ -50,7 +50,7 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
   Scene scene = pipeline::load_frame_scene(o.frame, global.quiet);
   const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
   for (const std::string& warning : pipeline::apply_light_options(o.frame, scene, settings.camera))
-    std::fprintf(stderr, "%s\n", warning.c_str());
+    if (!global.quiet) std::fprintf(stderr, "%s\n", warning.c_str());
   if (!o.output.empty()) {
     std::error_code ec;
     fs::create_directories(o.output, ec);

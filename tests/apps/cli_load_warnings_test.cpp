@@ -33,7 +33,7 @@ TEST(CliLoadWarnings, RenderInspectProfilePrintEachWarningOnce) {
   const CommandResult render = run_speculum("render " + sh_quote(kMissing) + kSmall + " -o " + sh_quote(out.string()), dir);
   EXPECT_EQ(render.status, 0) << render.err;
   EXPECT_EQ(count(render.err, line), 1u) << render.err;
-  EXPECT_EQ(count(render.err, "warning"), 1u) << render.err;
+  EXPECT_EQ(count(render.err, "missing or could not be decoded"), 1u) << render.err;
   EXPECT_TRUE(std::filesystem::exists(out));
   const CommandResult inspect =
       run_speculum("inspect " + sh_quote(kMissing) + kSmall + " -o " + sh_quote((dir / "insp").string()), dir);

@@ -10,6 +10,8 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "core/brdf.h"
+#include "core/optics.h"
 #include "raster/direct_light.h"
 #include "raster/gbuffer.h"
 #include "raster_test_scenes.h"
@@ -206,7 +208,9 @@ TEST(DirectLight, SpotLightConeFalloffAndShadow) {
 
 TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
   // No lights; a constant environment of radiance L has irradiance π·L on every normal, so
-  // the ambient term f_d·E = (1 − F)(1 − metallic) base_color/π · π·L = (1 − F) base_color·L.
+  // the ambient term is f_d·E = (1 − E_d(N·V)) base_color/π · π·L (the coupled Lambert lobe,
+  // core/brdf.h), and a rough surface's specular lobe adds E(F0)·L (every prefiltered level
+  // of a constant environment is L).
   Light unused;
   Scene scene = floor_and_occluder(unused);
   scene.lights.clear();
@@ -222,23 +226,32 @@ TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
     if (!g.covered(i)) continue;
     const SurfaceParams& s = g.surface.pixels[i];
     const float cos_nv = glm::dot(g.normal.pixels[i], g.view_direction(i));
-    const glm::vec3 expected =
-        (glm::vec3(1.0f) - specular_reflectance(s, cos_nv)) * glm::vec3(0.8f, 0.6f, 0.4f) * sky.constant;
+    const float e_d = specular_albedo(cos_nv, brdf_params_for_punctual_light(s).alpha)(fresnel_f0(s.ior));
+    glm::vec3 expected = (1.0f - e_d) * glm::vec3(0.8f, 0.6f, 0.4f) * sky.constant;
+    if (s.has_rough_specular_lobe()) expected += specular_reflectance(s, cos_nv) * sky.constant;
     for (int ch = 0; ch < 3; ++ch)
       EXPECT_NEAR(direct.pixels[i][ch], expected[ch], 0.01f * expected[ch]) << i << " ch " << ch;
     ++checked;
   }
   EXPECT_GT(checked, 1000u);
 
-  // A metal has no diffuse term, hence no SH ambient (its environment light is the
-  // specular layer's).
+  // A metal has no diffuse term, hence no SH ambient: its environment light is the
+  // specular layer's alone, E(base_color)·L when it is too rough for a reflection pass.
   scene.materials[0].metallic = 1.0f;
   const auto [gm, metal] = light_frame(ex, scene, 64, 48, {}, env);
+  std::size_t rough = 0;
   for (std::size_t i = 0; i < metal.size(); ++i) {
-    if (gm.covered(i)) {
-      EXPECT_EQ(glm::vec3(metal.pixels[i]), glm::vec3(0.0f)) << i;
+    if (!gm.covered(i)) continue;
+    const SurfaceParams& s = gm.surface.pixels[i];
+    glm::vec3 expected(0.0f);
+    if (s.has_rough_specular_lobe()) {
+      expected = specular_reflectance(s, glm::dot(gm.normal.pixels[i], gm.view_direction(i))) * sky.constant;
+      ++rough;
     }
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(metal.pixels[i][ch], expected[ch], 0.01f * expected[ch] + 1e-7f) << i << " ch " << ch;
   }
+  EXPECT_GT(rough, 1000u);
 }
 
 }  // namespace

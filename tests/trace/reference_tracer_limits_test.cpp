@@ -113,6 +113,36 @@ TEST(ReferenceTracer, GlossyFurnaceMatchesTheLobeAlbedo) {
   }
 }
 
+// The white furnace of environment lighting: a white dielectric sphere of any roughness
+// under a uniform environment of radiance L returns L at every pixel — its coupled diffuse
+// lobe (occluded, cosine-sampled) and its specular lobe (traced when glossy, environment-
+// sampled when rough) share exactly what arrives (core/brdf.h, core/shading.h).
+TEST(ReferenceTracer, WhiteSphereInAUniformEnvironmentReturnsItsRadiance) {
+  const float L = 0.6f;
+  for (float roughness : {1.0f, 0.7f, 0.3f}) {
+    Scene s;
+    const auto m = add_material(s, glm::vec3(1.0f), 0.0f, roughness);
+    add_sphere(s, glm::vec3(0.0f), 1.0f, 96, 192, m);
+    s.environment.constant = glm::vec3(L);
+    Camera cam;
+    cam.eye = {0, 0, 4};
+    cam.target = {0, 0, 0};
+    cam.vfov_degrees = 14;  // the sphere (half-angle 14.5°) covers the whole 8×8 image
+    ReferenceOptions opt;
+    opt.width = 8;
+    opt.height = 8;
+    opt.spp = 1024;
+    par::Executor ex(2);
+    const ImageRGBA img = render_reference(s, cam, opt, ex);
+    double sum = 0.0;
+    for (const glm::vec4& p : img.pixels) {
+      EXPECT_NEAR(p.x, L, 0.06f * L) << "roughness " << roughness;
+      sum += p.x;
+    }
+    EXPECT_NEAR(sum / double(img.pixels.size()), L, 0.015 * L) << "roughness " << roughness;
+  }
+}
+
 TEST(ReferenceTracer, DepthLimitBetweenFacingMirrors) {
   // Two facing emissive mirrors (z = -1 and z = 1), the camera between them looking down
   // -z with a narrow view: every camera ray bounces between them until the depth limit.
