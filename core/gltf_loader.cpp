@@ -513,13 +513,109 @@ struct Loader {
   }
 };
 
+// JSON nesting deeper than this is rejected before any parser recurses into it (glTF's own
+// schema nests a few levels; extras may nest more, but not thousands).
+constexpr int kMaxJsonDepth = 256;
+
+// One pass over the text, skipping strings: the deepest [ / { nesting.
+void check_json_depth(const std::string& path, const char* json, std::size_t size) {
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (std::size_t i = 0; i < size; ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw InputError(path, "JSON nests deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
+// The glTF 2.0 schema's minimums for the fields that locate bytes (bufferView.schema.json,
+// accessor.schema.json, buffer.schema.json): checked on the JSON itself, because a negative
+// or fractional value would otherwise be converted to an unsigned size by the parser.
+void check_schema_minimums(const std::string& path, const nlohmann::json& doc) {
+  struct Field {
+    const char* array;
+    const char* name;
+    double minimum, maximum;
+    bool required;
+  };
+  static const Field kFields[] = {
+      {"buffers", "byteLength", 1, 9007199254740991.0, true},
+      {"bufferViews", "buffer", 0, 2147483647.0, true},
+      {"bufferViews", "byteOffset", 0, 9007199254740991.0, false},
+      {"bufferViews", "byteLength", 1, 9007199254740991.0, true},
+      {"bufferViews", "byteStride", 4, 252, false},
+      {"accessors", "bufferView", 0, 2147483647.0, false},
+      {"accessors", "byteOffset", 0, 9007199254740991.0, false},
+      {"accessors", "count", 1, 9007199254740991.0, true},
+      {"accessors", "componentType", 5120, 5126, true},
+      {"images", "bufferView", 0, 2147483647.0, false},
+      {"textures", "source", 0, 2147483647.0, false},
+  };
+  for (const Field& f : kFields) {
+    const auto arr = doc.find(f.array);
+    if (arr == doc.end() || !arr->is_array()) continue;
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+      const nlohmann::json& item = (*arr)[i];
+      if (!item.is_object()) throw InputError(path, std::string(f.array) + "[" + std::to_string(i) + "] is not an object");
+      const std::string where = std::string(f.array) + "[" + std::to_string(i) + "]." + f.name;
+      const auto v = item.find(f.name);
+      if (v == item.end()) {
+        if (f.required) throw InputError(path, where + " is missing (required by glTF 2.0)");
+        continue;
+      }
+      const bool integer = v->is_number_integer() || v->is_number_unsigned() ||
+                           (v->is_number_float() && std::floor(v->get<double>()) == v->get<double>());
+      const double x = v->is_number() ? v->get<double>() : 0.0;
+      if (!v->is_number() || !integer || x < f.minimum || x > f.maximum)
+        throw InputError(path, where + " is " + v->dump() + "; glTF 2.0 requires an integer in [" +
+                                   std::to_string(static_cast<long long>(f.minimum)) + ", " +
+                                   std::to_string(static_cast<long long>(f.maximum)) + "]");
+    }
+  }
+}
+
+// An absolute URI (a path from /, or a file: URL) names a file wherever it is; tinygltf
+// would append it to the scene's folder, which hides what the file asked for. Refused
+// unless external files are allowed; relative URIs are checked where they resolve
+// (ExternalFiles).
+void check_uris_are_relative(const std::string& path, const nlohmann::json& doc) {
+  for (const char* array : {"buffers", "images"}) {
+    const auto arr = doc.find(array);
+    if (arr == doc.end() || !arr->is_array()) continue;
+    for (const auto& item : *arr) {
+      if (!item.is_object()) continue;
+      const auto uri = item.find("uri");
+      if (uri == item.end() || !uri->is_string()) continue;
+      const std::string u = uri->get<std::string>();
+      if (u.rfind("data:", 0) == 0) continue;
+      if (!u.empty() && (u[0] == '/' || u[0] == '\\' || u.rfind("file:", 0) == 0 ||
+                         (u.size() > 1 && u[1] == ':')))
+        throw InputError(path, "refers to '" + u + "' outside the scene's folder (--allow-external-files allows it)");
+    }
+  }
+}
+
 // Content this loader cannot read, named before tinygltf parses the file: otherwise a
 // glTF 1.0 file (id-keyed objects where 2.0 has arrays) fails with "no triangles" or a
 // schema complaint, and a Draco or meshopt-compressed one with "invalid bufferView".
 // JSON that does not parse is left to tinygltf, which says where it breaks.
-void check_version_and_required_extensions(const std::string& path, const char* json, std::size_t size) {
+void check_version_and_required_extensions(const std::string& path, const char* json, std::size_t size,
+                                           bool allow_external_files) {
+  check_json_depth(path, json, size);
   const nlohmann::json doc = nlohmann::json::parse(json, json + size, nullptr, false);
   if (!doc.is_object()) return;
+  check_schema_minimums(path, doc);
+  if (!allow_external_files) check_uris_are_relative(path, doc);
   bool version1 = false;
   if (const auto asset = doc.find("asset"); asset != doc.end() && asset->is_object()) {
     if (const auto v = asset->find("version"); v != asset->end()) {
@@ -554,6 +650,47 @@ bool tolerant_image_loader(tinygltf::Image* image, const int index, std::string*
   return true;
 }
 
+// tinygltf's file access for image and buffer URIs: paths are taken literally (tinygltf's
+// default expands them with wordexp, i.e. `~` and `$VAR`), and unless allowed, a file whose
+// real path (after `..` and symlinks) lies outside the scene's folder is neither tested nor
+// read: the first one is remembered and the load fails naming it. Its other candidate, the
+// URI against the current directory, is outside too unless the scene lies there.
+struct ExternalFiles {
+  std::filesystem::path folder;
+  bool allow = false;
+  std::string refused;
+
+  bool inside(const std::string& file) {
+    if (allow) return true;
+    std::error_code ec;
+    const auto root = std::filesystem::weakly_canonical(folder.empty() ? "." : folder, ec);
+    const auto real = std::filesystem::weakly_canonical(file, ec);
+    if (!ec) {
+      const auto rel = real.lexically_relative(root);
+      if (!rel.empty() && *rel.begin() != ".." && !rel.is_absolute()) return true;
+    }
+    // tinygltf also tries the URI against the current directory ("./uri"); that candidate
+    // is never used (URIs resolve against the scene's folder) and not worth naming.
+    const std::string base = folder.string();
+    if (refused.empty() && (base.empty() || file.rfind(base, 0) == 0)) refused = file;
+    return false;
+  }
+  static bool exists(const std::string& file, void* self) {
+    return static_cast<ExternalFiles*>(self)->inside(file) && tinygltf::FileExists(file, nullptr);
+  }
+  static std::string expand(const std::string& file, void*) { return file; }
+  static bool read(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* self) {
+    if (!static_cast<ExternalFiles*>(self)->inside(file)) {
+      if (err) *err += "refused: " + file + "\n";
+      return false;
+    }
+    return tinygltf::ReadWholeFile(out, err, file, nullptr);
+  }
+  static bool refuse_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) {
+    return false;
+  }
+};
+
 // Reads and parses the file (JSON .gltf or binary .glb) and rejects glTF 1.0 and required
 // extensions the loader does not implement.
 tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
@@ -561,12 +698,20 @@ tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
   const bool is_glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".glb" || ext == ".GLB" || is_glb) check_glb_container(path, bytes);
-  if (is_glb) check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()) + 20, le32(&bytes[12]));
-  else check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  const bool allow_external = report && report->allow_external_files;
+  if (is_glb)
+    check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()) + 20, le32(&bytes[12]),
+                                          allow_external);
+  else
+    check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()), bytes.size(),
+                                          allow_external);
 
   tinygltf::TinyGLTF parser;
   // No user data: tinygltf's decoder then uses its default options, as without a loader.
   parser.SetImageLoader(tolerant_image_loader, nullptr);
+  ExternalFiles external{std::filesystem::path(path).parent_path(), allow_external, {}};
+  parser.SetFsCallbacks(tinygltf::FsCallbacks{&ExternalFiles::exists, &ExternalFiles::expand,
+                                               &ExternalFiles::read, &ExternalFiles::refuse_write, &external});
   tinygltf::Model model;
   std::string err, warn;
   const std::string base_dir = std::filesystem::path(path).parent_path().string();
@@ -576,6 +721,9 @@ tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
              : parser.LoadASCIIFromString(&model, &err, &warn,
                                           reinterpret_cast<const char*>(bytes.data()),
                                           static_cast<unsigned>(bytes.size()), base_dir);
+  if (!external.refused.empty())
+    throw InputError(path, "refers to '" + external.refused +
+                               "' outside the scene's folder (--allow-external-files allows it)");
   if (!ok) throw InputError(path, one_line(err.empty() ? "tinygltf could not parse the file" : err));
   // tinygltf's warnings, one per line; those about images it could not load are left to
   // MaterialTable, which names the texture once and only when a material uses it.

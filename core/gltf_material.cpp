@@ -71,12 +71,8 @@ MaterialTable::MaterialTable(const std::string& path, const tinygltf::Model& mod
 std::uint32_t MaterialTable::scene_material(int index) {
   if (index < 0) {
     if (default_material_ < 0) {
-      Material m;
-      m.name = "default";
-      m.metallic = 0.0f;
-      m.roughness = 0.8f;
       default_material_ = static_cast<int>(scene_.materials.size());
-      scene_.materials.push_back(m);
+      scene_.materials.push_back(default_material());
     }
     return static_cast<std::uint32_t>(default_material_);
   }

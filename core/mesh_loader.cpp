@@ -242,11 +242,7 @@ void add_single_object(const std::string& path, Scene& scene) {
   const std::size_t nt = scene.mesh.triangle_count();
   scene.mesh.triangle_material.assign(nt, 0);
   scene.mesh.triangle_object.assign(nt, 0);
-  Material m;
-  m.name = "default";
-  m.metallic = 0.0f;
-  m.roughness = 0.5f;
-  scene.materials.push_back(m);
+  scene.materials.push_back(default_material());
   Object obj;
   obj.name = std::filesystem::path(path).stem().string();
   obj.triangle_count = static_cast<std::uint32_t>(nt);

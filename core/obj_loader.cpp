@@ -90,14 +90,14 @@ struct StatedKeys {
 // and remembers each material's folder (its textures resolve against it) and stated keys.
 class MtlReader : public tinyobj::MaterialReader {
  public:
-  explicit MtlReader(const fs::path& obj_dir) : dir_(obj_dir) {}
+  MtlReader(const fs::path& obj_dir, bool allow_outside) : dir_(obj_dir), allow_outside_(allow_outside) {}
   ~MtlReader() override = default;
 
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* names, std::string*, std::string*) override {
     const fs::path file = dir_ / as_path(name);
     std::error_code ec;
-    if (!inside(file, dir_)) {
+    if (!allow_outside_ && !inside(file, dir_)) {
       problems_.push_back("material library '" + name + "' lies outside the OBJ's folder: ignored");
       return false;
     }
@@ -147,6 +147,7 @@ class MtlReader : public tinyobj::MaterialReader {
 
  private:
   fs::path dir_;
+  bool allow_outside_ = false;
   std::vector<std::string> problems_;
   std::vector<fs::path> folders_;
   std::vector<StatedKeys> keys_;
@@ -197,7 +198,7 @@ class MtlConverter {
     if (auto it = cache_.find(file.string()); it != cache_.end()) return it->second;
     int index = -1;
     std::error_code ec;
-    if (!inside(file, dir_)) {
+    if (!report_.allow_external_files && !inside(file, dir_)) {
       report_.substitute(path_, "texture '" + name + "' lies outside the OBJ's folder: drawn without it");
     } else if (!fs::is_regular_file(file, ec)) {
       report_.substitute(path_, "texture '" + name + "' not found: drawn without it");
@@ -288,7 +289,7 @@ Scene load_obj(const std::string& path, LoadReport& report) {
   std::istringstream in(text);
 
   const fs::path dir = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
-  MtlReader reader(dir);
+  MtlReader reader(dir, report.allow_external_files);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
@@ -336,12 +337,8 @@ Scene load_obj(const std::string& path, LoadReport& report) {
   auto scene_material = [&](int id) -> std::uint32_t {
     if (id < 0 || static_cast<std::size_t>(id) >= materials.size()) {
       if (default_material < 0) {
-        Material m;
-        m.name = "default";
-        m.metallic = 0.0f;
-        m.roughness = 0.5f;
         default_material = static_cast<int>(scene.materials.size());
-        scene.materials.push_back(m);
+        scene.materials.push_back(speculum::default_material());
       }
       return static_cast<std::uint32_t>(default_material);
     }

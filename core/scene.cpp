@@ -37,6 +37,14 @@ MaterialKind Material::kind() const {
   return MaterialKind::Diffuse;
 }
 
+Material default_material() {
+  Material m;
+  m.name = "default";
+  m.metallic = 0.0f;
+  m.roughness = 0.8f;
+  return m;
+}
+
 float Material::phong_exponent() const {
   const float alpha = roughness * roughness;
   if (!(alpha > 1e-3f)) return 1e6f;  // a mirror: the exponent's cap exactly

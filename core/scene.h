@@ -58,6 +58,11 @@ struct Material {
   float phong_exponent() const;
 };
 
+// The material of geometry that names none (glTF primitives without a material, OBJ faces
+// without usemtl): a white, rough dielectric. (glTF's own default is a rough metal, which
+// renders black under most lighting; a neutral dielectric shows the shape.)
+Material default_material();
+
 // Roughness thresholds for MaterialKind (documented once, used everywhere).
 constexpr float kMirrorRoughness = 0.02f;   // at or below: mirror
 constexpr float kGlossyRoughness = 0.6f;    // below (and smooth enough / metallic): glossy

@@ -102,13 +102,7 @@ bool is_builtin_scene_name(const std::string& file_or_name) {
 }
 
 void finish_scene(Scene& scene) {
-  if (scene.materials.empty()) {
-    Material m;
-    m.name = "default";
-    m.metallic = 0.0f;
-    m.roughness = 0.8f;
-    scene.materials.push_back(m);
-  }
+  if (scene.materials.empty()) scene.materials.push_back(default_material());
   if (scene.cameras.empty()) scene.cameras.push_back(framing_camera(scene.bounds()));
   for (const Camera& c : scene.cameras) validate_camera(c, scene.name);
   scene.validate();
@@ -121,6 +115,7 @@ Scene load_scene(const std::string& file_or_name, const SceneOptions& options) {
   LoadReport local;
   LoadReport* report = options.report ? options.report : &local;
   report->strict = report->strict || options.strict;
+  report->allow_external_files = report->allow_external_files || options.allow_external_files;
   Scene scene;
   if (ext == ".gltf" || ext == ".glb") {
     scene = load_gltf(file_or_name, report);

@@ -18,6 +18,10 @@ struct LoadReport {
   // --strict: content the loader would replace by a fallback (a missing or undecodable
   // texture, a missing .mtl file) is an InputError instead of a warning.
   bool strict = false;
+  // --allow-external-files: a file a scene refers to (glTF image or buffer URI, OBJ .mtl or
+  // texture) may lie outside the scene file's folder. Off by default: a service rendering
+  // submitted scenes must not read the rest of the disk.
+  bool allow_external_files = false;
   void warn(std::string message);
   // A missing or unreadable part of `source` replaced by a documented fallback: a warning,
   // or InputError(source, message) when strict.
@@ -30,6 +34,7 @@ struct SceneOptions {
   std::uint64_t size = 0;
   LoadReport* report = nullptr;  // optional: receives warnings
   bool strict = false;           // see LoadReport::strict (sets report->strict too)
+  bool allow_external_files = false;  // see LoadReport::allow_external_files
 };
 
 // Loads `file_or_name`: a path ending in .gltf/.glb/.obj/.ply/.off/.stl, or a built-in

@@ -58,6 +58,9 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
   cmd.add_flag("--strict", o.strict,
                "A missing or undecodable texture, or a missing .mtl file, is an error (exit 2)\n"
                "instead of a warning with the texture or material left out");
+  cmd.add_flag("--allow-external-files", o.allow_external_files,
+               "Let the scene's image/buffer URIs and .mtl files point outside the scene\n"
+               "file's folder (refused by default: one line, exit 2 for glTF)");
   // The technique parameters, from the technique table (after the command's own footer).
   std::string params = "\n\nTechnique parameters (--param name=value; default, [valid range]):";
   for (const Technique& t : techniques())
@@ -71,6 +74,7 @@ Scene load_frame_scene(const FrameOptions& o, bool quiet) {
   SceneOptions so;
   so.report = &report;
   so.strict = o.strict;
+  so.allow_external_files = o.allow_external_files;
   Scene scene = load_scene(name, so);
   if (!quiet)
     for (const std::string& w : report.warnings)

@@ -32,6 +32,7 @@ struct FrameOptions {
   int cube_map_size = 256;
   int shadow_map_size = 512;
   CameraOverrides camera;
+  bool allow_external_files = false;  // --allow-external-files
   bool strict = false;  // --strict: a missing texture or .mtl is an error, not a warning
   // Set by add_frame_options: whether --width/--height were given (a file camera's aspect
   // ratio decides the other side otherwise).
