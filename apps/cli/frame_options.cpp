@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <map>
+#include <string>
 
 #include "core/error.h"
 
@@ -13,7 +15,10 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
                                    "default built-in scene)");
   cmd.add_option("--technique,-t", o.technique, "Technique (see `speculum techniques`)")
       ->capture_default_str();
-  cmd.add_option("--width", o.width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
+  cmd.add_option("--width", o.width,
+                 "Image width; width × height × spp at most 2^23 samples for the rasterized "
+                 "techniques (~190 bytes each), 2^26 for reference and yu-lod")
+      ->check(CLI::Range(1, 16384))->capture_default_str();
   cmd.add_option("--height", o.height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd.add_option("--spp", o.spp, "Samples per pixel (a square is k×k supersampling for feed-forward techniques)")
       ->check(CLI::Range(1, 65536))->capture_default_str();
@@ -26,10 +31,13 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
       ->check(CLI::Range(1, 16))->capture_default_str();
   cmd.add_option("--param", o.params,
                  "Technique parameter name=value, repeatable (see `speculum techniques`)");
-  cmd.add_option("--cube-size", o.cube_map_size, "Side of the per-reflector cube maps")
-      ->check(CLI::Range(1, 4096))->capture_default_str();
+  // The maxima bound memory: living-room (the built-in scene with most reflectors) peaks
+  // near 2.1 GB at --cube-size 1024 (7.8 GB at 2048) and 1.7 GB at --shadow-size 4096 (6.2 GB
+  // at 8192).
+  cmd.add_option("--cube-size", o.cube_map_size, "Side of the per-reflector cube maps (~2 GB for many reflectors at 1024)")
+      ->check(CLI::Range(1, 1024))->capture_default_str();
   cmd.add_option("--shadow-size", o.shadow_map_size, "Side of the shadow maps")
-      ->check(CLI::Range(1, 8192))->capture_default_str();
+      ->check(CLI::Range(1, 4096))->capture_default_str();
   add_camera_options(cmd, o.camera);
   // The technique parameters, from the technique table (after the command's own footer).
   std::string params = "\n\nTechnique parameters (--param name=value; default, [valid range]):";
@@ -38,14 +46,45 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
   cmd.footer(cmd.get_footer() + params);
 }
 
+std::map<std::string, double> check_frame_options(const FrameOptions& o) {
+  const Technique& technique = find_technique(o.technique);
+  // Memory grows with the samples a rasterized frame keeps (visibility, G-buffer and layers:
+  // ~190 bytes each, ~500 for ray-hierarchy's ray streams), so 2^23 caps it at a few GB
+  // (1080p at 4 spp fits); the reference tracer and yu-lod keep only pixels and pay for
+  // samples in time, so 2^26 paths or rays (about two minutes on two cores) is theirs.
+  const bool sampled = technique.name == "reference" || technique.name == "yu-lod";
+  const double samples = double(o.width) * double(o.height) * double(o.spp);
+  const double limit = sampled ? double(1 << 26) : double(1 << 23);
+  if (samples > limit)
+    throw InputError("--width/--height/--spp",
+                     std::to_string(o.width) + "×" + std::to_string(o.height) + " at " + std::to_string(o.spp) +
+                         " spp is " + std::to_string(static_cast<long long>(samples)) + " samples; " +
+                         technique.name + " takes at most " + std::to_string(static_cast<long long>(limit)) +
+                         (sampled ? " (2^26)" : " (2^23)"));
+  std::map<std::string, double> params;
+  for (const std::string& item : o.params) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--param", "expected name=number, got '" + item + "'");
+    const std::string name = item.substr(0, eq), text = item.substr(eq + 1);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0')
+      throw InputError("--param " + name, "'" + text + "' is not a number");
+    if (!std::isfinite(v)) throw InputError("--param " + name, "'" + text + "' is not a finite number");
+    params[name] = v;
+  }
+  check_technique_params(technique, params);
+  return params;
+}
+
 FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
   // A square spp is k×k supersampling for feed-forward techniques; any other count only
   // reaches sample-based techniques (reference, yu-lod) through FrameSettings::spp.
   int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
   if (k * k != o.spp) k = 1;
-  if (double(o.width) * o.height * o.spp > double(1 << 26))
-    throw InputError("--width/--height/--spp", "more than 67M samples");
   FrameSettings f;
+  f.params = check_frame_options(o);
   f.width = o.width;
   f.height = o.height;
   f.supersample = k;
@@ -56,16 +95,6 @@ FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
   f.bounces = o.bounces;
   f.cube_map_size = o.cube_map_size;
   f.shadow_map_size = o.shadow_map_size;
-  for (const std::string& item : o.params) {
-    const auto eq = item.find('=');
-    char* end = nullptr;
-    const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
-    if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0' ||
-        !std::isfinite(v))
-      throw InputError("--param", "expected name=number, got '" + item + "'");
-    f.params[item.substr(0, eq)] = v;
-  }
-  check_technique_params(find_technique(o.technique), f.params);
   f.camera = resolve_camera(scene, o.camera);
   return f;
 }

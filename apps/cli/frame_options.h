@@ -2,6 +2,7 @@
 // technique parameters, map sizes, camera) and the FrameSettings they make.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,13 @@ struct FrameOptions {
 
 void add_frame_options(CLI::App& cmd, FrameOptions& options);
 
-// Validates (InputError on bad values) and resolves the camera. A square spp is k×k
-// supersampling; other counts reach only sample-based techniques through FrameSettings::spp.
+// What can be checked before the scene is loaded: the frame's sample count against its
+// limit and the technique parameters (parsed). Throws InputError naming the option.
+std::map<std::string, double> check_frame_options(const FrameOptions& options);
+
+// Validates (InputError on bad values; check_frame_options included) and resolves the
+// camera. A square spp is k×k supersampling; other counts reach only sample-based techniques
+// through FrameSettings::spp.
 FrameSettings make_frame_settings(const FrameOptions& options, const Scene& scene);
 
 }  // namespace speculum::pipeline

@@ -16,6 +16,7 @@
 #include "apps/techniques/render_frame.h"
 #include "apps/cli/progress.h"
 #include "core/error.h"
+#include "core/output_file.h"
 #include "core/scene_loader.h"
 
 namespace speculum::cli {
@@ -37,9 +38,7 @@ std::string safe(const std::string& s) {
 }
 
 void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out) throw InputError(path.string(), "cannot write");
+  write_text_file(path.string(), text);  // whole or nothing, with the real reason on failure
 }
 
 std::string shell_quote(const std::string& s) {

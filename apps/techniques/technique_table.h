@@ -34,7 +34,8 @@ struct Technique {
   FrameOutputs add_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings) const {
     return recipe(graph, scene, with_defaults(settings));
   }
-  // "rounds=3 [1, 16] reflector map rounds" lines, one per parameter; "" when it has none.
+  // "rounds=3  integer in [1, 16]  reflector map rounds" lines, one per parameter; "" when
+  // it has none.
   std::string describe_params(const std::string& indent) const;
 };
 
