@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "tests/apps/speculum_run.h"
@@ -19,12 +20,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Threads of process `pid` (from /proc): the executor's workers exist once rendering began.
-int thread_count(pid_t pid) {
-  std::error_code ec;
-  int n = 0;
-  for (const auto& e : fs::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) (void)e, ++n;
-  return n;
+// Whether process `pid` catches SIGINT yet (the SigCgt mask of /proc/PID/status): true once
+// speculum's main has installed its handler.
+bool catches_sigint(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1;
+  return false;
 }
 
 TEST(Interrupt, SigintStopsARenderWithoutWritingAnything) {
@@ -43,11 +45,11 @@ TEST(Interrupt, SigintStopsARenderWithoutWritingAnything) {
             "--width", "128", "--height", "128", "-o", out.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  // Wait until the executor's worker threads exist (the handler is installed long before),
-  // or the process has ended on its own (then the test fails below).
+  // Wait until the handler is installed (a signal before that would kill the process like
+  // any program's), or the process has ended on its own (then the test fails below).
   int status = 0;
   bool ended = false;
-  while (thread_count(pid) < 2) {
+  while (!catches_sigint(pid)) {
     if (::waitpid(pid, &status, WNOHANG) == pid) {
       ended = true;
       break;
