@@ -40,7 +40,7 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
       ->check(CLI::Range(1, 4096))->capture_default_str();
   add_camera_options(cmd, o.camera);
   // The technique parameters, from the technique table (after the command's own footer).
-  std::string params = "\n\nTechnique parameters (--param name=value; default, [valid range]):";
+  std::string params = "\n\nTechnique parameters (--param name=value: default, type and valid range, meaning):";
   for (const Technique& t : techniques())
     if (!t.params.empty()) params += "\n  " + t.name + "\n" + t.describe_params("    ");
   cmd.footer(cmd.get_footer() + params);
@@ -70,8 +70,8 @@ std::map<std::string, double> check_frame_options(const FrameOptions& o) {
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
     if (text.empty() || *end != '\0')
-      throw InputError("--param " + name, "'" + text + "' is not a number");
-    if (!std::isfinite(v)) throw InputError("--param " + name, "'" + text + "' is not a finite number");
+      throw InputError("--param " + name, "expected a number, got '" + item + "'");
+    if (!std::isfinite(v)) throw InputError("--param " + name, "expected a finite number, got '" + item + "'");
     params[name] = v;
   }
   check_technique_params(technique, params);

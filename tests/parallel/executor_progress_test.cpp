@@ -47,12 +47,12 @@ TEST(ExecutorProgress, CountsAreMonotonicAndReachTheTotalOnAnyThreadCount) {
     // A poller, as the progress bar's: every read must be >= the previous and consistent.
     std::thread poller([&] {
       WorkCount last;
-      while (!stop.load()) {
+      do {
         const WorkCount w = ex.work();
         if (w.done < last.done || w.launched < last.launched || w.done > w.launched) ++violations;
         last = w;
         ++polls;
-      }
+      } while (!stop.load());
     });
     std::uint64_t expected = 0;
     for (std::size_t n : {0u, 1u, 1000u, 123'457u}) {
