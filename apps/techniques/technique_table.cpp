@@ -79,8 +79,9 @@ const std::vector<Technique>& techniques() {
        "mirror plane, scene clipped at the plane, recursive; other specular surfaces as envmap",
        add_planar_mirror_passes,
        // Each level renders the frame again per mirror seen: m mirrors that see each other
-       // cost up to (m-1)^depth views, so the depth stays small.
-       {{"depth", 3, 0, 8, true, "mirror bounces rendered by reflected cameras (up to (m-1)^depth views)"}}},
+       // cost up to (m-1)^depth views, so the depth stays small and the pass renders at most
+       // 256 mirrored views in all (PlanarMirrorSettings::max_views, counted when reached).
+       {{"depth", 3, 0, 8, true, "mirror bounces rendered by reflected cameras (at most 256 views in all)"}}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",
