@@ -111,7 +111,10 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
 
   par::Executor executor(global.threads, global.lanes);
   executor.clear_launches();
-  const pipeline::FrameResult frame = pipeline::render_frame(scene, technique, settings, executor, capture);
+  const pipeline::FrameResult frame = [&] {
+    WorkPoller poller(executor, progress);  // the bar moves inside long passes too
+    return pipeline::render_frame(scene, technique, settings, executor, capture);
+  }();
   progress.finish();
   const auto launches = executor.launches();
   report.frame_ms = frame.report.duration_ns * 1e-6;

@@ -55,6 +55,7 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
   }
   par::Executor executor(global.threads, global.lanes);
   Progress progress("profile " + technique.name, std::size_t(o.warmup + o.repeat), global.quiet);
+  WorkPoller poller(executor, progress);  // the bar moves inside long frames too
   for (int i = 0; i < o.warmup; ++i) {
     pipeline::render_frame(scene, technique, settings, executor);
     progress.step("warm-up");
