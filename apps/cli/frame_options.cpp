@@ -16,8 +16,8 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
   cmd.add_option("--technique,-t", o.technique, "Technique (see `speculum techniques`)")
       ->capture_default_str();
   cmd.add_option("--width", o.width,
-                 "Image width; width × height × spp at most 2^23 samples for the rasterized "
-                 "techniques (~190 bytes each), 2^26 for reference and yu-lod")
+                 "Image width; width × height × spp at most 2^23 samples (2^22 for ray-hierarchy, "
+                 "2^26 for reference and yu-lod) to bound memory")
       ->check(CLI::Range(1, 16384))->capture_default_str();
   cmd.add_option("--height", o.height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd.add_option("--spp", o.spp, "Samples per pixel (a square is k×k supersampling for feed-forward techniques)")
@@ -48,19 +48,16 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
 
 std::map<std::string, double> check_frame_options(const FrameOptions& o) {
   const Technique& technique = find_technique(o.technique);
-  // Memory grows with the samples a rasterized frame keeps (visibility, G-buffer and layers:
-  // ~190 bytes each, ~500 for ray-hierarchy's ray streams), so 2^23 caps it at a few GB
-  // (1080p at 4 spp fits); the reference tracer and yu-lod keep only pixels and pay for
-  // samples in time, so 2^26 paths or rays (about two minutes on two cores) is theirs.
-  const bool sampled = technique.name == "reference" || technique.name == "yu-lod";
+  // The technique's sample limit bounds memory (rasterized frames keep every sample) or time
+  // (reference and yu-lod keep pixels); see Technique::max_samples.
   const double samples = double(o.width) * double(o.height) * double(o.spp);
-  const double limit = sampled ? double(1 << 26) : double(1 << 23);
-  if (samples > limit)
+  if (samples > technique.max_samples)
     throw InputError("--width/--height/--spp",
                      std::to_string(o.width) + "×" + std::to_string(o.height) + " at " + std::to_string(o.spp) +
                          " spp is " + std::to_string(static_cast<long long>(samples)) + " samples; " +
-                         technique.name + " takes at most " + std::to_string(static_cast<long long>(limit)) +
-                         (sampled ? " (2^26)" : " (2^23)"));
+                         technique.name + " takes at most " +
+                         std::to_string(static_cast<long long>(technique.max_samples)) + " (2^" +
+                         std::to_string(std::ilogb(technique.max_samples)) + ")");
   std::map<std::string, double> params;
   for (const std::string& item : o.params) {
     const auto eq = item.find('=');

@@ -52,7 +52,8 @@ const std::vector<Technique>& techniques() {
        "reference tracer: BVH ray tracing, Whitted mirrors/refraction, Phong-lobe glossy "
        "sampling (--spp path samples); the ground truth",
        add_reference_passes,
-       {}},
+       {},
+       double(1 << 26)},  // paths cost time only (memory is per pixel): about two minutes on two cores
       {"distance-map",
        "distance maps (SURVEY §4.1-4.2): per-reflector colour+distance cube, searched per sample",
        add_distance_map_passes, search_params()},
@@ -97,7 +98,8 @@ const std::vector<Technique>& techniques() {
        add_yu_lod_passes,
        // The bake traces triangles × env_samples rays; 256 already brings its noise to 1/16
        // of a single ray's (σ/√n).
-       {{"env_samples", 8, 0, 256, true, "sky rays per triangle in the radiance bake (time ∝ triangles × samples)"}}},
+       {{"env_samples", 8, 0, 256, true, "sky rays per triangle in the radiance bake (time ∝ triangles × samples)"}},
+       double(1 << 26)},  // glossy rays, ~32 bytes each in flight: ~2 GB at the limit
       {"ray-hierarchy",
        "ROGER ch.3 ray hierarchy: one reflected/refracted ray per specular pixel through a "
        "screen-space cone-sphere quad-tree over stream compaction, exact closest hits; --bounces B",
@@ -105,7 +107,8 @@ const std::vector<Technique>& techniques() {
        // The pair buffer takes ≈ 10 bytes per pair at its fullest: 2^26 pairs ≈ 0.7 GB. A
        // smaller capacity costs nothing but batches (the same hits, ROGER §4.3).
        {{"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
-        {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}}},
+        {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
+       double(1 << 22)},  // ~770 bytes per pixel of ray streams and hierarchy: ~3.3 GB at the limit
   };
   return table;
 }

@@ -26,6 +26,10 @@ struct Technique {
   std::string summary;  // one line
   std::function<FrameOutputs(par::Graph&, const Scene*, const FrameSettings&)> recipe;
   std::vector<TechniqueParam> params;
+  // The most samples (width × height × spp) a frame may take. Rasterized frames keep every
+  // sample (visibility, G-buffer, layers: memory); the sampled ones keep pixels and pay for
+  // samples in time. Each figure is set from the technique's measured peak.
+  double max_samples = double(1 << 23);
 
   // `settings` with every parameter of the table present (defaults where not given).
   // Throws InputError for an unknown, out-of-range or fractional-where-whole parameter.

@@ -84,6 +84,12 @@ TEST(CliErrors, AbsurdSizesAreRejectedUpFrontNamingTheLimit) {
   EXPECT_TRUE(contains(one_line_error("render --spp 1000000 -q -o x.png", dir), "--spp"));
   const std::string samples = one_line_error("render --width 16384 --height 16384 -q -o x.png", dir);
   EXPECT_TRUE(contains(samples, "samples")) << samples;
+  // Each technique's own limit (Technique::max_samples), named in the message.
+  EXPECT_TRUE(contains(samples, "envmap takes at most 8388608 (2^23)")) << samples;
+  const std::string rays = one_line_error("render -t ray-hierarchy --width 4096 --height 2048 -q -o x.png", dir);
+  EXPECT_TRUE(contains(rays, "ray-hierarchy takes at most 4194304 (2^22)")) << rays;
+  const std::string paths = one_line_error("render -t reference --width 16384 --height 16384 -q -o x.png", dir);
+  EXPECT_TRUE(contains(paths, "reference takes at most 67108864 (2^26)")) << paths;
   EXPECT_TRUE(contains(one_line_error("render sphere-in-room:size=1e13 -q -o x.png", dir), "size"));
   EXPECT_FALSE(fs::exists(dir / "x.png"));
 }
