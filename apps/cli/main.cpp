@@ -21,7 +21,8 @@ extern "C" void on_sigint(int) {
   std::signal(SIGINT, SIG_DFL);
 }
 
-// CLI11's message on one line: its own newlines folded, and the hint that follows it dropped.
+// CLI11's message on one line (its own newlines folded; app.exit's "Run with --help" line is
+// replaced by a short hint).
 std::string one_line(std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
   for (char& c : text)
