@@ -15,6 +15,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "core/error.h"
+#include "core/output_file.h"
 #include "core/gltf_environment.h"
 
 namespace speculum {
@@ -330,19 +331,14 @@ void write_gltf(const Scene& scene, const std::string& path) {
   model.extensionsUsed.assign(w.extensions_used.begin(), w.extensions_used.end());
   if (model.textures.empty()) model.samplers.clear();
 
-  const std::string tmp = path + ".tmp-speculum";
+  // Whole or nothing, and the system's reason if the file cannot be created
+  // (core/output_file.h); buffers and images are embedded, so the temporary name is not
+  // referenced from inside the file.
+  OutputFile file(path);
   tinygltf::TinyGLTF writer;
-  const bool ok = writer.WriteGltfSceneToFile(&model, tmp, true, true, ext == ".gltf", ext == ".glb");
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    throw InputError(path, "could not write the glTF file");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw InputError(path, "could not move the written file into place: " + ec.message());
-  }
+  if (!writer.WriteGltfSceneToFile(&model, file.temp_path(), true, true, ext == ".gltf", ext == ".glb"))
+    throw InputError(path, "cannot write: the glTF writer failed");
+  file.commit();
 }
 
 }  // namespace speculum

@@ -43,6 +43,11 @@ ImageRGBA read_image(const std::string& path, bool srgb_to_linear = true);
 // failure never leaves a half-written output. Throws InputError naming the file.
 void write_image(const std::string& path, const ImageRGBA& image);
 void write_image(const std::string& path, const ImageF& image);
+// Writes an EXR whose channels are named (`names`, e.g. "R","G","B","A","albedo.R",
+// "normal.X", "depth.Z": OpenImageIO's layer.channel convention), `interleaved` holding
+// names.size() floats per pixel, rows top to bottom. Same temporary-file rule.
+void write_exr_channels(const std::string& path, int width, int height,
+                        const std::vector<std::string>& names, const std::vector<float>& interleaved);
 
 float srgb_to_linear(float c);
 float linear_to_srgb(float c);

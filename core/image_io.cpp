@@ -2,11 +2,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 
 #include <OpenImageIO/imageio.h>
 
 #include "core/error.h"
 #include "core/image.h"
+#include "core/output_file.h"
 
 namespace speculum {
 
@@ -75,29 +77,36 @@ ImageRGBA read_image(const std::string& path, bool to_linear) {
 
 namespace {
 
+// Writes interleaved float channels through a temporary file (core/output_file.h).
+// `names` empty: OpenImageIO's default channel names (R, G, B, A / Y).
 void write_float_channels(const std::string& path, int w, int h, int nc,
-                          const std::vector<float>& linear) {
+                          const std::vector<float>& linear,
+                          const std::vector<std::string>& names = {}) {
   const std::string ext = extension_of(path);
   const bool is_exr = ext == ".exr";
   const bool is_png = ext == ".png";
   if (!is_exr && !is_png) throw InputError(path, "unsupported output format (use .png or .exr)");
   if (w <= 0 || h <= 0) throw InputError(path, "refusing to write an empty image");
 
-  const std::filesystem::path final_path(path);
-  const std::filesystem::path tmp_path =
-      final_path.parent_path() / (final_path.filename().string() + ".tmp" + ext);
-  auto out = OIIO::ImageOutput::create(tmp_path.string());
+  OutputFile file(path);
+  const std::string& tmp = file.temp_path();
+  auto out = OIIO::ImageOutput::create(tmp);
   if (!out) throw InputError(path, "no image writer for this format");
 
   bool ok = false;
   if (is_exr) {
     OIIO::ImageSpec spec(w, h, nc, OIIO::TypeDesc::FLOAT);
+    if (!names.empty()) {
+      spec.channelnames = names;
+      spec.alpha_channel = -1;
+      for (int c = 0; c < nc; ++c)
+        if (names[static_cast<std::size_t>(c)] == "A") spec.alpha_channel = c;
+    }
     spec.attribute("compression", "zip");
     // OpenEXR stamps the write time into `capDate`; a fixed value keeps the file bytes a
     // function of the pixels only (same inputs, same bytes: docs/architecture.md).
     spec.attribute("DateTime", "1970:01:01 00:00:00");
-    ok = out->open(tmp_path.string(), spec) &&
-         out->write_image(OIIO::TypeDesc::FLOAT, linear.data());
+    ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, linear.data());
   } else {
     std::vector<unsigned char> bytes(linear.size());
     for (std::size_t i = 0; i < linear.size(); ++i) {
@@ -109,22 +118,17 @@ void write_float_channels(const std::string& path, int w, int h, int nc,
       bytes[i] = static_cast<unsigned char>(std::lround(v * 255.0f));
     }
     OIIO::ImageSpec spec(w, h, nc, OIIO::TypeDesc::UINT8);
-    ok = out->open(tmp_path.string(), spec) &&
-         out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+    ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
   }
   ok = out->close() && ok;
   if (!ok) {
+    // OpenImageIO's message names the temporary file: name the user's instead.
     std::string msg = out->geterror();
-    std::error_code ec;
-    std::filesystem::remove(tmp_path, ec);
-    throw InputError(path, "cannot write image: " + msg.substr(0, msg.find('\n')));
+    msg = msg.substr(0, msg.find('\n'));
+    for (std::size_t at; (at = msg.find(tmp)) != std::string::npos;) msg.replace(at, tmp.size(), path);
+    throw InputError(path, "cannot write image: " + (msg.empty() ? std::string("the image writer failed") : msg));
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp_path, final_path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp_path, ec);
-    throw InputError(path, "cannot write image: " + ec.message());
-  }
+  file.commit();
 }
 
 }  // namespace
@@ -142,6 +146,15 @@ void write_image(const std::string& path, const ImageRGBA& image) {
 
 void write_image(const std::string& path, const ImageF& image) {
   write_float_channels(path, image.width, image.height, 1, image.pixels);
+}
+
+void write_exr_channels(const std::string& path, int width, int height,
+                        const std::vector<std::string>& names, const std::vector<float>& interleaved) {
+  if (extension_of(path) != ".exr") throw InputError(path, "named layers need an .exr output");
+  const int nc = static_cast<int>(names.size());
+  if (nc == 0 || interleaved.size() != std::size_t(width) * std::size_t(height) * names.size())
+    throw std::invalid_argument("write_exr_channels: channel data does not match the names");
+  write_float_channels(path, width, height, nc, interleaved, names);
 }
 
 }  // namespace speculum

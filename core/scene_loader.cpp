@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "core/camera_rays.h"
+#include "core/did_you_mean.h"
 #include "core/error.h"
 #include "core/gltf_loader.h"
 #include "core/mesh_loader.h"
@@ -15,6 +16,13 @@
 
 namespace speculum {
 namespace {
+
+// " (did you mean 'sphere-in-room'?)" for a misspelt built-in scene name, else "".
+std::string scene_suggestion(const std::string& spec) {
+  std::vector<std::string> names;
+  for (const BuiltinScene& s : builtin_scenes()) names.emplace_back(s.name);
+  return did_you_mean(spec.substr(0, spec.find(':')), names);
+}
 
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -44,7 +52,8 @@ Scene build_builtin(const std::string& spec, const SceneOptions& options) {
   const std::size_t colon = spec.find(':');
   const std::string name = spec.substr(0, colon);
   const BuiltinScene* def = find_builtin_scene(name);
-  if (!def) throw InputError(spec, "no such built-in scene (see `speculum scenes list`)");
+  if (!def)
+    throw InputError(spec, "no such built-in scene" + scene_suggestion(spec) + " (see `speculum scenes list`)");
   BuiltinParams params;
   params.size = options.size ? options.size : def->default_size;
   if (colon != std::string::npos) {
@@ -130,7 +139,8 @@ Scene load_scene(const std::string& file_or_name, const SceneOptions& options) {
     if (std::filesystem::exists(file_or_name, ec))
       throw InputError(file_or_name, "unsupported file extension '" + ext +
                                          "' (expected .gltf, .glb, .obj, .ply, .off or .stl)");
-    throw InputError(file_or_name, "no such file or built-in scene (see `speculum scenes list`)");
+    throw InputError(file_or_name, "no such file or built-in scene" + scene_suggestion(file_or_name) +
+                                       " (see `speculum scenes list`)");
   }
   finish_scene(scene);
   return scene;

@@ -45,6 +45,22 @@ void Executor::clear_launches() {
   records_.clear();
 }
 
+void Executor::begin_launch(std::string_view name, std::size_t n) {
+  std::lock_guard lock(records_mutex_);  // once per launch, not per chunk
+  work_launched_.fetch_add(n, std::memory_order_relaxed);
+  last_launch_.assign(name);
+}
+
+WorkCount Executor::work() const {
+  std::lock_guard lock(records_mutex_);
+  WorkCount w;
+  // done first: a launch that begins in between only raises `launched`, so done <= launched.
+  w.done = work_done_.load(std::memory_order_relaxed);
+  w.launched = work_launched_.load(std::memory_order_relaxed);
+  w.launch = last_launch_;
+  return w;
+}
+
 void Executor::record(std::string_view name, std::size_t n, std::size_t chunks,
                       std::int64_t start, std::int64_t duration) {
   if (!recording_) return;

@@ -4,6 +4,7 @@
 // "Determinism").
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -20,6 +21,7 @@
 #include <tbb/task_arena.h>
 
 #include "parallel/fork_join.h"
+#include "parallel/interrupt.h"
 
 namespace speculum::par {
 
@@ -31,6 +33,15 @@ struct LaunchRecord {
   std::int64_t start_ns = 0;  // since the executor's epoch
   std::int64_t duration_ns = 0;
   std::string scope;  // the graph node that issued it ("" outside a graph)
+};
+
+// Work counted by an executor since it was made, in elements (pixels, rays, ...) of its
+// launches: what a progress bar polls while a long launch runs. Both counts only grow, and
+// `done` reaches `launched` when every launch has finished.
+struct WorkCount {
+  std::uint64_t launched = 0;  // elements of every launch begun
+  std::uint64_t done = 0;      // elements of finished chunks
+  std::string launch;          // the name of the launch begun last
 };
 
 // Names the graph node running on this thread, so launches can be attributed to it in
@@ -85,11 +96,15 @@ class Executor {
     if (chunk == 0) chunk = 1;
     const std::size_t chunks = chunk_count(n, chunk);
     auto run_chunk = [&](std::size_t c) {
+      // Ctrl-C: the remaining chunks are skipped and launch() throws Interrupted.
+      if (interrupted()) return;
       const std::size_t begin = c * chunk;
       const std::size_t end = begin + chunk < n ? begin + chunk : n;
       body(begin, end);
+      // One relaxed add per chunk (never per element): the progress bar's count.
+      work_done_.fetch_add(end - begin, std::memory_order_relaxed);
     };
-    launch(name, n, chunks, chunks, run_chunk);
+    launch(name, n, chunks, chunks, run_chunk, false);
   }
 
   // Calls body(w) for each w in [0, workers) at once, for a kernel whose workers claim the
@@ -98,7 +113,8 @@ class Executor {
   template <class Body>
   void run_workers(std::string_view name, std::size_t workers, std::size_t n, std::size_t chunks,
                    Body&& body) {
-    launch(name, n, chunks, workers, body);
+    // The workers claim chunks themselves, so the work counts as done when they all end.
+    launch(name, n, chunks, workers, body, true);
   }
 
   // Deterministic reduction: partial = chunk_fn(begin, end) per fixed chunk (in parallel),
@@ -137,6 +153,9 @@ class Executor {
   void clear_launches();
   void set_recording(bool on) { recording_ = on; }
 
+  // The work counts so far; safe from any thread while launches run (a progress poller).
+  WorkCount work() const;
+
   std::int64_t now_ns() const {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
                std::chrono::steady_clock::now() - epoch_)
@@ -145,8 +164,13 @@ class Executor {
 
  private:
   // Runs task(t) for t in [0, tasks) and records the launch as `n` elements in `chunks`.
+  // `done_at_end`: count the n elements done when the launch ends (else the tasks count them).
+  // Throws Interrupted, before starting or after the tasks, once Ctrl-C was pressed.
   template <class Task>
-  void launch(std::string_view name, std::size_t n, std::size_t chunks, std::size_t tasks, Task& task) {
+  void launch(std::string_view name, std::size_t n, std::size_t chunks, std::size_t tasks, Task& task,
+              bool done_at_end) {
+    throw_if_interrupted();
+    begin_launch(name, n);
     const auto t0 = now_ns();
     if (synchronous() || tasks <= 1) {
       for (std::size_t t = 0; t < tasks; ++t) task(t);
@@ -158,8 +182,11 @@ class Executor {
       arena_->execute([&] { fork_join_chunks(sync, tasks, task); });
     }
     record(name, n, chunks, t0, now_ns() - t0);
+    if (done_at_end) work_done_.fetch_add(n, std::memory_order_relaxed);
+    throw_if_interrupted();
   }
 
+  void begin_launch(std::string_view name, std::size_t n);
   void record(std::string_view name, std::size_t n, std::size_t chunks, std::int64_t start,
               std::int64_t duration);
 
@@ -173,6 +200,9 @@ class Executor {
   bool recording_ = true;
   mutable std::mutex records_mutex_;
   std::vector<LaunchRecord> records_;
+  std::atomic<std::uint64_t> work_launched_{0};
+  std::atomic<std::uint64_t> work_done_{0};
+  std::string last_launch_;  // guarded by records_mutex_
 };
 
 }  // namespace speculum::par

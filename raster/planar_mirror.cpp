@@ -97,6 +97,10 @@ struct Recursion {
       bool seen = false;
       for (std::size_t i = 0; i < g.object.size() && !seen; ++i) seen = g.object.pixels[i] == mirror.object;
       if (!seen) continue;
+      if (stats.mirrored_views >= static_cast<std::uint64_t>(settings.max_views)) {
+        ++stats.views_over_budget;  // a bound that is hit is counted, never silent
+        continue;
+      }
       const ImageRGBA mirrored = view_radiance(mirror.clipped_for(camera.eye),
                                                mirrored_camera(camera, mirror.plane), level + 1);
       const int w = g.width;
@@ -154,6 +158,7 @@ ImageRGBA PlanarMirrorReflectPass::operator()(par::NodeContext& c, const PlanarM
                                              environment, settings, &stats);
   c.count("mirrored_views", stats.mirrored_views);
   c.count("mirror_samples", stats.mirror_samples);
+  c.count("views_over_budget", stats.views_over_budget);
   return specular;
 }
 

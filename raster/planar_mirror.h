@@ -36,11 +36,17 @@ struct PlanarMirrorSettings {
   int depth = 3;  // mirror bounces rendered by geometry transformation
   int width = 0;  // target size in samples (the camera G-buffer's)
   int height = 0;
+  // Mirrors that see each other multiply the views per level (up to (m-1)^depth), so the
+  // whole recursion renders at most this many mirrored views (each a full frame); a mirror
+  // whose view would exceed it keeps the environment lookup, as beyond `depth`. The views are
+  // rendered depth-first in mirror order, so which ones fit does not depend on threads.
+  int max_views = 256;
 };
 
 struct PlanarMirrorStats {
-  std::uint64_t mirrored_views = 0;  // visibility + shading passes of mirrored cameras
-  std::uint64_t mirror_samples = 0;  // samples that received a mirrored image
+  std::uint64_t mirrored_views = 0;     // visibility + shading passes of mirrored cameras
+  std::uint64_t mirror_samples = 0;     // samples that received a mirrored image
+  std::uint64_t views_over_budget = 0;  // mirrored views not rendered (max_views reached)
 };
 
 // The specular layer of G-buffer `g` (seen from `camera` in `view_scene`, object ids of

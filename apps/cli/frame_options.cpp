@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <string>
 
 #include <glm/common.hpp>
 #include <glm/trigonometric.hpp>
@@ -20,8 +22,11 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
                                    "default built-in scene)");
   cmd.add_option("--technique,-t", o.technique, "Technique (see `speculum techniques`)")
       ->capture_default_str();
-  o.width_option = cmd.add_option("--width", o.width, "Image width")
-                       ->check(CLI::Range(1, 16384))->capture_default_str();
+  o.width_option =
+      cmd.add_option("--width", o.width,
+                     "Image width; width × height × spp at most 2^23 samples (2^22 for ray-hierarchy, "
+                     "2^26 for reference and yu-lod) to bound memory")
+          ->check(CLI::Range(1, 16384))->capture_default_str();
   o.height_option =
       cmd.add_option("--height", o.height,
                      "Image height (default: from a glTF camera's aspect ratio when it has one)")
@@ -50,10 +55,13 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
       ->check(CLI::Range(1, 16))->capture_default_str();
   cmd.add_option("--param", o.params,
                  "Technique parameter name=value, repeatable (see `speculum techniques`)");
-  cmd.add_option("--cube-size", o.cube_map_size, "Side of the per-reflector cube maps")
-      ->check(CLI::Range(1, 4096))->capture_default_str();
+  // The maxima bound memory: living-room (the built-in scene with most reflectors) peaks
+  // near 2.1 GB at --cube-size 1024 (7.8 GB at 2048) and 1.7 GB at --shadow-size 4096 (6.2 GB
+  // at 8192).
+  cmd.add_option("--cube-size", o.cube_map_size, "Side of the per-reflector cube maps (~2 GB for many reflectors at 1024)")
+      ->check(CLI::Range(1, 1024))->capture_default_str();
   cmd.add_option("--shadow-size", o.shadow_map_size, "Side of the shadow maps")
-      ->check(CLI::Range(1, 8192))->capture_default_str();
+      ->check(CLI::Range(1, 4096))->capture_default_str();
   add_camera_options(cmd, o.camera);
   cmd.add_flag("--strict", o.strict,
                "A missing or undecodable texture, or a missing .mtl file, is an error (exit 2)\n"
@@ -62,7 +70,7 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
                "Let the scene's image/buffer URIs and .mtl files point outside the scene\n"
                "file's folder (refused by default: one line, exit 2 for glTF)");
   // The technique parameters, from the technique table (after the command's own footer).
-  std::string params = "\n\nTechnique parameters (--param name=value; default, [valid range]):";
+  std::string params = "\n\nTechnique parameters (--param name=value: default, type and valid range, meaning):";
   for (const Technique& t : techniques())
     if (!t.params.empty()) params += "\n  " + t.name + "\n" + t.describe_params("    ");
   cmd.footer(cmd.get_footer() + params);
@@ -80,6 +88,35 @@ Scene load_frame_scene(const FrameOptions& o, bool quiet) {
     for (const std::string& w : report.warnings)
       std::fprintf(stderr, "speculum: warning: %s: %s\n", name.c_str(), w.c_str());
   return scene;
+}
+
+std::map<std::string, double> check_frame_options(const FrameOptions& o) {
+  const Technique& technique = find_technique(o.technique);
+  // The technique's sample limit bounds memory (rasterized frames keep every sample) or time
+  // (reference and yu-lod keep pixels); see Technique::max_samples.
+  const double samples = double(o.width) * double(o.height) * double(o.spp);
+  if (samples > technique.max_samples)
+    throw InputError("--width/--height/--spp",
+                     std::to_string(o.width) + "×" + std::to_string(o.height) + " at " + std::to_string(o.spp) +
+                         " spp is " + std::to_string(static_cast<long long>(samples)) + " samples; " +
+                         technique.name + " takes at most " +
+                         std::to_string(static_cast<long long>(technique.max_samples)) + " (2^" +
+                         std::to_string(std::ilogb(technique.max_samples)) + ")");
+  std::map<std::string, double> params;
+  for (const std::string& item : o.params) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--param", "expected name=number, got '" + item + "'");
+    const std::string name = item.substr(0, eq), text = item.substr(eq + 1);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0')
+      throw InputError("--param " + name, "expected a number, got '" + item + "'");
+    if (!std::isfinite(v)) throw InputError("--param " + name, "expected a finite number, got '" + item + "'");
+    params[name] = v;
+  }
+  check_technique_params(technique, params);
+  return params;
 }
 
 FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
@@ -113,16 +150,7 @@ FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
   f.bounces = o.bounces;
   f.cube_map_size = o.cube_map_size;
   f.shadow_map_size = o.shadow_map_size;
-  for (const std::string& item : o.params) {
-    const auto eq = item.find('=');
-    char* end = nullptr;
-    const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
-    if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0' ||
-        !std::isfinite(v))
-      throw InputError("--param", "expected name=number, got '" + item + "'");
-    f.params[item.substr(0, eq)] = v;
-  }
-  check_technique_params(find_technique(o.technique), f.params);
+  f.params = check_frame_options(o);
   return f;
 }
 

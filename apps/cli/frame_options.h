@@ -3,6 +3,7 @@
 // FrameSettings they make.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -46,9 +47,14 @@ void add_frame_options(CLI::App& cmd, FrameOptions& options);
 // loader warning once on stderr as `speculum: warning: FILE: message`, unless `quiet`.
 Scene load_frame_scene(const FrameOptions& options, bool quiet);
 
-// Validates (InputError on bad values) and resolves the camera. A square spp is k×k
-// supersampling; other counts reach only sample-based techniques through FrameSettings::spp.
-// Without --width/--height, a file camera's aspect ratio sets the height from the width.
+// What can be checked before the scene is loaded: the frame's sample count against its
+// limit and the technique parameters (parsed). Throws InputError naming the option.
+std::map<std::string, double> check_frame_options(const FrameOptions& options);
+
+// Validates (InputError on bad values; check_frame_options included) and resolves the
+// camera. A square spp is k×k supersampling; other counts reach only sample-based techniques
+// through FrameSettings::spp. Without --width/--height, a file camera's aspect ratio sets the
+// height from the width.
 FrameSettings make_frame_settings(const FrameOptions& options, const Scene& scene);
 
 // --exposure: "auto" (metered by the tonemap pass, raster/composite.h) or a multiplier, finite

@@ -1,11 +1,55 @@
 // speculum: render, inspect, profile and compare GPU reflection techniques on the CPU.
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "apps/cli/commands.h"
+#include "core/did_you_mean.h"
 #include "core/error.h"
 #include "parallel/graph.h"
+#include "parallel/interrupt.h"
+
+namespace {
+
+// Ctrl-C: the run stops at the next chunk boundary (parallel/interrupt.h) and main exits 130
+// without writing; a second Ctrl-C ends the process at once (nothing is ever renamed into
+// place half-written: outputs go through temporary files).
+extern "C" void on_sigint(int) {
+  speculum::par::request_interrupt();
+  std::signal(SIGINT, SIG_DFL);
+}
+
+// CLI11's message on one line (its own newlines folded; app.exit's "Run with --help" line is
+// replaced by a short hint).
+std::string one_line(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  for (char& c : text)
+    if (c == '\n') c = ' ';
+  return text;
+}
+
+std::vector<std::string> subcommand_names(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+  return names;
+}
+
+// The argument that is a typo of a subcommand ("rendr"), when none was recognised (CLI11
+// reports that as an unexpected argument or a missing subcommand); "" otherwise.
+std::string subcommand_typo(const CLI::App& app, int argc, char** argv) {
+  if (!app.get_subcommands().empty()) return "";
+  const std::vector<std::string> names = subcommand_names(app);
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.empty() || arg[0] == '-') continue;
+    if (!speculum::closest_name(arg, names).empty()) return arg;
+  }
+  return "";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace speculum;
@@ -39,10 +83,23 @@ int main(int argc, char** argv) {
   cli::add_profile_command(app, global);
   cli::add_compare_command(app, global);
 
+  std::signal(SIGINT, on_sigint);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --help-all, --version: CLI11 prints them
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    // One line, like every other error (CLI11's own adds a second one).
+    const std::string typo = subcommand_typo(app, argc, argv);
+    if (!typo.empty())
+      std::fprintf(stderr, "speculum: unknown subcommand '%s' (did you mean '%s'?)\n", typo.c_str(),
+                   speculum::closest_name(typo, subcommand_names(app)).c_str());
+    else
+      std::fprintf(stderr, "speculum: %s (see --help)\n", one_line(e.what()).c_str());
+    return 2;
+  } catch (const par::Interrupted&) {
+    std::fprintf(stderr, "speculum: interrupted (Ctrl-C); the output under way was not written\n");
+    return 130;
   } catch (const InputError& e) {
     std::fprintf(stderr, "speculum: %s\n", e.what());
     return 2;
@@ -56,6 +113,9 @@ int main(int argc, char** argv) {
     // still bad input, named by its own message; anything else names the pass.
     try {
       std::rethrow_exception(e.cause());
+    } catch (const par::Interrupted&) {
+      std::fprintf(stderr, "speculum: interrupted (Ctrl-C); the output under way was not written\n");
+      return 130;
     } catch (const InputError& input) {
       std::fprintf(stderr, "speculum: %s\n", input.what());
       return 2;

@@ -2,14 +2,23 @@
 // silent when stderr is not a terminal or with --quiet; thread-safe.
 //   Progress p("yu-fig9", rows, global.quiet);
 //   for (...) { ...; p.step(); }       // or p.step("row 3") to show what just finished
+// Inside a long step, a poller reports the work of the running launches (Executor::work()):
+//   p.work("reference_render", done, launched);   // the bar moves, with a rate and an ETA
 #pragma once
 
 #include <chrono>
+#include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <thread>
+
+namespace speculum::par {
+class Executor;
+}
 
 namespace speculum::cli {
 
@@ -29,6 +38,10 @@ class Progress {
 
   // One unit done; `detail` (optional) names it on the bar. Safe from any thread.
   void step(std::string_view detail = {});
+  // The element counts of the launches under way (both only grow; done <= launched) and the
+  // name of the latest: the bar adds the share of the launched work that is done, and the line
+  // shows it with the rate over the last seconds and the time left at that rate. Any thread.
+  void work(std::string_view launch, std::uint64_t done, std::uint64_t launched);
   // Ends the bar: a last redraw and a newline, only if anything was drawn.
   void finish();
   // Erases the drawn bar from its line (the next step redraws it), so a caller can print a
@@ -42,6 +55,7 @@ class Progress {
 
  private:
   std::string line_locked(double elapsed) const;
+  void draw_locked();
   double elapsed() const;
 
   std::string label_;
@@ -55,6 +69,29 @@ class Progress {
   double last_draw_ = -1.0;
   bool drawn_ = false;
   bool finished_ = false;
+  // Work inside the running steps (work()): counts since the poller last saw it idle, and two
+  // samples (time, done) a few seconds apart for the rate.
+  std::string launch_;
+  std::uint64_t work_base_ = 0, work_done_ = 0, work_launched_ = 0;
+  double rate_t0_ = 0, rate_t1_ = 0;
+  std::uint64_t rate_d0_ = 0, rate_d1_ = 0;
+};
+
+// While it lives, a thread reports `executor`'s work counts to `progress` ten times a second,
+// so the bar moves inside a long pass. The executor counts per chunk, so this costs the
+// render nothing per element and changes no output.
+class WorkPoller {
+ public:
+  WorkPoller(const par::Executor& executor, Progress& progress);
+  ~WorkPoller();
+  WorkPoller(const WorkPoller&) = delete;
+  WorkPoller& operator=(const WorkPoller&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::thread thread_;
 };
 
 }  // namespace speculum::cli

@@ -1,16 +1,19 @@
 // `speculum render [SCENE] --technique T -o out.png|exr`: loads a scene, runs the
 // technique's graph (apps/techniques/technique_table.h) and writes the image.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 
+#include "apps/cli/aov_output.h"
 #include "apps/cli/commands.h"
 #include "apps/cli/frame_options.h"
 #include "apps/techniques/technique_table.h"
 #include "apps/cli/progress.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "raster/visibility.h"
 
 namespace speculum::cli {
 namespace {
@@ -18,6 +21,8 @@ namespace {
 struct RenderOptions {
   pipeline::FrameOptions frame;  // scene, technique, size, spp, parameters, camera
   std::string output = "speculum.png";
+  std::string aov;  // "albedo,normal,depth": G-buffer layers of the EXR
+  bool aov_given = false;
   bool timings = false;
 };
 
@@ -34,6 +39,10 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
                                   std::to_string(o.spp));
   if (!ends_with(opts.output, ".png") && !ends_with(opts.output, ".exr"))
     throw InputError(opts.output, "output must end in .png or .exr");
+  const std::vector<std::string> aovs = opts.aov_given ? parse_aovs(opts.aov) : std::vector<std::string>{};
+  if (!aovs.empty() && !ends_with(opts.output, ".exr"))
+    throw InputError("--aov", "layers need an .exr output, got '" + opts.output + "'");
+  pipeline::check_frame_options(o);  // before a possibly long scene load
   Scene scene = pipeline::load_frame_scene(o, global.quiet);
   const pipeline::FrameSettings f = pipeline::make_frame_settings(o, scene);
   for (const std::string& warning : pipeline::apply_light_options(o, scene, f.camera))
@@ -44,15 +53,53 @@ void run_render(const RenderOptions& opts, const GlobalOptions& global) {
   const bool exr = ends_with(opts.output, ".exr");
   const par::Resource<ImageRGBA>& image = exr ? outputs.radiance : outputs.display;
   graph.request(image);
+  // --aov: the technique's own G-buffer (the node `gbuffer` of the rasterized techniques),
+  // taken as it is produced; a technique without one (the reference tracer) gets the same two
+  // raster passes at the output size: its first hits at the pixel centres.
+  AovLayers layers;
+  par::Resource<raster::GBuffer> own_gbuffer;
+  if (!aovs.empty()) {
+    const auto& nodes = graph.nodes();
+    if (std::none_of(nodes.begin(), nodes.end(), [](const auto& n) { return n.name == "gbuffer"; })) {
+      auto vis = graph.add("aov_visibility", raster::VisibilityPass{&scene, f.camera, f.width, f.height});
+      own_gbuffer = graph.add("aov_gbuffer", raster::GBufferPass{&scene, f.camera.eye}, vis);
+      graph.request(own_gbuffer);
+    }
+  }
+  auto take_aovs = [&](const raster::GBuffer& g) {
+    layers = make_aov_layers(g, std::max(1, g.width / f.width), f.camera, aovs);
+  };
   // Progress per finished node (a node's first captured output), only for long renders.
   graph.compile();
   Progress progress("render " + technique.name, graph.order().size(), global.quiet);
   std::string last_node;
-  const par::RunReport report = graph.run(executor, [&](const par::CapturedOutput& out) {
-    if (out.node != last_node) progress.step(out.node), last_node = out.node;
-  });
+  par::RunReport report;
+  {
+    WorkPoller poller(executor, progress);  // the bar moves inside long passes too
+    report = graph.run(executor, [&](const par::CapturedOutput& out) {
+      if (out.node != last_node) progress.step(out.node), last_node = out.node;
+      if (!aovs.empty() && !own_gbuffer && out.node == "gbuffer")
+        if (const auto* g = out.as<raster::GBuffer>()) take_aovs(*g);
+    });
+  }
   progress.finish();
-  write_image(opts.output, graph.get(image));
+  if (own_gbuffer) take_aovs(graph.get(own_gbuffer));
+  if (aovs.empty()) {
+    write_image(opts.output, graph.get(image));
+  } else {
+    const ImageRGBA& beauty = graph.get(image);
+    const std::size_t nc = 4 + layers.names.size();
+    std::vector<std::string> names = {"R", "G", "B", "A"};
+    names.insert(names.end(), layers.names.begin(), layers.names.end());
+    std::vector<float> data(beauty.size() * nc);
+    for (std::size_t i = 0; i < beauty.size(); ++i) {
+      const glm::vec4 c = beauty.pixels[i];
+      float* p = &data[i * nc];
+      p[0] = c.x, p[1] = c.y, p[2] = c.z, p[3] = c.w;
+      std::copy_n(&layers.data[i * layers.names.size()], layers.names.size(), p + 4);
+    }
+    write_exr_channels(opts.output, beauty.width, beauty.height, names, data);
+  }
   // The metered exposure (the tonemap pass records it; an EXR skips that pass).
   for (const auto& node : report.nodes)
     if (const auto it = node.counters.find("exposure");
@@ -82,8 +129,16 @@ void add_render_command(CLI::App& app, GlobalOptions& global) {
   pipeline::add_frame_options(*cmd, opts->frame);
   cmd->add_option("-o,--output", opts->output, "Output image: .png (tone-mapped) or .exr (linear)")
       ->capture_default_str();
+  cmd->add_option("--aov", opts->aov,
+                  "G-buffer layers to add to the .exr output, comma-separated: albedo (base colour), "
+                  "normal (world), depth (camera-space Z; +inf on the background), position "
+                  "(world), roughness; named albedo.R, normal.X, depth.Z, ... For a denoiser or a "
+                  "compositor. The reference tracer's are its first hits at the pixel centres");
   cmd->add_flag("--timings", opts->timings, "Print each pass's wall time on stderr");
-  cmd->callback([opts, &global] { run_render(*opts, global); });
+  cmd->callback([opts, cmd, &global] {
+    opts->aov_given = cmd->count("--aov") > 0;
+    run_render(*opts, global);
+  });
 }
 
 }  // namespace speculum::cli

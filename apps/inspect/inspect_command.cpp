@@ -16,6 +16,7 @@
 #include "apps/techniques/render_frame.h"
 #include "apps/cli/progress.h"
 #include "core/error.h"
+#include "core/output_file.h"
 #include "core/scene_loader.h"
 
 namespace speculum::cli {
@@ -37,9 +38,7 @@ std::string safe(const std::string& s) {
 }
 
 void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out) throw InputError(path.string(), "cannot write");
+  write_text_file(path.string(), text);  // whole or nothing, with the real reason on failure
 }
 
 std::string shell_quote(const std::string& s) {
@@ -114,7 +113,10 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
 
   par::Executor executor(global.threads, global.lanes);
   executor.clear_launches();
-  const pipeline::FrameResult frame = pipeline::render_frame(scene, technique, settings, executor, capture);
+  const pipeline::FrameResult frame = [&] {
+    WorkPoller poller(executor, progress);  // the bar moves inside long passes too
+    return pipeline::render_frame(scene, technique, settings, executor, capture);
+  }();
   progress.finish();
   const auto launches = executor.launches();
   report.frame_ms = frame.report.duration_ns * 1e-6;

@@ -17,6 +17,7 @@
 #include "apps/cli/progress.h"
 #include "apps/cli/result_table.h"
 #include "core/error.h"
+#include "core/output_file.h"
 #include "core/scene_loader.h"
 
 namespace speculum::cli {
@@ -40,9 +41,7 @@ double median(std::vector<double> v) {
 }
 
 void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out) throw InputError(path.string(), "cannot write");
+  write_text_file(path.string(), text);  // whole or nothing, with the real reason on failure
 }
 
 void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
@@ -58,6 +57,7 @@ void run_profile(const ProfileOptions& o, const GlobalOptions& global) {
   }
   par::Executor executor(global.threads, global.lanes);
   Progress progress("profile " + technique.name, std::size_t(o.warmup + o.repeat), global.quiet);
+  WorkPoller poller(executor, progress);  // the bar moves inside long frames too
   for (int i = 0; i < o.warmup; ++i) {
     pipeline::render_frame(scene, technique, settings, executor);
     progress.step("warm-up");

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "apps/techniques/recipes.h"
+#include "core/did_you_mean.h"
 #include "core/error.h"
 
 namespace speculum::pipeline {
@@ -13,12 +14,16 @@ namespace {
 
 // The distance-map search (SURVEY §4.1), shared by the techniques that search distance maps.
 std::vector<TechniqueParam> search_params() {
+  // The step counts multiply the search's cost per sample (and, in multi-reflection, per
+  // cube-map texel and round); their maxima stop where more steps cannot help: 256 linear
+  // steps are finer than a texel along a ray through the default 256² cube face, and the
+  // secant and parallax iterations reach float precision long before 16.
   return {{"parallax", 1, 0, 1, true, "1: parallax correction (eq.4) when no bracket is found"},
           {"linear", 1, 0, 1, true, "1: linear search along the ray (§4.1.2)"},
           {"secant", 1, 0, 1, true, "1: secant refinement of the bracket (eq.5)"},
-          {"parallax_steps", 1, 1, 64, true, "parallax iterations"},
-          {"linear_steps", 16, 1, 1024, true, "linear search steps"},
-          {"secant_steps", 4, 0, 64, true, "secant iterations"}};
+          {"parallax_steps", 1, 1, 16, true, "parallax iterations (converged long before 16)"},
+          {"linear_steps", 16, 1, 256, true, "linear search steps (256: under a texel of a 256² face)"},
+          {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"}};
 }
 
 std::vector<TechniqueParam> concat(std::vector<TechniqueParam> a, const std::vector<TechniqueParam>& b) {
@@ -47,7 +52,8 @@ const std::vector<Technique>& techniques() {
        "reference tracer: BVH ray tracing, Whitted mirrors/refraction, Phong-lobe glossy "
        "sampling (--spp path samples); the ground truth",
        add_reference_passes,
-       {}},
+       {},
+       double(1 << 26)},  // paths cost time only (memory is per pixel): about two minutes on two cores
       {"distance-map",
        "distance maps (SURVEY §4.1-4.2): per-reflector colour+distance cube, searched per sample",
        add_distance_map_passes, search_params()},
@@ -55,7 +61,7 @@ const std::vector<Technique>& techniques() {
        "inter-object reflections (SURVEY §4.3): reflector distance maps rebuilt in rounds, one "
        "bounce each",
        add_multi_reflection_passes,
-       concat({{"rounds", 3, 1, 16, true, "rounds of map re-rendering (bounces)"},
+       concat({{"rounds", 3, 1, 8, true, "rounds of map re-rendering (bounces; each re-renders every map)"},
                {"lagged", 0, 0, 1, true, "1: one round per frame from the previous frame's maps"}},
               search_params())},
       {"layered-distance-map",
@@ -63,45 +69,60 @@ const std::vector<Technique>& techniques() {
        "linear+secant tracer",
        add_layered_distance_map_passes,
        {{"layers", 3, 1, 8, true, "depth-peeled layers"},
-        {"layer_size", 128, 8, 1024, true, "cube face side of the layers"},
-        {"linear_steps", 16, 2, 1024, true, "linear search steps per layer"},
-        {"secant_steps", 4, 0, 64, true, "secant iterations"},
+        // ≈ 100 bytes per texel per layer (a G-buffer, distance and colour): 8 layers of 512²
+        // faces peak near 1.5 GB, of 1024² near 5.4 GB.
+        {"layer_size", 128, 8, 512, true, "cube face side of the layers (8 layers at 512: ~1.5 GB)"},
+        {"linear_steps", 16, 2, 256, true, "linear search steps per layer"},
+        {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
         {"bounces", 2, 1, 16, true, "specular hits followed (--bounces raises it)"}}},
       {"planar-mirror",
        "planar mirrors by geometry transformation (SURVEY §5): the camera reflected about each "
        "mirror plane, scene clipped at the plane, recursive; other specular surfaces as envmap",
        add_planar_mirror_passes,
-       {{"depth", 3, 0, 16, true, "mirror bounces rendered by reflected cameras"}}},
+       // Each level renders the frame again per mirror seen: m mirrors that see each other
+       // cost up to (m-1)^depth views, so the depth stays small and the pass renders at most
+       // 256 mirrored views in all (PlanarMirrorSettings::max_views, counted when reached).
+       {{"depth", 3, 0, 8, true, "mirror bounces rendered by reflected cameras (at most 256 views in all)"}}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",
        add_refraction_passes,
        {{"method", 1, 0, 2, true, "0 single interface, 1 two-face, 2 distance impostors"},
-        {"linear_steps", 16, 0, 1024, true, "linear search steps (both searches; < 2: off)"},
-        {"secant_steps", 4, 0, 64, true, "secant iterations"},
-        {"impostor_size", 128, 4, 4096, true, "cube face side of the distance impostors (method 2)"}}},
+        {"linear_steps", 16, 0, 256, true, "linear search steps (both searches; < 2: off)"},
+        {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
+        // ≈ 150 MB per refractor at 1024² faces, ≈ 3.6 GB at 4096².
+        {"impostor_size", 128, 4, 1024, true, "cube face side of the distance impostors (method 2; ~150 MB each at 1024)"}}},
       {"yu-lod",
        "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
        "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",
        add_yu_lod_passes,
-       {{"env_samples", 8, 0, 1024, true, "sky rays per triangle in the radiance bake"}}},
+       // The bake traces triangles × env_samples rays; 256 already brings its noise to 1/16
+       // of a single ray's (σ/√n).
+       {{"env_samples", 8, 0, 256, true, "sky rays per triangle in the radiance bake (time ∝ triangles × samples)"}},
+       double(1 << 26)},  // glossy rays, ~32 bytes each in flight: ~2 GB at the limit
       {"ray-hierarchy",
        "ROGER ch.3 ray hierarchy: one reflected/refracted ray per specular pixel through a "
        "screen-space cone-sphere quad-tree over stream compaction, exact closest hits; --bounces B",
        add_ray_hierarchy_passes,
-       {{"pair_capacity", 2048.0 * 2048.0, 1, 1 << 30, true, "pair buffer capacity (pairs)"},
-        {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}}},
+       // The pair buffer takes ≈ 10 bytes per pair at its fullest: 2^26 pairs ≈ 0.7 GB. A
+       // smaller capacity costs nothing but batches (the same hits, ROGER §4.3).
+       {{"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
+        {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
+       double(1 << 22)},  // ~770 bytes per pixel of ray streams and hierarchy: ~3.3 GB at the limit
   };
   return table;
 }
 
 const Technique& find_technique(const std::string& name) {
   std::string known;
+  std::vector<std::string> names;
   for (const Technique& t : techniques()) {
     if (t.name == name) return t;
     known += (known.empty() ? "" : ", ") + t.name;
+    names.push_back(t.name);
   }
-  throw InputError("--technique", "unknown technique '" + name + "' (known: " + known + ")");
+  throw InputError("--technique", "unknown technique '" + name + "'" + did_you_mean(name, names) +
+                                      " (known: " + known + ")");
 }
 
 void check_technique_params(const Technique& technique, const std::map<std::string, double>& params) {
@@ -111,17 +132,25 @@ void check_technique_params(const Technique& technique, const std::map<std::stri
       if (p.name == name) spec = &p;
     if (!spec) {
       std::string list;
-      for (const TechniqueParam& p : technique.params) list += (list.empty() ? "" : ", ") + p.name;
+      std::vector<std::string> names;
+      for (const TechniqueParam& p : technique.params) {
+        list += (list.empty() ? "" : ", ") + p.name;
+        names.push_back(p.name);
+      }
       throw InputError("--param " + name,
-                       "unknown parameter '" + name + "' for technique '" + technique.name + "' (" +
+                       "unknown parameter '" + name + "' for technique '" + technique.name + "'" +
+                           did_you_mean(name, names) + " (" +
                            (list.empty() ? std::string("it takes no parameters") : "known: " + list) +
                            ")");
     }
-    if (!(value >= spec->min && value <= spec->max) || (spec->integer && value != std::floor(value)))
-      throw InputError("--param " + name,
-                       number(value) + " is outside the valid range of '" + name + "' for technique '" +
-                           technique.name + "': " + (spec->integer ? "whole numbers " : "") + "[" +
-                           number(spec->min) + ", " + number(spec->max) + "]");
+    const std::string range = std::string(spec->integer ? "integer" : "number") + " in [" + number(spec->min) +
+                              ", " + number(spec->max) + "]";
+    if (!(value >= spec->min && value <= spec->max))
+      throw InputError("--param " + name, number(value) + " is outside the valid range of '" + name +
+                                              "' for technique '" + technique.name + "': " + range);
+    if (spec->integer && value != std::floor(value))
+      throw InputError("--param " + name, number(value) + " is not a whole number: '" + name +
+                                              "' for technique '" + technique.name + "' takes an " + range);
   }
 }
 
@@ -134,8 +163,8 @@ FrameSettings Technique::with_defaults(FrameSettings settings) const {
 std::string Technique::describe_params(const std::string& indent) const {
   std::string out;
   for (const TechniqueParam& p : params)
-    out += indent + p.name + "=" + number(p.fallback) + "  [" + number(p.min) + ", " + number(p.max) +
-           "]  " + p.doc + "\n";
+    out += indent + p.name + "=" + number(p.fallback) + "  " + (p.integer ? "integer" : "number") + " in [" +
+           number(p.min) + ", " + number(p.max) + "]  " + p.doc + "\n";
   return out;
 }
 

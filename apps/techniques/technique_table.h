@@ -26,6 +26,10 @@ struct Technique {
   std::string summary;  // one line
   std::function<FrameOutputs(par::Graph&, const Scene*, const FrameSettings&)> recipe;
   std::vector<TechniqueParam> params;
+  // The most samples (width × height × spp) a frame may take. Rasterized frames keep every
+  // sample (visibility, G-buffer, layers: memory); the sampled ones keep pixels and pay for
+  // samples in time. Each figure is set from the technique's measured peak.
+  double max_samples = double(1 << 23);
 
   // `settings` with every parameter of the table present (defaults where not given).
   // Throws InputError for an unknown, out-of-range or fractional-where-whole parameter.
@@ -34,7 +38,8 @@ struct Technique {
   FrameOutputs add_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings) const {
     return recipe(graph, scene, with_defaults(settings));
   }
-  // "rounds=3 [1, 16] reflector map rounds" lines, one per parameter; "" when it has none.
+  // "rounds=3  integer in [1, 16]  reflector map rounds" lines, one per parameter; "" when
+  // it has none.
   std::string describe_params(const std::string& indent) const;
 };
 

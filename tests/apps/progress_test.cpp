@@ -97,5 +97,34 @@ TEST(Progress, QuietOrNotATerminalDrawsNothingButStillCounts) {
   EXPECT_NE(p.line().find(" b"), std::string::npos);
 }
 
+// Work reported inside a step (the executor's counts, polled): the bar fills by the share of
+// the launched work done, the line names the launch and its percentage, counts that go
+// backwards are ignored, and an idle count (all done) starts the next share afresh.
+TEST(Progress, WorkInsideAStepMovesTheBar) {
+  Captured out;
+  Progress p("render", 2, out.sink(), 0.0);
+  const auto filled = [&] {
+    const std::string l = p.line();
+    return std::count(l.begin(), l.begin() + static_cast<std::ptrdiff_t>(l.find(']')), '#');
+  };
+  p.work("reference_render", 0, 1000);
+  EXPECT_NE(p.line().find("reference_render 0%"), std::string::npos) << p.line();
+  EXPECT_EQ(filled(), 0);
+  p.work("reference_render", 500, 1000);
+  EXPECT_NE(p.line().find("reference_render 50%"), std::string::npos) << p.line();
+  EXPECT_EQ(filled(), 7);  // (0 steps + half of one) of 2, on a 28-wide bar
+  p.work("reference_render", 400, 1000);  // older than what was seen: ignored
+  EXPECT_NE(p.line().find("50%"), std::string::npos) << p.line();
+  p.work("reference_render", 1000, 1000);  // idle: no launch under way
+  EXPECT_EQ(p.line().find('%'), std::string::npos) << p.line();
+  p.step("reference_trace");
+  p.work("tonemap", 1000, 3000);  // a new launch of 2000 elements: none done yet
+  EXPECT_NE(p.line().find("tonemap 0%"), std::string::npos) << p.line();
+  p.work("tonemap", 2000, 3000);
+  EXPECT_NE(p.line().find("tonemap 50%"), std::string::npos) << p.line();
+  EXPECT_EQ(filled(), 21);  // (1 + 0.5) of 2
+  EXPECT_FALSE(out.writes.empty());
+}
+
 }  // namespace
 }  // namespace speculum::cli

@@ -237,5 +237,61 @@ TEST(PlanarMirror, SameBytesForOneAndTwoThreads) {
                            a.radiance.size() * sizeof(glm::vec4)));
 }
 
+// Four mirrors around the camera see each other, so the views multiply (up to 3 per view per
+// level): the recursion renders at most max_views of them, counts the rest, and the budget
+// is spent in a fixed order (the same bytes and counts on 1 and 2 threads); below the budget
+// nothing changes.
+TEST(PlanarMirror, MirrorsThatSeeEachOtherStopAtTheViewBudget) {
+  Scene s;
+  s.name = "mirror box";
+  s.materials = {mirror_material(0.9f), emitter(glm::vec3(1.0f))};
+  add_quad(s, 0, -2.0f, {-20.0f, -20.0f}, {20.0f, 20.0f}, 1.0f, 0);   // facing +x
+  add_quad(s, 0, 2.0f, {-20.0f, -20.0f}, {20.0f, 20.0f}, -1.0f, 0);   // facing -x
+  add_quad(s, 2, -2.0f, {-20.0f, -20.0f}, {20.0f, 20.0f}, 1.0f, 0);   // facing +z
+  add_quad(s, 2, 2.0f, {-20.0f, -20.0f}, {20.0f, 20.0f}, -1.0f, 0);   // facing -z
+  add_quad(s, 1, -1.0f, {-0.3f, -0.3f}, {0.3f, 0.3f}, 1.0f, 1);      // a lamp on the floor
+  s.environment.constant = glm::vec3(0.1f);
+  Camera c;
+  c.eye = {0.3f, 0.0f, 0.2f};
+  c.target = {-2.0f, -0.2f, -2.0f};  // into a corner: two mirrors in view
+  c.vfov_degrees = 60.0f;
+  const auto mirrors = find_planar_mirrors(s);
+  ASSERT_EQ(mirrors.size(), 4u);
+  const auto run = [&](par::Executor& ex, int depth, int max_views, PlanarMirrorStats& stats) {
+    const GBuffer g = resolve_gbuffer(ex, s, render_visibility(ex, s, c, 24, 16), c.eye);
+    const EnvironmentMap env = build_environment(ex, s.environment, 8);
+    PlanarMirrorSettings settings;
+    settings.depth = depth;
+    settings.width = 24;
+    settings.height = 16;
+    settings.max_views = max_views;
+    return planar_mirror_reflect(ex, s, mirrors, g, c, {}, env, settings, &stats);
+  };
+  par::Executor one(1), two(2);
+  PlanarMirrorStats free_stats, budget_stats, budget_stats2;
+  const ImageRGBA free = run(two, 3, 1 << 20, free_stats);
+  EXPECT_GT(free_stats.mirrored_views, 8u);  // the views multiply
+  EXPECT_EQ(free_stats.views_over_budget, 0u);
+  // A budget the recursion does not reach changes nothing.
+  PlanarMirrorStats same_stats;
+  const ImageRGBA same = run(two, 3, static_cast<int>(free_stats.mirrored_views), same_stats);
+  EXPECT_EQ(same_stats.views_over_budget, 0u);
+  EXPECT_EQ(0, std::memcmp(free.pixels.data(), same.pixels.data(), free.size() * sizeof(glm::vec4)));
+  // A budget it does reach: exactly that many views, the rest counted.
+  const int budget = static_cast<int>(free_stats.mirrored_views / 2);
+  const ImageRGBA a = run(one, 3, budget, budget_stats);
+  const ImageRGBA b = run(two, 3, budget, budget_stats2);
+  EXPECT_EQ(budget_stats.mirrored_views, static_cast<std::uint64_t>(budget));
+  EXPECT_GT(budget_stats.views_over_budget, 0u);
+  EXPECT_EQ(budget_stats2.mirrored_views, budget_stats.mirrored_views);
+  EXPECT_EQ(budget_stats2.views_over_budget, budget_stats.views_over_budget);
+  EXPECT_EQ(0, std::memcmp(a.pixels.data(), b.pixels.data(), a.size() * sizeof(glm::vec4)));
+  // Depth 8 with the default budget: bounded by it.
+  PlanarMirrorStats deep;
+  run(two, 8, PlanarMirrorSettings{}.max_views, deep);
+  EXPECT_EQ(deep.mirrored_views, static_cast<std::uint64_t>(PlanarMirrorSettings{}.max_views));
+  EXPECT_GT(deep.views_over_budget, 0u);
+}
+
 }  // namespace
 }  // namespace speculum::raster
