@@ -1,0 +1,117 @@
+// `speculum matrix`: results.json holds one record per cell with its errors against the
+// cached references; a rerun does not retrace them and gives the same records (times aside);
+// bad input is one line, exit 2, nothing written.
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "speculum_run.h"
+
+namespace speculum::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSmall =
+    "--threads 2 matrix --techniques envmap,planar-mirror --scenes mirror-corridor,bowl --width 40 --height 30 "
+    "--repeat 1 --spp-reference 4";
+
+std::size_t line_count(const std::string& s) { return std::count(s.begin(), s.end(), '\n'); }
+
+// The record without its wall times (every key ending in "ms").
+nlohmann::json without_times(nlohmann::json j) {
+  if (j.is_object()) {
+    nlohmann::json out = nlohmann::json::object();
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      const std::string& k = it.key();
+      if (k.size() >= 2 && k.compare(k.size() - 2, 2, "ms") == 0) continue;
+      out[k] = without_times(it.value());
+    }
+    return out;
+  }
+  if (j.is_array())
+    for (auto& e : j) e = without_times(e);
+  return j;
+}
+
+TEST(Matrix, RecordsEveryCellAndReusesTheReferences) {
+  const auto dir = scratch_dir();
+  const std::string out = (dir / "m").string();
+  const CommandResult first = run_speculum(kSmall + " -o " + sh_quote(out), dir);
+  ASSERT_EQ(first.status, 0) << first.err;
+  EXPECT_NE(first.err.find("tracing the reference of bowl"), std::string::npos) << first.err;
+  EXPECT_EQ(line_count(first.out), 2u + 4u) << first.out;  // header, rule, one row per cell
+  const nlohmann::json a = nlohmann::json::parse(slurp(dir / "m" / "results.json"));
+  ASSERT_EQ(a["cells"].size(), 4u);
+  for (const auto& c : a["cells"]) {
+    SCOPED_TRACE(c["id"].get<std::string>());
+    EXPECT_TRUE(fs::exists(dir / "m" / c["image"].get<std::string>()));
+    EXPECT_TRUE(fs::exists(dir / "m" / c["reference"]["image"].get<std::string>()));
+    for (const char* metric : {"mae8", "rmse", "psnr", "flip"}) EXPECT_TRUE(c["frame"].contains(metric));
+    // A feed-forward frame with shadow maps is never the 4-spp path-traced one.
+    EXPECT_GT(c["frame"]["mae8"].get<double>(), 0.0);
+    EXPECT_LT(c["frame"]["psnr"].get<double>(), 100.0);
+    EXPECT_GT(c["ms"].get<double>(), 0.0);
+    EXPECT_GE(c["nodes"].size(), 3u);
+    EXPECT_EQ(c["options"]["width"], 40);
+  }
+  EXPECT_EQ(a["cells"][0]["technique"], "envmap");
+  EXPECT_EQ(a["cells"][0]["scene"], "mirror-corridor");
+
+  // Rerun: references come from the cache, every record is the same but for its times.
+  const CommandResult second = run_speculum(kSmall + " -o " + sh_quote(out) + " --json", dir);
+  ASSERT_EQ(second.status, 0) << second.err;
+  EXPECT_EQ(second.err.find("tracing the reference"), std::string::npos) << second.err;
+  EXPECT_EQ(line_count(second.out), 4u);
+  EXPECT_EQ(nlohmann::json::parse(second.out.substr(0, second.out.find('\n')))["id"], "envmap@mirror-corridor");
+  const nlohmann::json b = nlohmann::json::parse(slurp(dir / "m" / "results.json"));
+  EXPECT_EQ(without_times(a), without_times(b));
+
+  // Another reference spp is another cache key: traced again.
+  const CommandResult third =
+      run_speculum("--threads 2 matrix --techniques envmap --scenes bowl --width 40 --height 30 --repeat 1 "
+                   "--spp-reference 1 -o " + sh_quote(out), dir);
+  ASSERT_EQ(third.status, 0) << third.err;
+  EXPECT_NE(third.err.find("tracing the reference of bowl"), std::string::npos) << third.err;
+  fs::remove_all(dir);
+}
+
+TEST(Matrix, BadInputIsOneLineExitTwoAndWritesNothing) {
+  const auto dir = scratch_dir();
+  const std::string out = (dir / "m").string();
+  struct Case {
+    std::string args, expect;
+  };
+  const Case cases[] = {
+      {"matrix --techniques envmp -o " + sh_quote(out), "did you mean 'envmap'"},
+      {"matrix --scenes bowl,sphere-in-rom -o " + sh_quote(out), "did you mean 'sphere-in-room'"},
+      {"matrix --techniques , -o " + sh_quote(out), "empty selection"},
+      {"matrix --techniques reference -o " + sh_quote(out), "unknown technique 'reference'"},
+      {"matrix --techniques envmap --param envmap:foo=1 -o " + sh_quote(out), "foo"},
+      {"matrix --techniques envmap --scenes bowl --cell envmap@glass-sphere -o " + sh_quote(out), "unknown cell"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const CommandResult r = run_speculum(c.args, dir);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("speculum: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // DIR is a file: left as it was.
+  const fs::path file = dir / "file";
+  { std::ofstream(file) << "keep"; }
+  const CommandResult r = run_speculum("matrix --techniques envmap --scenes bowl -o " + sh_quote(file.string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(line_count(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("is not a directory"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(file), "keep");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace speculum::test
