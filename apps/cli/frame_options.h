@@ -22,7 +22,7 @@ struct FrameOptions {
   std::uint32_t seed = 0;
   float exposure = 1.0f;
   float alpha = 0.0f;
-  int bounces = 1;
+  int bounces = 0;  // 0: the technique's default
   std::vector<std::string> params;
   int cube_map_size = 256;
   int shadow_map_size = 512;

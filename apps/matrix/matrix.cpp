@@ -2,6 +2,7 @@
 #include "apps/matrix/matrix.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "core/image_metrics.h"
 #include "core/procedural_scenes.h"
 #include "core/scene_loader.h"
+#include "raster/gbuffer.h"
 
 namespace speculum::matrix {
 
@@ -148,18 +150,37 @@ pipeline::FrameOptions frame_options(const MatrixOptions& o, const std::string& 
 struct ReferenceKey {
   std::string text;  // human-readable, stored beside the image
   fs::path image, record;
+  fs::path mask;  // specular references: white where the G-buffer surface is specular
 };
 
-ReferenceKey reference_key(const MatrixOptions& o, const std::string& scene_name, const Scene& scene) {
-  const pipeline::FrameOptions fo = frame_options(o, scene_name, "reference");
-  const pipeline::FrameSettings f = pipeline::make_frame_settings(fo, scene);
-  const Camera& c = f.camera;
+std::string camera_text(const Camera& c) {
   char camera[256];
   std::snprintf(camera, sizeof camera, "eye %.9g %.9g %.9g target %.9g %.9g %.9g up %.9g %.9g %.9g fov %.9g",
                 c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z,
                 static_cast<double>(c.vfov_degrees));
+  return camera;
+}
+
+// The exact specular reference of `scene` at `bounces` specular bounces.
+ReferenceKey specular_key(const MatrixOptions& o, const std::string& scene_name, const Scene& scene, int bounces) {
+  const pipeline::FrameSettings f = pipeline::make_frame_settings(frame_options(o, scene_name, "specular-reference"), scene);
   ReferenceKey k;
-  k.text = std::string(kReferenceVersion) + " scene " + scene_name + " camera " + camera + " size " +
+  k.text = std::string(kReferenceVersion) + " specular scene " + scene_name + " camera " + camera_text(f.camera) +
+           " size " + std::to_string(o.width) + "x" + std::to_string(o.height) + " glossy_samples " +
+           std::to_string(o.glossy_samples) + " bounces " + std::to_string(bounces) + " seed " + std::to_string(o.seed);
+  const fs::path dir = fs::path(o.output) / "references";
+  const std::string stem = scene_name + "-specular-b" + std::to_string(bounces) + "-" + hex64(fnv1a(k.text));
+  k.image = dir / (stem + ".png");
+  k.record = dir / (stem + ".json");
+  k.mask = dir / (stem + ".mask.png");
+  return k;
+}
+
+ReferenceKey reference_key(const MatrixOptions& o, const std::string& scene_name, const Scene& scene) {
+  const pipeline::FrameOptions fo = frame_options(o, scene_name, "reference");
+  const pipeline::FrameSettings f = pipeline::make_frame_settings(fo, scene);
+  ReferenceKey k;
+  k.text = std::string(kReferenceVersion) + " scene " + scene_name + " camera " + camera_text(f.camera) + " size " +
            std::to_string(o.width) + "x" + std::to_string(o.height) + " spp " + std::to_string(o.spp_reference) +
            " bounces " + std::to_string(o.bounces) + " seed " + std::to_string(o.seed);
   const fs::path dir = fs::path(o.output) / "references";
@@ -171,7 +192,7 @@ ReferenceKey reference_key(const MatrixOptions& o, const std::string& scene_name
 
 // The cached reference's record, or null when absent or for another key.
 cli::OrderedJson cached_reference(const ReferenceKey& k) {
-  if (!fs::exists(k.record) || !fs::exists(k.image)) return nullptr;
+  if (!fs::exists(k.record) || !fs::exists(k.image) || (!k.mask.empty() && !fs::exists(k.mask))) return nullptr;
   try {
     cli::OrderedJson j = cli::OrderedJson::parse(read_text(k.record));
     if (j.value("key", "") == k.text) return j;
@@ -188,6 +209,49 @@ cli::OrderedJson error_json(const ImageRGBA& reference, const ImageRGBA& test) {
   const FlipResult flip = flip_error(reference, test);
   return {{"mae8", rounded(e.mae8, 6)}, {"rmse", rounded(e.rmse, 8)}, {"psnr", rounded(e.psnr, 4)},
           {"flip", rounded(flip.mean, 6)}};
+}
+
+// The errors on the pixels where mask is set only: mae8, rmse and psnr of their 8-bit values,
+// the mean of the FLIP map over them, and their count.
+cli::OrderedJson masked_error_json(const ImageRGBA& reference, const ImageRGBA& test, const ImageRGBA& mask) {
+  if (reference.width != test.width || reference.height != test.height || mask.width != test.width ||
+      mask.height != test.height)
+    throw InputError("matrix", "specular reference and cell image differ in size");
+  const FlipResult flip = flip_error(reference, test);
+  double abs_sum = 0, sq_sum = 0, flip_sum = 0;
+  std::size_t pixels = 0;
+  for (std::size_t i = 0; i < test.size(); ++i) {
+    if (mask.pixels[i].x < 0.5f) continue;
+    ++pixels;
+    flip_sum += flip.error.pixels[i];
+    for (int c = 0; c < 3; ++c) {
+      const double d = display_to_8bit(reference.pixels[i][c]) - display_to_8bit(test.pixels[i][c]);
+      abs_sum += std::abs(d);
+      sq_sum += d * d;
+    }
+  }
+  const double n = 3.0 * double(std::max<std::size_t>(pixels, 1));
+  const double rmse = std::sqrt(sq_sum / n) / 255.0;
+  const double psnr = rmse > 0 ? 20.0 * std::log10(1.0 / rmse) : kPsnrIdentical;
+  return {{"mae8", rounded(abs_sum / n, 6)}, {"rmse", rounded(rmse, 8)}, {"psnr", rounded(psnr, 4)},
+          {"flip", rounded(pixels ? flip_sum / double(pixels) : 0.0, 6)}, {"pixels", pixels}};
+}
+
+// The specular bounces a technique follows, which its specular reference traces: the rounds
+// of multi-reflection, the mirror depth of planar-mirror, the layered tracer's bounces, the
+// two interfaces a refracted ray crosses, --bounces for ray-hierarchy; one otherwise.
+int specular_bounces(const std::string& technique, const pipeline::FrameSettings& f) {
+  if (technique == "multi-reflection") return int(f.param("rounds"));
+  if (technique == "planar-mirror") return std::max(1, int(f.param("depth")));
+  if (technique == "layered-distance-map") return std::max(int(f.param("bounces")), f.bounces);
+  if (technique == "refraction") return 2;
+  if (technique == "ray-hierarchy") return std::max(1, f.bounces);
+  return 1;
+}
+
+pipeline::FrameSettings cell_settings(const MatrixOptions& o, const Cell& cell, const Scene& scene) {
+  const pipeline::Technique& technique = pipeline::find_technique(cell.technique);
+  return technique.with_defaults(pipeline::make_frame_settings(frame_options(o, cell.scene, cell.technique), scene));
 }
 
 }  // namespace
@@ -257,8 +321,43 @@ void prepare_output(const fs::path& dir) {
 fs::path cell_image(const fs::path& dir, const Cell& cell) { return dir / "cells" / (cell.id() + ".png"); }
 fs::path cell_record(const fs::path& dir, const Cell& cell) { return dir / "cells" / (cell.id() + ".json"); }
 
-void ensure_reference(const MatrixOptions& o, const std::string& scene_name, par::Executor& executor, bool quiet) {
+namespace {
+
+void ensure_specular_reference(const MatrixOptions& o, const std::string& scene_name, const Scene& scene,
+                               int bounces, par::Executor& executor, bool quiet) {
+  const ReferenceKey k = specular_key(o, scene_name, scene, bounces);
+  if (!cached_reference(k).is_null()) return;
+  const pipeline::Technique& technique = pipeline::find_technique("specular-reference");
+  pipeline::FrameOptions fo = frame_options(o, scene_name, "specular-reference");
+  fo.bounces = bounces;
+  fo.params = {"glossy_samples=" + std::to_string(o.glossy_samples)};
+  const pipeline::FrameSettings f = pipeline::make_frame_settings(fo, scene);
+  if (!quiet)
+    std::fprintf(stderr, "speculum: matrix: tracing the specular reference of %s (%dx%d, %d bounce%s)\n",
+                 scene_name.c_str(), o.width, o.height, bounces, bounces == 1 ? "" : "s");
+  ImageRGBA mask;
+  const pipeline::FrameResult r = pipeline::render_frame(scene, technique, f, executor, [&](const par::CapturedOutput& out) {
+    if (const auto* g = out.as<raster::GBuffer>()) {
+      mask = ImageRGBA(g->width, g->height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+      for (std::size_t i = 0; i < g->object.size(); ++i)
+        if (g->covered(i) && raster::is_specular(g->surface.pixels[i])) mask.pixels[i] = glm::vec4(1.0f);
+    }
+  });
+  write_image(k.mask.string(), mask);
+  write_image(k.image.string(), r.display);
+  const cli::OrderedJson record{{"key", k.text}, {"scene", scene_name}, {"bounces", bounces},
+                                {"glossy_samples", o.glossy_samples}, {"ms", rounded(r.report.duration_ns * 1e-6, 3)}};
+  write_atomic(k.record, cli::json_document(record));
+}
+
+}  // namespace
+
+void ensure_reference(const MatrixOptions& o, const std::string& scene_name, par::Executor& executor, bool quiet,
+                      const std::vector<std::string>& techniques) {
   const Scene scene = load(scene_name);
+  std::set<int> bounces;
+  for (const std::string& t : techniques) bounces.insert(specular_bounces(t, cell_settings(o, {t, scene_name}, scene)));
+  for (int b : bounces) ensure_specular_reference(o, scene_name, scene, b, executor, quiet);
   const ReferenceKey k = reference_key(o, scene_name, scene);
   if (!cached_reference(k).is_null()) return;
   const pipeline::Technique& technique = pipeline::find_technique("reference");
@@ -276,13 +375,15 @@ void ensure_reference(const MatrixOptions& o, const std::string& scene_name, par
 }
 
 cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executor& executor, bool quiet) {
-  ensure_reference(o, cell.scene, executor, quiet);
+  ensure_reference(o, cell.scene, executor, quiet, {cell.technique});
   const Scene scene = load(cell.scene);
   const ReferenceKey k = reference_key(o, cell.scene, scene);
   const cli::OrderedJson ref = cached_reference(k);
   const pipeline::Technique& technique = pipeline::find_technique(cell.technique);
-  const pipeline::FrameSettings f =
-      technique.with_defaults(pipeline::make_frame_settings(frame_options(o, cell.scene, cell.technique), scene));
+  const pipeline::FrameSettings f = cell_settings(o, cell, scene);
+  const int bounces = specular_bounces(cell.technique, f);
+  const ReferenceKey sk = specular_key(o, cell.scene, scene, bounces);
+  const cli::OrderedJson spec_ref = cached_reference(sk);
 
   std::vector<double> frame_ms;
   std::map<std::string, std::vector<double>> node_ms;
@@ -325,9 +426,15 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
                           {"repeat", o.repeat},
                           {"nodes", nodes},
                           {"frame", error_json(reference, image)},
+                          {"specular", masked_error_json(read_image(sk.image.string()), image,
+                                                         read_image(sk.mask.string(), false))},
                           {"counters", counters},
                           {"reference", {{"spp", o.spp_reference}, {"ms", ref.value("ms", 0.0)},
                                          {"image", fs::relative(k.image, dir).string()}}},
+                          {"specular_reference", {{"bounces", bounces}, {"glossy_samples", o.glossy_samples},
+                                                  {"ms", spec_ref.value("ms", 0.0)},
+                                                  {"image", fs::relative(sk.image, dir).string()},
+                                                  {"mask", fs::relative(sk.mask, dir).string()}}},
                           {"image", fs::relative(cell_image(dir, cell), dir).string()}};
   write_atomic(cell_record(dir, cell), cli::json_document(record));
   return record;
@@ -358,7 +465,8 @@ cli::OrderedJson merge(const MatrixOptions& o, const std::vector<Cell>& cells) {
                                        " cells missing: " + names);
   }
   cli::OrderedJson results{{"version", kReferenceVersion}, {"width", o.width}, {"height", o.height},
-                           {"spp_reference", o.spp_reference}, {"cells", list}};
+                           {"spp_reference", o.spp_reference}, {"glossy_samples", o.glossy_samples},
+                           {"cells", list}};
   write_atomic(dir / "results.json", cli::json_document(results));
   return results;
 }

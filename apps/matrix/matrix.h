@@ -26,7 +26,8 @@ struct MatrixOptions {
   int width = 320, height = 240;
   int repeat = 3;
   int spp_reference = 64;
-  int bounces = 1;
+  int glossy_samples = 256;  // specular reference: GGX samples per glossy pixel
+  int bounces = 0;           // 0: each technique's default (the frame reference: 8)
   std::uint32_t seed = 0;
   std::vector<std::string> params;  // technique:name=value
   std::string output;
@@ -47,8 +48,11 @@ std::vector<std::string> cell_scenes(const std::vector<Cell>& cells);
 // The output directory, created if missing; InputError when it is a file or cannot be made.
 void prepare_output(const std::filesystem::path& dir);
 
-// The converged `reference` of `scene` in DIR/references (traced unless cached).
-void ensure_reference(const MatrixOptions& o, const std::string& scene, par::Executor& executor, bool quiet);
+// The references of `scene` in DIR/references, each traced unless cached: the converged
+// `reference` (frame error) and the `specular-reference` at every specular bounce count the
+// `techniques` follow (specular error).
+void ensure_reference(const MatrixOptions& o, const std::string& scene, par::Executor& executor, bool quiet,
+                      const std::vector<std::string>& techniques);
 // Runs one cell (its reference first if it is not cached) into DIR/cells/ID.{png,json}.
 nlohmann::ordered_json run_cell(const MatrixOptions& o, const Cell& cell, par::Executor& executor, bool quiet);
 // Finds a cell of the selection by its id ("technique@scene"); InputError when none.

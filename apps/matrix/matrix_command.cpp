@@ -57,7 +57,8 @@ std::string common_args(const CommandOptions& o) {
   const matrix::MatrixOptions& m = o.m;
   std::string s = "--width " + std::to_string(m.width) + " --height " + std::to_string(m.height) + " --repeat " +
                   std::to_string(m.repeat) + " --spp-reference " + std::to_string(m.spp_reference) +
-                  " --bounces " + std::to_string(m.bounces) + " --seed " + std::to_string(m.seed);
+                  " --bounces " + std::to_string(m.bounces) +
+                  " --glossy-samples " + std::to_string(m.glossy_samples) + " --seed " + std::to_string(m.seed);
   for (const std::string& p : m.params) s += " --param '" + p + "'";
   return s;
 }
@@ -176,6 +177,13 @@ void update_golden(const CommandOptions& o, const std::vector<matrix::Cell>& cel
                 read_image(matrix::cell_image(o.m.output, c).string()));
 }
 
+std::vector<std::string> techniques_of(const std::vector<matrix::Cell>& cells) {
+  std::vector<std::string> out;
+  for (const matrix::Cell& c : cells)
+    if (std::find(out.begin(), out.end(), c.technique) == out.end()) out.push_back(c.technique);
+  return out;
+}
+
 void run_matrix(CommandOptions& o, const GlobalOptions& global, const std::string& argv0) {
   const int modes = !o.cell.empty() + !o.reference.empty() + !o.merge.empty();
   if (modes > 1) throw InputError("--cell/--reference/--merge", "give at most one of them");
@@ -206,7 +214,7 @@ void run_matrix(CommandOptions& o, const GlobalOptions& global, const std::strin
     if (std::find(scenes.begin(), scenes.end(), o.reference) == scenes.end())
       throw InputError("--reference", "scene '" + o.reference + "' is not in the selection");
     matrix::prepare_output(o.m.output);
-    matrix::ensure_reference(o.m, o.reference, executor, global.quiet);
+    matrix::ensure_reference(o.m, o.reference, executor, global.quiet, techniques_of(cells));
     return;
   }
   if (!o.cell.empty()) {
@@ -218,7 +226,8 @@ void run_matrix(CommandOptions& o, const GlobalOptions& global, const std::strin
   }
   if (o.merge.empty()) {
     matrix::prepare_output(o.m.output);
-    for (const std::string& s : matrix::cell_scenes(cells)) matrix::ensure_reference(o.m, s, executor, global.quiet);
+    for (const std::string& s : matrix::cell_scenes(cells))
+      matrix::ensure_reference(o.m, s, executor, global.quiet, techniques_of(cells));
     Progress progress("matrix", cells.size(), global.quiet);
     for (const matrix::Cell& c : cells) {
       matrix::run_cell(o.m, c, executor, true);
@@ -259,8 +268,11 @@ void add_matrix_command(CLI::App& app, GlobalOptions& global) {
       ->check(CLI::Range(1, 1000))->capture_default_str();
   cmd->add_option("--spp-reference", m.spp_reference, "Samples per pixel of the converged frame reference")
       ->check(CLI::Range(1, 65536))->capture_default_str();
-  cmd->add_option("--bounces", m.bounces, "Specular bounces (ray-hierarchy, and the frame reference)")
-      ->check(CLI::Range(1, 16))->capture_default_str();
+  cmd->add_option("--bounces", m.bounces,
+                  "Specular bounces of ray-hierarchy and the frame reference (0: their defaults, 1 and 8)")
+      ->check(CLI::Range(0, 16))->capture_default_str();
+  cmd->add_option("--glossy-samples", m.glossy_samples, "GGX samples per glossy pixel of the specular reference")
+      ->check(CLI::Range(1, 65536))->capture_default_str();
   cmd->add_option("--seed", m.seed, "Random seed")->capture_default_str();
   cmd->add_option("--param", m.params, "technique:name=value, repeatable (see `speculum techniques`)");
   cmd->add_option("-o,--output", m.output, "Output directory (results.json, cells/, references/)");

@@ -44,10 +44,16 @@ const std::vector<Technique>& techniques() {
        add_envmap_passes,
        {}},
       {"reference",
-       "reference tracer: BVH ray tracing, Whitted mirrors/refraction, Phong-lobe glossy "
-       "sampling (--spp path samples); the ground truth",
+       "reference tracer: BVH ray tracing, Whitted mirrors/refraction, GGX-lobe glossy "
+       "sampling (--spp path samples, --bounces specular depth, default 8); the ground truth",
        add_reference_passes,
        {}},
+      {"specular-reference",
+       "reference for the specular term alone: the feed-forward G-buffer and direct light, "
+       "reflected/refracted rays traced exactly through the BVH to --bounces, glossy lobes "
+       "sampled to convergence",
+       add_specular_reference_passes,
+       {{"glossy_samples", 256, 1, 65536, true, "GGX visible-normal samples per glossy pixel"}}},
       {"distance-map",
        "distance maps (SURVEY §4.1-4.2): per-reflector colour+distance cube, searched per sample",
        add_distance_map_passes, search_params()},

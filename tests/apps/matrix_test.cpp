@@ -58,6 +58,21 @@ TEST(Matrix, RecordsEveryCellAndReusesTheReferences) {
     EXPECT_GE(c["nodes"].size(), 3u);
     EXPECT_EQ(c["options"]["width"], 40);
   }
+  // The specular error isolates the technique's own approximation: the planar mirror is
+  // exact but for edges on the corridor's flat mirrors, envmap (no parallax) is far off.
+  auto cell = [&](const std::string& id) {
+    for (const auto& c : a["cells"])
+      if (c["id"] == id) return c;
+    return nlohmann::json();
+  };
+  const auto mirror = cell("planar-mirror@mirror-corridor"), envmap = cell("envmap@mirror-corridor");
+  ASSERT_TRUE(mirror.contains("specular"));
+  EXPECT_GT(mirror["specular"]["pixels"].get<int>(), 100);
+  EXPECT_EQ(mirror["specular"]["pixels"], envmap["specular"]["pixels"]);  // one G-buffer, one mask
+  EXPECT_LT(mirror["specular"]["mae8"].get<double>(), 2.0);
+  EXPECT_GT(envmap["specular"]["mae8"].get<double>(), 5.0 * mirror["specular"]["mae8"].get<double>());
+  EXPECT_EQ(mirror["specular_reference"]["bounces"], 3);  // planar-mirror's depth
+  EXPECT_EQ(envmap["specular_reference"]["bounces"], 1);
   EXPECT_EQ(a["cells"][0]["technique"], "envmap");
   EXPECT_EQ(a["cells"][0]["scene"], "mirror-corridor");
 
@@ -76,6 +91,42 @@ TEST(Matrix, RecordsEveryCellAndReusesTheReferences) {
                    "--spp-reference 1 -o " + sh_quote(out), dir);
   ASSERT_EQ(third.status, 0) << third.err;
   EXPECT_NE(third.err.find("tracing the reference of bowl"), std::string::npos) << third.err;
+  fs::remove_all(dir);
+}
+
+// The reference follows --bounces (0 or absent: its default depth, 8).
+TEST(Matrix, ReferenceHonoursBounces) {
+  const auto dir = scratch_dir();
+  const std::string base = "-q render mirror-corridor -t reference --width 40 --height 30 -o ";
+  const std::pair<std::string, std::string> runs[] = {{"", "r.png"}, {"--bounces 8 ", "r8.png"}, {"--bounces 1 ", "r1.png"}};
+  for (const auto& [b, name] : runs) {
+    const CommandResult r = run_speculum(base + sh_quote((dir / name).string()) + " " + b, dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  EXPECT_EQ(slurp(dir / "r.png"), slurp(dir / "r8.png"));
+  EXPECT_NE(slurp(dir / "r.png"), slurp(dir / "r1.png"));  // facing mirrors: later bounces show
+  fs::remove_all(dir);
+}
+
+// The specular reference's glossy lobes converge: 1024 samples differ from 256 less than 256
+// from 16.
+TEST(Matrix, SpecularReferenceGlossyLobeConverges) {
+  const auto dir = scratch_dir();
+  for (int n : {16, 256, 1024}) {
+    const CommandResult r = run_speculum("-q render glossy-plane -t specular-reference --width 40 --height 30 "
+                                         "--param glossy_samples=" + std::to_string(n) + " -o " +
+                                             sh_quote((dir / ("g" + std::to_string(n) + ".png")).string()),
+                                         dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  auto mae8 = [&](const std::string& a, const std::string& b) {
+    const CommandResult r = run_speculum("compare --json " + sh_quote((dir / a).string()) + " " + sh_quote((dir / b).string()), dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(r.out)["mae8"].get<double>();
+  };
+  const double coarse = mae8("g16.png", "g256.png"), fine = mae8("g256.png", "g1024.png");
+  EXPECT_GT(coarse, 0.0);
+  EXPECT_LT(fine, 0.5 * coarse);
   fs::remove_all(dir);
 }
 
