@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include <expat.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -127,6 +129,84 @@ TEST(Matrix, SpecularReferenceGlossyLobeConverges) {
   const double coarse = mae8("g16.png", "g256.png"), fine = mae8("g256.png", "g1024.png");
   EXPECT_GT(coarse, 0.0);
   EXPECT_LT(fine, 0.5 * coarse);
+  fs::remove_all(dir);
+}
+
+// What a JUnit report holds, as an XML parser reads it.
+struct JUnit {
+  bool well_formed = false;
+  int suites = 0, cases = 0, failures = 0;
+  std::string suite_tests, suite_failures;
+  std::vector<std::string> failed;  // classname@name of the failing cases
+  std::string current;
+};
+
+JUnit parse_junit(const std::string& xml) {
+  JUnit j;
+  XML_Parser p = XML_ParserCreate(nullptr);
+  XML_SetUserData(p, &j);
+  XML_SetStartElementHandler(p, [](void* data, const XML_Char* name, const XML_Char** attrs) {
+    auto& j = *static_cast<JUnit*>(data);
+    auto attr = [&](const std::string& key) {
+      for (int i = 0; attrs[i]; i += 2)
+        if (key == attrs[i]) return std::string(attrs[i + 1]);
+      return std::string();
+    };
+    const std::string element = name;
+    if (element == "testsuite") {
+      ++j.suites;
+      j.suite_tests = attr("tests");
+      j.suite_failures = attr("failures");
+    } else if (element == "testcase") {
+      ++j.cases;
+      j.current = attr("classname") + "@" + attr("name");
+    } else if (element == "failure") {
+      ++j.failures;
+      j.failed.push_back(j.current);
+    }
+  });
+  j.well_formed = XML_Parse(p, xml.data(), static_cast<int>(xml.size()), 1) == XML_STATUS_OK;
+  XML_ParserFree(p);
+  return j;
+}
+
+// Goldens written by --update-golden pass; a changed parameter fails exactly the cells it
+// changes, and the JUnit XML says so.
+TEST(Matrix, GoldenImagesAndJUnit) {
+  const auto dir = scratch_dir();
+  const std::string out = sh_quote((dir / "m").string()), golden = sh_quote((dir / "golden").string());
+  const std::string run = "-q --threads 2 matrix --techniques distance-map,planar-mirror --scenes mirror-corridor,bowl "
+                          "--width 40 --height 30 --repeat 1 --spp-reference 2 --glossy-samples 4 -o " + out;
+  const CommandResult update = run_speculum(run + " --update-golden " + golden, dir);
+  ASSERT_EQ(update.status, 0) << update.err;
+  EXPECT_TRUE(fs::exists(dir / "golden" / "planar-mirror@bowl.png"));
+
+  const std::string junit = (dir / "report.xml").string();
+  const CommandResult pass = run_speculum(run + " --golden " + golden + " --max-mae8 0 --junit " + sh_quote(junit), dir);
+  EXPECT_EQ(pass.status, 0) << pass.err;
+  JUnit j = parse_junit(slurp(junit));
+  EXPECT_TRUE(j.well_formed);
+  EXPECT_EQ(j.suites, 1);
+  EXPECT_EQ(j.cases, 4);
+  EXPECT_EQ(j.failures, 0);
+  EXPECT_EQ(j.suite_tests, "4");
+  EXPECT_EQ(j.suite_failures, "0");
+
+  // One mirror bounce instead of three: only the planar mirrors facing each other change.
+  const CommandResult fail =
+      run_speculum(run + " --param planar-mirror:depth=1 --golden " + golden + " --max-mae8 0 --junit " + sh_quote(junit), dir);
+  EXPECT_EQ(fail.status, 1) << fail.err;
+  j = parse_junit(slurp(junit));
+  EXPECT_TRUE(j.well_formed);
+  EXPECT_EQ(j.cases, 4);
+  EXPECT_EQ(j.failures, 1);
+  EXPECT_EQ(j.suite_failures, "1");
+  EXPECT_EQ(j.failed, std::vector<std::string>{"planar-mirror@mirror-corridor"});
+  EXPECT_NE(fail.err.find("planar-mirror@mirror-corridor: mae8"), std::string::npos) << fail.err;
+
+  // A golden directory that does not exist is bad input.
+  const CommandResult bad = run_speculum(run + " --golden " + sh_quote((dir / "none").string()), dir);
+  EXPECT_EQ(bad.status, 2) << bad.err;
   fs::remove_all(dir);
 }
 
