@@ -1,6 +1,8 @@
 // The matrix's jobs: see matrix.h.
 #include "apps/matrix/matrix.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -24,6 +26,8 @@ namespace speculum::matrix {
 
 namespace fs = std::filesystem;
 using cli::rounded;
+
+void write_image_atomic(const fs::path& path, const ImageRGBA& image);
 
 namespace {
 
@@ -256,8 +260,26 @@ pipeline::FrameSettings cell_settings(const MatrixOptions& o, const Cell& cell, 
 
 }  // namespace
 
+// A temporary name beside `path` no other process uses: jobs of one plan may run at once on
+// machines sharing DIR, and two may finish the same reference.
+fs::path temporary(const fs::path& path) {
+  char host[128] = "host";
+  gethostname(host, sizeof host - 1);
+  return path.parent_path() / ("." + path.stem().string() + "." + host + "." + std::to_string(getpid()) +
+                               path.extension().string());
+}
+
+// write_image through a name of this process's own, renamed into place.
+void write_image_atomic(const fs::path& path, const ImageRGBA& image) {
+  const fs::path tmp = temporary(path);
+  write_image(tmp.string(), image);
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw InputError(path.string(), "cannot write: " + ec.message());
+}
+
 void write_atomic(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp");
+  const fs::path tmp = temporary(fs::path(path.string() + ".tmp"));
   {
     std::ofstream out(tmp, std::ios::binary);
     out << text;
@@ -343,8 +365,8 @@ void ensure_specular_reference(const MatrixOptions& o, const std::string& scene_
         if (g->covered(i) && raster::is_specular(g->surface.pixels[i])) mask.pixels[i] = glm::vec4(1.0f);
     }
   });
-  write_image(k.mask.string(), mask);
-  write_image(k.image.string(), r.display);
+  write_image_atomic(k.mask, mask);
+  write_image_atomic(k.image, r.display);
   const cli::OrderedJson record{{"key", k.text}, {"scene", scene_name}, {"bounces", bounces},
                                 {"glossy_samples", o.glossy_samples}, {"ms", rounded(r.report.duration_ns * 1e-6, 3)}};
   write_atomic(k.record, cli::json_document(record));
@@ -368,7 +390,7 @@ void ensure_reference(const MatrixOptions& o, const std::string& scene_name, par
     std::fprintf(stderr, "speculum: matrix: tracing the reference of %s (%dx%d, %d spp)\n", scene_name.c_str(),
                  o.width, o.height, o.spp_reference);
   const pipeline::FrameResult r = pipeline::render_frame(scene, technique, f, executor);
-  write_image(k.image.string(), r.display);
+  write_image_atomic(k.image, r.display);
   const cli::OrderedJson record{{"key", k.text}, {"scene", scene_name}, {"spp", o.spp_reference},
                                 {"bounces", o.bounces}, {"ms", rounded(r.report.duration_ns * 1e-6, 3)}};
   write_atomic(k.record, cli::json_document(record));  // last: the record marks the image complete
@@ -395,7 +417,7 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
     last = std::move(r);
   }
   const fs::path dir = o.output;
-  write_image(cell_image(dir, cell).string(), last.display);
+  write_image_atomic(cell_image(dir, cell), last.display);
   // Judge the images as stored: both read back from their PNGs, so a cached reference and a
   // fresh one give the same numbers.
   const ImageRGBA reference = read_image(k.image.string());

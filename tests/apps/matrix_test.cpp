@@ -3,6 +3,8 @@
 // bad input is one line, exit 2, nothing written.
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -207,6 +209,63 @@ TEST(Matrix, GoldenImagesAndJUnit) {
   // A golden directory that does not exist is bad input.
   const CommandResult bad = run_speculum(run + " --golden " + sh_quote((dir / "none").string()), dir);
   EXPECT_EQ(bad.status, 2) << bad.err;
+  fs::remove_all(dir);
+}
+
+// Every file under `dir` (relative path → bytes), results.json left out.
+std::map<std::string, std::string> images(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file() && e.path().extension() == ".png") out[fs::relative(e.path(), dir).string()] = slurp(e.path());
+  return out;
+}
+
+// The plan's jobs run by GNU parallel (references, then cells), then merged: the same
+// results.json (times aside) and the same image bytes as one `speculum matrix` process.
+TEST(Matrix, PlanRunByGnuParallelEqualsOneProcess) {
+  const auto dir = scratch_dir();
+  ASSERT_EQ(run_shell("command -v parallel", dir).status, 0) << "GNU parallel is not installed (.ci/setup.sh)";
+  const std::string selection = "matrix --techniques envmap,ray-hierarchy --scenes sphere-in-room,glass-sphere "
+                                "--width 40 --height 30 --repeat 1 --spp-reference 2 --glossy-samples 4 --param "
+                                "ray-hierarchy:block=16";
+  const std::string one = sh_quote((dir / "one").string()), jobs = sh_quote((dir / "jobs").string());
+  const CommandResult single = run_speculum("-q --threads 1 " + selection + " -o " + one, dir);
+  ASSERT_EQ(single.status, 0) << single.err;
+
+  const CommandResult plan = run_speculum(selection + " --plan -o " + jobs, dir);
+  ASSERT_EQ(plan.status, 0) << plan.err;
+  EXPECT_EQ(line_count(plan.out), 2u + 4u) << plan.out;  // two reference jobs, four cells
+  EXPECT_NE(plan.out.find("matrix --reference 'glass-sphere'"), std::string::npos) << plan.out;
+  EXPECT_NE(plan.out.find("matrix --cell 'ray-hierarchy@sphere-in-room'"), std::string::npos) << plan.out;
+  EXPECT_TRUE(plan.out.find("matrix --cell") > plan.out.rfind("matrix --reference"));
+  EXPECT_FALSE(fs::exists(dir / "jobs"));  // --plan only prints
+
+  for (const std::string phase : {"references", "cells"}) {
+    const CommandResult r = run_shell(sh_quote(SPECULUM_BINARY) + " " + selection + " --plan " + phase + " -o " + jobs +
+                                          " | parallel --will-cite -j2 --halt now,fail=1", dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  // Remove a cell: the merge names it, exit 2, and writes no results.json.
+  const fs::path record = dir / "jobs" / "cells" / "envmap@glass-sphere.json";
+  const std::string kept = slurp(record);
+  fs::remove(record);
+  const CommandResult missing = run_speculum(selection + " --merge " + jobs, dir);
+  EXPECT_EQ(missing.status, 2) << missing.err;
+  EXPECT_NE(missing.err.find("1 of 4 cells missing: envmap@glass-sphere"), std::string::npos) << missing.err;
+  EXPECT_EQ(line_count(missing.err), 1u) << missing.err;
+  EXPECT_FALSE(fs::exists(dir / "jobs" / "results.json"));
+  { std::ofstream(record, std::ios::binary) << kept; }
+
+  const CommandResult merged = run_speculum(selection + " --merge " + jobs, dir);
+  ASSERT_EQ(merged.status, 0) << merged.err;
+  EXPECT_EQ(line_count(merged.out), 2u + 4u);
+  const auto a = nlohmann::json::parse(slurp(dir / "one" / "results.json"));
+  const auto b = nlohmann::json::parse(slurp(dir / "jobs" / "results.json"));
+  EXPECT_EQ(without_times(a), without_times(b));
+  EXPECT_EQ(a["cells"].size(), 4u);
+  const auto ia = images(dir / "one"), ib = images(dir / "jobs");
+  EXPECT_EQ(ia.size(), 4u + 2u + 2u * 2u);  // cells; frame references; specular images + masks (1 bounce)
+  EXPECT_TRUE(ia == ib);
   fs::remove_all(dir);
 }
 
