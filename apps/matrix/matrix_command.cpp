@@ -200,6 +200,7 @@ void run_matrix(CommandOptions& o, const GlobalOptions& global, const std::strin
     print_plan(o, cells, argv0);
     return;
   }
+  if (!o.junit.empty() && o.golden.empty()) throw InputError("--junit", "needs --golden DIR (the images to check against)");
   if (!o.golden.empty()) {
     std::error_code ec;
     if (!fs::is_directory(o.golden, ec)) throw InputError(o.golden, "golden directory not found");
