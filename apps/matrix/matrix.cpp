@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "apps/cli/frame_options.h"
+#include "apps/matrix/atlas.h"
 #include "apps/cli/json_output.h"
 #include "apps/techniques/render_frame.h"
 #include "core/error.h"
@@ -422,6 +423,12 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
   // fresh one give the same numbers.
   const ImageRGBA reference = read_image(k.image.string());
   const ImageRGBA image = read_image(cell_image(dir, cell).string());
+  const ImageRGBA specular_reference = read_image(sk.image.string());
+  const ImageRGBA mask = read_image(sk.mask.string(), false);
+  const fs::path frame_heat = dir / "cells" / (cell.id() + ".frame-diff.png");
+  const fs::path specular_heat = dir / "cells" / (cell.id() + ".specular-diff.png");
+  write_image_atomic(frame_heat, difference_heat_map(reference, image));
+  write_image_atomic(specular_heat, difference_heat_map(specular_reference, image, &mask));
 
   cli::OrderedJson nodes = cli::OrderedJson::array();
   cli::OrderedJson counters = cli::OrderedJson::object();
@@ -448,8 +455,7 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
                           {"repeat", o.repeat},
                           {"nodes", nodes},
                           {"frame", error_json(reference, image)},
-                          {"specular", masked_error_json(read_image(sk.image.string()), image,
-                                                         read_image(sk.mask.string(), false))},
+                          {"specular", masked_error_json(specular_reference, image, mask)},
                           {"counters", counters},
                           {"reference", {{"spp", o.spp_reference}, {"ms", ref.value("ms", 0.0)},
                                          {"image", fs::relative(k.image, dir).string()}}},
@@ -457,7 +463,9 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
                                                   {"ms", spec_ref.value("ms", 0.0)},
                                                   {"image", fs::relative(sk.image, dir).string()},
                                                   {"mask", fs::relative(sk.mask, dir).string()}}},
-                          {"image", fs::relative(cell_image(dir, cell), dir).string()}};
+                          {"image", fs::relative(cell_image(dir, cell), dir).string()},
+                          {"frame_heat_map", fs::relative(frame_heat, dir).string()},
+                          {"specular_heat_map", fs::relative(specular_heat, dir).string()}};
   write_atomic(cell_record(dir, cell), cli::json_document(record));
   return record;
 }

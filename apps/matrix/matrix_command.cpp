@@ -9,6 +9,7 @@
 #include "apps/cli/commands.h"
 #include "apps/cli/json_output.h"
 #include "apps/cli/progress.h"
+#include "apps/matrix/atlas.h"
 #include "apps/matrix/matrix.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -238,6 +239,7 @@ void run_matrix(CommandOptions& o, const GlobalOptions& global, const std::strin
     progress.finish();
   }
   const OrderedJson results = matrix::merge(o.m, cells);
+  matrix::write_atlas(o.m.output, results, global.quiet);
   print_table(results, o.json);
   std::fflush(stdout);
   if (!o.update_golden.empty()) update_golden(o, cells);
@@ -252,7 +254,7 @@ void add_matrix_command(CLI::App& app, GlobalOptions& global) {
       "matrix",
       "Every technique on every built-in scene: median frame time, per-pass split and the error\n"
       "against the converged reference (frame) and an exact specular reference; results.json,\n"
-      "each cell's PNG and a Markdown table. Cells are independent jobs (--plan, --cell, --merge)");
+      "each cell's PNG, an atlas (index.html) and a Markdown table. Cells are independent jobs (--plan, --cell, --merge)");
   cmd->footer(
       "Examples:\n"
       "  speculum matrix --width 160 --height 120 -o m/\n"
