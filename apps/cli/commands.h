@@ -23,6 +23,8 @@ void add_techniques_command(CLI::App& app, GlobalOptions& global);
 void add_inspect_command(CLI::App& app, GlobalOptions& global);
 void add_profile_command(CLI::App& app, GlobalOptions& global);
 void add_compare_command(CLI::App& app, GlobalOptions& global);
+// matrix (apps/matrix/): every technique × scene, timed and judged against cached references.
+void add_matrix_command(CLI::App& app, GlobalOptions& global);
 // Thrown by a command whose result is an exit status (compare: 1 when outside the bound);
 // main returns `code` without printing anything more.
 struct ExitStatus {

@@ -51,8 +51,10 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
                "environment and key light, with a warning)");
   cmd.add_option("--alpha", o.alpha, "yu-lod: LOD threshold α of YU eq.7 (0: LOD off)")
       ->check(CLI::Range(0.0f, 1e6f))->capture_default_str();
-  cmd.add_option("--bounces", o.bounces, "Specular bounces (ray-hierarchy, recursive techniques)")
-      ->check(CLI::Range(1, 16))->capture_default_str();
+  cmd.add_option("--bounces", o.bounces,
+                 "Specular bounces (ray-hierarchy, recursive techniques, reference, specular-reference;\n"
+                 "0: the technique's default: 1, reference 8)")
+      ->check(CLI::Range(0, 16))->capture_default_str();
   cmd.add_option("--param", o.params,
                  "Technique parameter name=value, repeatable (see `speculum techniques`)");
   // The maxima bound memory: living-room (the built-in scene with most reflectors) peaks

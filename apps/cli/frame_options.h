@@ -28,7 +28,7 @@ struct FrameOptions {
   float env_rotate = 0.0f;     // degrees about +Y
   bool no_default_light = false;
   float alpha = 0.0f;
-  int bounces = 1;
+  int bounces = 0;  // 0: the technique's default
   std::vector<std::string> params;
   int cube_map_size = 256;
   int shadow_map_size = 512;

@@ -82,6 +82,7 @@ int main(int argc, char** argv) {
   cli::add_inspect_command(app, global);
   cli::add_profile_command(app, global);
   cli::add_compare_command(app, global);
+  cli::add_matrix_command(app, global);
 
   std::signal(SIGINT, on_sigint);
   try {

@@ -27,7 +27,8 @@ struct FrameSettings {
   float exposure = 1.0f;
   bool auto_exposure = false;  // meter the frame instead (raster/composite.h meter_exposure)
   float alpha = 0.0f;  // yu-lod: LOD threshold of YU eq.7; 0: LOD off
-  int bounces = 1;     // ray-hierarchy and recursive techniques: specular bounces
+  int bounces = 0;     // specular bounces of ray-hierarchy, the recursive techniques and the
+                       // references; 0: each technique's default (1; reference: 8)
   // The technique's parameters (`--param name=value`). Technique::add_passes fills in the
   // defaults of the technique table and checks the ranges before the recipe runs, so a
   // recipe reads every parameter it declares with param(name).

@@ -16,6 +16,8 @@ namespace speculum::pipeline {
 FrameOutputs add_envmap_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // reference: reference_trace → tonemap.
 FrameOutputs add_reference_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
+// specular-reference: surface passes → specular_trace (exact specular layer) → output passes.
+FrameOutputs add_specular_reference_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // distance-map (SURVEY §4.1–4.2): reflector_cube_maps → distance_map_reflect.
 FrameOutputs add_distance_map_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // multi-reflection (SURVEY §4.3): multi_reflection_maps → distance_map_reflect.

@@ -11,6 +11,7 @@ FrameOutputs add_reference_passes(par::Graph& g, const Scene* scene, const Frame
   o.width = f.width;
   o.height = f.height;
   o.spp = f.spp;
+  if (f.bounces > 0) o.max_depth = f.bounces;  // 0: the tracer's own default depth
   o.seed = f.seed;
   o.pixel_jitter = f.spp > 1;
   FrameOutputs out;

@@ -49,11 +49,18 @@ const std::vector<Technique>& techniques() {
        add_envmap_passes,
        {}},
       {"reference",
-       "reference tracer: BVH ray tracing, Whitted mirrors/refraction, Phong-lobe glossy "
-       "sampling (--spp path samples); the ground truth",
+       "reference tracer: BVH ray tracing, Whitted mirrors/refraction, GGX-lobe glossy "
+       "sampling (--spp path samples, --bounces specular depth, default 8); the ground truth",
        add_reference_passes,
        {},
        double(1 << 26)},  // paths cost time only (memory is per pixel): about two minutes on two cores
+      {"specular-reference",
+       "reference for the specular term alone: the feed-forward G-buffer and direct light, "
+       "reflected/refracted rays traced exactly through the BVH to --bounces, glossy lobes "
+       "sampled to convergence",
+       add_specular_reference_passes,
+       {{"glossy_samples", 256, 1, 4096, true,
+         "GGX visible-normal samples per glossy pixel (≤ 4096: time grows with it)"}}},
       {"distance-map",
        "distance maps (SURVEY §4.1-4.2): per-reflector colour+distance cube, searched per sample",
        add_distance_map_passes, search_params()},

@@ -38,6 +38,10 @@ TEST(LanesThreadsDeterminism, RayHierarchySameBytesForEveryWidthAndThreadCount) 
   expect_same_bytes_for_every_width_and_thread_count("ray-hierarchy");
 }
 
+TEST(LanesThreadsDeterminism, SpecularReferenceSameBytesForEveryWidthAndThreadCount) {
+  expect_same_bytes_for_every_width_and_thread_count("specular-reference");
+}
+
 TEST(LanesThreadsDeterminism, EnvmapSameBytesForEveryWidthAndThreadCount) {
   expect_same_bytes_for_every_width_and_thread_count("envmap");
 }
