@@ -170,6 +170,19 @@ glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d) {
   return glm::vec3(sample_bilinear_repeat(img, clamped)) * env.intensity;
 }
 
+glm::vec3 environment_mean_radiance(const Environment& env) {
+  if (!env.has_image()) return env.constant * env.intensity;
+  const ImageRGBA& img = env.equirect;
+  glm::dvec3 sum(0.0);
+  double weight = 0.0;
+  for (int y = 0; y < img.height; ++y) {
+    const double w = std::sin(kPi * (y + 0.5) / img.height);  // the row's solid angle share
+    for (int x = 0; x < img.width; ++x) sum += w * glm::dvec3(glm::vec3(img.at(x, y)));
+    weight += w * img.width;
+  }
+  return glm::vec3(sum / weight) * env.intensity;
+}
+
 std::vector<std::uint8_t> refractor_objects(const Scene& scene) {
   std::vector<std::uint8_t> out(scene.objects.size(), 0);
   for (std::size_t t = 0; t < scene.mesh.triangle_count(); ++t) {

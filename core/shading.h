@@ -114,6 +114,10 @@ glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv);
 // (d: unit direction of the ray leaving the scene).
 glm::vec2 equirect_uv(const glm::vec3& d);
 glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d);
+// The environment's radiance averaged over the sphere (each equirect row weighted by its
+// solid angle); π times it is the irradiance of a constant environment, and the ambient
+// term of shading that has no spherical-harmonic projection at hand.
+glm::vec3 environment_mean_radiance(const Environment& env);
 
 // Bilinear lookup with repeat wrapping in u and v (texel centres at (i+0.5)/w).
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv);

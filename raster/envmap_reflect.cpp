@@ -8,15 +8,15 @@
 namespace speculum::raster {
 namespace {
 
-template <class MapOf>
-ImageRGBA reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& map_of) {
+template <class MapOf, class Takes>
+ImageRGBA reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& map_of, const Takes& takes) {
   ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   executor.parallel_for("envmap_reflect.lookup", out.size(), 4096,
                         [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface.pixels[i];
-      if (!is_specular(s)) continue;
+      if (!takes(s)) continue;
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return map_of(g.object.pixels[i]).radiance(d, exponent);
       };
@@ -35,7 +35,17 @@ ImageRGBA envmap_reflect(par::Executor& executor, const GBuffer& g, const Enviro
   return reflect_with(executor, g, [&](std::uint32_t object) -> const EnvironmentMap& {
     const EnvironmentMap* own = reflectors ? reflectors->for_object(object) : nullptr;
     return own ? *own : env;
-  });
+  }, [](const SurfaceParams& s) { return is_specular(s); });
+}
+
+ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env) {
+  return reflect_with(executor, g, [&](std::uint32_t) -> const EnvironmentMap& { return env; },
+                      [](const SurfaceParams& s) { return s.is_refractor(); });
+}
+
+ImageRGBA RefractorEnvironmentPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                               const EnvironmentMap& environment) const {
+  return refractor_environment(c.executor(), gbuffer, environment);
 }
 
 ImageRGBA EnvmapReflectPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,

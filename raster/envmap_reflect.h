@@ -29,4 +29,18 @@ struct EnvmapReflectPass {
                        const ReflectorMaps* maps) const;
 };
 
+// The fallback of techniques that do not follow refraction (yu-lod traces reflections only):
+// refractor samples get the environment along R and T as envmap_reflect computes them, every
+// other sample 0.
+ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env);
+
+// Pass "refractor_environment".
+struct RefractorEnvironmentPass {
+  static constexpr const char* description =
+      "Refractor samples only: the environment along the reflected and refracted directions, "
+      "Fresnel-weighted (SURVEY §3.1) — the documented fallback of a technique that traces "
+      "reflections only, so glass is never black.";
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const EnvironmentMap& environment) const;
+};
+
 }  // namespace speculum::raster

@@ -5,7 +5,9 @@
 
 #include <glm/geometric.hpp>
 
+#include "raster/composite.h"
 #include "raster/direct_light.h"
+#include "raster/envmap_reflect.h"
 #include "raster/specular_radiance.h"
 
 namespace speculum::raster {
@@ -79,7 +81,10 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
     CubeMap cube = render_cube_map(
         executor, scene, centre, opt, [&](const GBuffer& g, const Camera& cam) {
-          return direct_light(executor, scene, g, cam, shadows, env);
+          // Other reflectors seen in this map show the environment along their own R (and
+          // T): the first-order fallback, so a mirror seen in a mirror is never black.
+          return composite(executor, direct_light(executor, scene, g, cam, shadows, env),
+                           envmap_reflect(executor, g, env));
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
     out.maps.push_back(environment_from_faces(executor, cube.colour, false,

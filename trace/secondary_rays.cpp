@@ -9,6 +9,7 @@
 
 #include "core/optics.h"
 #include "core/ray_offset.h"
+#include "core/sampling.h"
 
 namespace speculum::trace {
 
@@ -151,6 +152,10 @@ SecondaryRays shadow_rays(par::Executor& ex, const Scene& scene, const Light& li
 
 void shade_hits(par::Executor& ex, const Scene& scene, const SecondaryRays& gen, const HitStream& hits,
                 const std::vector<HitStream>& shadow_hits, ImageRGBA& out) {
+  // Ambient light on the diffuse lobe, unshadowed, as the rasterized direct light adds it
+  // (core/shading.h): without it a hit in a light's shadow would be black where the
+  // reference shows the sky's light.
+  const glm::vec3 ambient = kPi * environment_mean_radiance(scene.environment);
   ex.parallel_for("shade_hits", gen.active.size(), kPixelChunk, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (!gen.active[i]) continue;
@@ -167,6 +172,7 @@ void shade_hits(par::Executor& ex, const Scene& scene, const SecondaryRays& gen,
           if (l < shadow_hits.size() && shadow_hits[l].triangle[i] != kNoHit) continue;
           L += shade_light(hs.s, hs.n, -dir, ls);
         }
+        L += diffuse_albedo_over_pi(hs.s, std::max(-glm::dot(hs.n, dir), 0.0f)) * ambient;
       }
       const glm::vec3 c = gen.weight[i] * L;
       out.pixels[i] += glm::vec4(c, 0.0f);

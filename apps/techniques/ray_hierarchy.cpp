@@ -13,7 +13,9 @@ namespace speculum::pipeline {
 
 FrameOutputs add_ray_hierarchy_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   const int width = f.width * f.supersample, height = f.height * f.supersample;
-  const int bounces = std::max(1, f.bounces);
+  // Two generations by default: one reflects, and a refracted ray needs the second to leave
+  // the glass it entered (with one, glass shows only its own back face).
+  const int bounces = f.bounces > 0 ? f.bounces : 2;
   trace::HierarchyTraverseOptions traverse;
   traverse.pair_capacity = static_cast<std::size_t>(f.param("pair_capacity"));
   traverse.block_size = static_cast<std::size_t>(f.param("block"));

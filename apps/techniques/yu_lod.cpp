@@ -3,6 +3,8 @@
 #include "apps/techniques/frame_passes.h"
 #include "apps/techniques/gbuffer_rays.h"
 #include "apps/techniques/recipes.h"
+#include "raster/composite.h"
+#include "raster/envmap_reflect.h"
 
 namespace speculum::pipeline {
 
@@ -37,7 +39,10 @@ FrameOutputs add_yu_lod_passes_cached(par::Graph& g, const Scene* scene, const F
   lod_options.alpha = f.alpha;
   auto hits = g.add("lod_trace", trace::LodTracePass{lod_options}, bvh, lod, rays);
   auto specular = g.add("hit_radiance", trace::HitRadiancePass{scene}, lod, lighting, rays, hits);
-  return add_output_passes(g, one, s.direct, specular);
+  // YU traces reflections only; refractors fall back to the environment (never black).
+  auto refractors = g.add("refractor_environment", raster::RefractorEnvironmentPass{}, s.gbuffer, s.environment);
+  auto direct = g.add("direct_and_refractors", raster::CompositePass{}, s.direct, refractors);
+  return add_output_passes(g, one, direct, specular);
 }
 
 }  // namespace speculum::pipeline

@@ -1,0 +1,82 @@
+// Every technique renders every built-in scene without black regions the reference lacks:
+// a pixel the technique leaves black (all channels below 1/255 after tone mapping, exposure
+// 1) must be black in the reference too — at its full specular depth or at one bounce (a
+// first-order technique is not asked to show a mirror inside a mirror). At most 0.5 % of the
+// pixels may break this, per technique × scene, except the cells listed in kOpenCells.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "apps/techniques/render_frame.h"
+#include "apps/techniques/technique_table.h"
+#include "core/scene_loader.h"
+#include "parallel/executor.h"
+#include "raster/composite.h"
+#include "trace/reference_tracer.h"
+
+namespace speculum::pipeline {
+namespace {
+
+constexpr int kWidth = 96, kHeight = 72;
+
+bool black(const glm::vec4& p) { return p.x < 1.0f / 255.0f && p.y < 1.0f / 255.0f && p.z < 1.0f / 255.0f; }
+
+ImageRGBA reference_display(const Scene& s, int depth, par::Executor& ex) {
+  trace::ReferenceOptions o;
+  o.width = kWidth;
+  o.height = kHeight;
+  o.spp = 4;
+  o.pixel_jitter = false;
+  o.max_depth = depth;
+  return raster::tonemap(ex, trace::render_reference(s, s.cameras.front(), o, ex), 1.0f);
+}
+
+// Cells that still break the rule, bounded at their current count so they cannot get worse
+// (a bound may only be lowered): in living-room, yu-lod's glass ball falls back to the
+// environment, which is dark inside the room, and ray-hierarchy's chrome balls see a few
+// black hits at the table's edge.
+struct OpenCell {
+  const char* technique;
+  const char* scene;
+  std::size_t max_black;
+};
+constexpr OpenCell kOpenCells[] = {{"yu-lod", "living-room", 124}, {"ray-hierarchy", "living-room", 35}};
+
+class NoBlackRegions : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(NoBlackRegions, EveryTechniqueAgainstTheReference) {
+  const Scene s = load_scene(GetParam() + ":size=4000");
+  par::Executor ex(2);
+  const ImageRGBA full = reference_display(s, 8, ex), first = reference_display(s, 1, ex);
+  for (const Technique& t : techniques()) {
+    if (t.name == "reference" || t.name == "specular-reference") continue;
+    FrameSettings f;
+    f.width = kWidth;
+    f.height = kHeight;
+    f.camera = s.cameras.front();
+    f.cube_map_size = 128;
+    f.shadow_map_size = 256;
+    f = t.with_defaults(f);
+    const ImageRGBA img = render_frame(s, t, f, ex).display;
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < img.pixels.size(); ++i)
+      if (black(img.pixels[i]) && !black(full.pixels[i]) && !black(first.pixels[i])) ++wrong;
+    std::size_t bound = img.pixels.size() / 200;  // 0.5 %
+    for (const OpenCell& c : kOpenCells)
+      if (t.name == c.technique && GetParam() == c.scene) bound = c.max_black;
+    EXPECT_LE(wrong, bound) << t.name << " on " << GetParam() << ": " << wrong << " black pixels the reference lacks";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(BuiltinScenes, NoBlackRegions,
+                         ::testing::Values("sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",
+                                           "glass-sphere", "bowl", "bumpy-sphere"),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           for (char& c : n) if (c == '-') c = '_';
+                           return n;
+                         });
+
+}  // namespace
+}  // namespace speculum::pipeline
