@@ -146,7 +146,7 @@ pipeline::FrameOptions frame_options(const MatrixOptions& o, const std::string& 
   f.height = o.height;
   f.seed = o.seed;
   f.bounces = o.bounces;
-  f.exposure = 1.0f;  // fixed: every image is judged at the same exposure
+  f.exposure = "1";  // fixed: every image is judged at the same exposure
   f.params = params_of(o, technique);
   return f;
 }
