@@ -15,6 +15,7 @@
 #include "apps/matrix/atlas.h"
 #include "apps/cli/json_output.h"
 #include "apps/techniques/render_frame.h"
+#include "core/did_you_mean.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/image_flip.h"
@@ -41,33 +42,12 @@ std::vector<std::string> split(const std::string& list) {
   return out;
 }
 
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
 // "unknown technique 'envmp' (did you mean 'envmap'? known: a, b, ...)".
 std::string unknown(const std::string& kind, const std::string& name, const std::vector<std::string>& known) {
-  std::string best;
-  std::size_t best_d = std::string::npos;
-  for (const std::string& k : known) {
-    const std::size_t d = edit_distance(name, k);
-    if (d < best_d) best_d = d, best = k;
-  }
+  const std::string best = closest_name(name, known);
   std::string list;
   for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-  const bool close = best_d <= std::max<std::size_t>(2, name.size() / 3);
-  return "unknown " + kind + " '" + name + "' (" + (close ? "did you mean '" + best + "'? " : "") +
+  return "unknown " + kind + " '" + name + "' (" + (best.empty() ? "" : "did you mean '" + best + "'? ") +
          "known: " + list + ")";
 }
 
