@@ -9,6 +9,7 @@
 #include "apps/cli/commands.h"
 #include "apps/cli/json_output.h"
 #include "apps/cli/progress.h"
+#include "apps/inspect/inspect_report.h"
 #include "apps/matrix/atlas.h"
 #include "apps/matrix/matrix.h"
 #include "core/error.h"
@@ -38,20 +39,8 @@ std::string number(double v, int digits) {
   return text;
 }
 
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+// The JUnit XML needs the same five escapes as HTML (&#39; is valid XML too).
+using inspect::html_escape;
 
 std::string quoted(const std::string& s) {
   std::string out = "'";
@@ -152,12 +141,12 @@ int check_golden(const CommandOptions& o, const std::vector<matrix::Cell>& cells
     xml += "  <testsuite name=\"speculum matrix golden\" tests=\"" + std::to_string(cases.size()) +
            "\" failures=\"" + std::to_string(failures) + "\" errors=\"0\" skipped=\"0\">\n";
     for (const Case& k : cases) {
-      xml += "    <testcase classname=\"" + xml_escape(k.technique) + "\" name=\"" + xml_escape(k.scene) + "\"";
+      xml += "    <testcase classname=\"" + html_escape(k.technique) + "\" name=\"" + html_escape(k.scene) + "\"";
       if (k.failure.empty()) {
         xml += "/>\n";
       } else {
-        xml += ">\n      <failure message=\"" + xml_escape(k.failure) + "\" type=\"golden\">" +
-               xml_escape(k.technique + "@" + k.scene + ": " + k.failure) + "</failure>\n    </testcase>\n";
+        xml += ">\n      <failure message=\"" + html_escape(k.failure) + "\" type=\"golden\">" +
+               html_escape(k.technique + "@" + k.scene + ": " + k.failure) + "</failure>\n    </testcase>\n";
       }
     }
     xml += "  </testsuite>\n</testsuites>\n";
