@@ -29,32 +29,6 @@ std::string ms_text(double ms) {
   return buf;
 }
 
-// Records failed images and script errors before anything else loads.
-constexpr const char* kHeadScript = R"(<script>
-window.inspectErrors = [];
-window.addEventListener('error', function (e) {
-  var t = e.target;
-  if (t && t.tagName === 'IMG') window.inspectErrors.push('image failed: ' + t.getAttribute('src'));
-  else window.inspectErrors.push('script error: ' + (e.message || e));
-}, true);
-window.addEventListener('load', function () {
-  var images = document.images, loaded = 0, failed = [];
-  for (var i = 0; i < images.length; i++) {
-    if (images[i].complete && images[i].naturalWidth > 0) loaded++;
-    else failed.push(images[i].getAttribute('src'));
-  }
-  var s = document.getElementById('inspect-status');
-  var bad = failed.length > 0 || window.inspectErrors.length > 0;
-  s.setAttribute('data-images', String(images.length));
-  s.setAttribute('data-loaded', String(loaded));
-  s.setAttribute('data-failed', failed.join(' '));
-  s.setAttribute('data-errors', window.inspectErrors.join(' | '));
-  s.setAttribute('data-state', bad ? 'error' : 'ok');
-  s.textContent = loaded + ' of ' + images.length + ' images loaded' +
-      (bad ? ' — problems: ' + failed.concat(window.inspectErrors).join(', ') : '');
-  s.className = bad ? 'bad' : 'good';
-});
-</script>)";
 
 constexpr const char* kStyle = R"(<style>
 body { font-family: sans-serif; margin: 1.5em; max-width: 1400px; color: #222; }
@@ -79,6 +53,34 @@ void kv_table(std::ostringstream& h, const std::vector<std::pair<std::string, st
 }
 
 }  // namespace
+
+std::string page_check_script(const std::string& status_id) {
+  return R"(<script>
+window.pageErrors = [];
+window.addEventListener('error', function (e) {
+  var t = e.target;
+  if (t && t.tagName === 'IMG') window.pageErrors.push('image failed: ' + t.getAttribute('src'));
+  else window.pageErrors.push('script error: ' + (e.message || e));
+}, true);
+window.addEventListener('load', function () {
+  var images = document.images, loaded = 0, failed = [];
+  for (var i = 0; i < images.length; i++) {
+    if (images[i].complete && images[i].naturalWidth > 0) loaded++;
+    else failed.push(images[i].getAttribute('src'));
+  }
+  var s = document.getElementById(')" + status_id + R"(');
+  var bad = failed.length > 0 || window.pageErrors.length > 0;
+  s.setAttribute('data-images', String(images.length));
+  s.setAttribute('data-loaded', String(loaded));
+  s.setAttribute('data-failed', failed.join(' '));
+  s.setAttribute('data-errors', window.pageErrors.join(' | '));
+  s.setAttribute('data-state', bad ? 'error' : 'ok');
+  s.textContent = loaded + ' of ' + images.length + ' images loaded' +
+      (bad ? ' — problems: ' + failed.concat(window.pageErrors).join(', ') : '');
+  s.className = bad ? 'bad' : 'good';
+});
+</script>)";
+}
 
 std::string html_escape(const std::string& s) {
   std::string out;
@@ -120,7 +122,7 @@ std::string index_html(const Report& r) {
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>speculum inspect: "
     << html_escape(r.technique) << " on " << html_escape(r.scene) << "</title>\n"
-    << kStyle << "\n" << kHeadScript << "\n</head><body>\n";
+    << kStyle << "\n" << page_check_script("inspect-status") << "\n</head><body>\n";
   h << "<h1>" << html_escape(r.technique) << " on " << html_escape(r.scene) << "</h1>\n";
   h << "<p id=\"inspect-status\" data-state=\"pending\">checking images…</p>\n";
   h << "<p>Frame " << ms_text(r.frame_ms) << ", " << r.nodes.size()

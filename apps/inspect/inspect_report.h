@@ -56,5 +56,10 @@ nlohmann::json manifest_json(const Report& report);
 std::string index_html(const Report& report);
 
 std::string html_escape(const std::string& s);
+// A page's self-check, placed in its <head>: records images that fail and script errors,
+// and after the load event writes into the element with id `status_id` how many images
+// loaded (data-images, data-loaded, data-failed, data-errors, data-state ok|error) — what
+// the headless-browser tests of `inspect` and `matrix` read.
+std::string page_check_script(const std::string& status_id);
 
 }  // namespace speculum::inspect

@@ -22,32 +22,6 @@ using inspect::html_escape;
 
 namespace {
 
-// Records failed images and script errors; after the load event the status line says how many
-// images loaded (what the headless-browser test reads).
-constexpr const char* kHeadScript = R"(<script>
-window.atlasErrors = [];
-window.addEventListener('error', function (e) {
-  var t = e.target;
-  if (t && t.tagName === 'IMG') window.atlasErrors.push('image failed: ' + t.getAttribute('src'));
-  else window.atlasErrors.push('script error: ' + (e.message || e));
-}, true);
-window.addEventListener('load', function () {
-  var images = document.images, loaded = 0, failed = [];
-  for (var i = 0; i < images.length; i++) {
-    if (images[i].complete && images[i].naturalWidth > 0) loaded++;
-    else failed.push(images[i].getAttribute('src'));
-  }
-  var s = document.getElementById('atlas-status');
-  var bad = failed.length > 0 || window.atlasErrors.length > 0;
-  s.setAttribute('data-images', String(images.length));
-  s.setAttribute('data-loaded', String(loaded));
-  s.setAttribute('data-failed', failed.join(' '));
-  s.setAttribute('data-state', bad ? 'error' : 'ok');
-  s.textContent = loaded + ' of ' + images.length + ' images loaded' +
-      (bad ? ' — problems: ' + failed.concat(window.atlasErrors).join(', ') : '');
-  s.className = bad ? 'bad' : 'good';
-});
-</script>)";
 
 constexpr const char* kStyle = R"(<style>
 body { font-family: sans-serif; margin: 1.5em; color: #222; }
@@ -180,7 +154,7 @@ void write_atlas(const fs::path& dir, const nlohmann::ordered_json& results, boo
 
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>speculum matrix</title>\n"
-    << kStyle << "\n" << kHeadScript << "\n</head><body>\n<h1>speculum matrix</h1>\n"
+    << kStyle << "\n" << inspect::page_check_script("atlas-status") << "\n</head><body>\n<h1>speculum matrix</h1>\n"
     << "<p id=\"atlas-status\" data-state=\"pending\">checking images…</p>\n"
     << "<p>" << results["width"].get<int>() << "×" << results["height"].get<int>()
     << "; frame error against <code>reference</code> at " << results["spp_reference"].get<int>()
