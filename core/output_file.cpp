@@ -32,10 +32,14 @@ std::string create_failure(const std::string& path, int error) {
 OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
   std::error_code ec;
   if (fs::is_directory(path_, ec)) throw InputError(path_, "cannot write: it is a directory");
-  // "<name>.tmp-<pid><ext>": unique per process, in the same directory, and keeping the
-  // extension (OpenImageIO picks the format by it).
+  // "<name>.tmp-<host>-<pid><ext>": unique per process even when processes on several
+  // machines write into one shared directory (cluster jobs), in the same directory, and
+  // keeping the extension (OpenImageIO picks the format by it).
+  char host[256] = "host";
+  ::gethostname(host, sizeof host - 1);
+  host[sizeof host - 1] = '\0';
   const fs::path p(path_);
-  temp_ = (p.parent_path() / (p.stem().string() + ".tmp-" + std::to_string(::getpid()) +
+  temp_ = (p.parent_path() / (p.stem().string() + ".tmp-" + host + "-" + std::to_string(::getpid()) +
                               p.extension().string()))
               .string();
   const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);

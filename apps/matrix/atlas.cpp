@@ -14,6 +14,7 @@
 #include "apps/matrix/matrix.h"
 #include "core/error.h"
 #include "core/image_metrics.h"
+#include "core/output_file.h"
 
 namespace speculum::matrix {
 
@@ -194,7 +195,7 @@ void write_atlas(const fs::path& dir, const nlohmann::ordered_json& results, boo
   else
     h << "<p>gnuplot was not found when this page was written: no charts.</p>\n";
   h << "</body></html>\n";
-  write_atomic(dir / "index.html", h.str());
+  write_text_file((dir / "index.html").string(), h.str());
 }
 
 }  // namespace speculum::matrix

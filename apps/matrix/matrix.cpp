@@ -1,7 +1,6 @@
 // The matrix's jobs: see matrix.h.
 #include "apps/matrix/matrix.h"
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,14 +11,15 @@
 #include <sstream>
 
 #include "apps/cli/frame_options.h"
-#include "apps/matrix/atlas.h"
 #include "apps/cli/json_output.h"
+#include "apps/matrix/atlas.h"
 #include "apps/techniques/render_frame.h"
 #include "core/did_you_mean.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/image_flip.h"
 #include "core/image_metrics.h"
+#include "core/output_file.h"
 #include "core/procedural_scenes.h"
 #include "core/scene_loader.h"
 #include "raster/gbuffer.h"
@@ -29,7 +29,6 @@ namespace speculum::matrix {
 namespace fs = std::filesystem;
 using cli::rounded;
 
-void write_image_atomic(const fs::path& path, const ImageRGBA& image);
 
 namespace {
 
@@ -241,36 +240,6 @@ pipeline::FrameSettings cell_settings(const MatrixOptions& o, const Cell& cell, 
 
 }  // namespace
 
-// A temporary name beside `path` no other process uses: jobs of one plan may run at once on
-// machines sharing DIR, and two may finish the same reference.
-fs::path temporary(const fs::path& path) {
-  char host[128] = "host";
-  gethostname(host, sizeof host - 1);
-  return path.parent_path() / ("." + path.stem().string() + "." + host + "." + std::to_string(getpid()) +
-                               path.extension().string());
-}
-
-// write_image through a name of this process's own, renamed into place.
-void write_image_atomic(const fs::path& path, const ImageRGBA& image) {
-  const fs::path tmp = temporary(path);
-  write_image(tmp.string(), image);
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw InputError(path.string(), "cannot write: " + ec.message());
-}
-
-void write_atomic(const fs::path& path, const std::string& text) {
-  const fs::path tmp = temporary(fs::path(path.string() + ".tmp"));
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out) throw InputError(path.string(), "cannot write");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw InputError(path.string(), "cannot write: " + ec.message());
-}
-
 std::vector<Cell> select_cells(const MatrixOptions& o) {
   const auto techniques = pick("--techniques", "technique", o.techniques, technique_names());
   const auto scenes = pick("--scenes", "scene", o.scenes, scene_names());
@@ -346,11 +315,11 @@ void ensure_specular_reference(const MatrixOptions& o, const std::string& scene_
         if (g->covered(i) && raster::is_specular(g->surface.pixels[i])) mask.pixels[i] = glm::vec4(1.0f);
     }
   });
-  write_image_atomic(k.mask, mask);
-  write_image_atomic(k.image, r.display);
+  write_image(k.mask.string(), mask);
+  write_image(k.image.string(), r.display);
   const cli::OrderedJson record{{"key", k.text}, {"scene", scene_name}, {"bounces", bounces},
                                 {"glossy_samples", o.glossy_samples}, {"ms", rounded(r.report.duration_ns * 1e-6, 3)}};
-  write_atomic(k.record, cli::json_document(record));
+  write_text_file(k.record.string(), cli::json_document(record));
 }
 
 }  // namespace
@@ -371,10 +340,10 @@ void ensure_reference(const MatrixOptions& o, const std::string& scene_name, par
     std::fprintf(stderr, "speculum: matrix: tracing the reference of %s (%dx%d, %d spp)\n", scene_name.c_str(),
                  o.width, o.height, o.spp_reference);
   const pipeline::FrameResult r = pipeline::render_frame(scene, technique, f, executor);
-  write_image_atomic(k.image, r.display);
+  write_image(k.image.string(), r.display);
   const cli::OrderedJson record{{"key", k.text}, {"scene", scene_name}, {"spp", o.spp_reference},
                                 {"bounces", o.bounces}, {"ms", rounded(r.report.duration_ns * 1e-6, 3)}};
-  write_atomic(k.record, cli::json_document(record));  // last: the record marks the image complete
+  write_text_file(k.record.string(), cli::json_document(record));  // last: the record marks the image complete
 }
 
 cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executor& executor, bool quiet) {
@@ -398,7 +367,7 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
     last = std::move(r);
   }
   const fs::path dir = o.output;
-  write_image_atomic(cell_image(dir, cell), last.display);
+  write_image(cell_image(dir, cell).string(), last.display);
   // Judge the images as stored: both read back from their PNGs, so a cached reference and a
   // fresh one give the same numbers.
   const ImageRGBA reference = read_image(k.image.string());
@@ -407,8 +376,8 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
   const ImageRGBA mask = read_image(sk.mask.string(), false);
   const fs::path frame_heat = dir / "cells" / (cell.id() + ".frame-diff.png");
   const fs::path specular_heat = dir / "cells" / (cell.id() + ".specular-diff.png");
-  write_image_atomic(frame_heat, difference_heat_map(reference, image));
-  write_image_atomic(specular_heat, difference_heat_map(specular_reference, image, &mask));
+  write_image(frame_heat.string(), difference_heat_map(reference, image));
+  write_image(specular_heat.string(), difference_heat_map(specular_reference, image, &mask));
 
   cli::OrderedJson nodes = cli::OrderedJson::array();
   cli::OrderedJson counters = cli::OrderedJson::object();
@@ -446,7 +415,7 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
                           {"image", fs::relative(cell_image(dir, cell), dir).string()},
                           {"frame_heat_map", fs::relative(frame_heat, dir).string()},
                           {"specular_heat_map", fs::relative(specular_heat, dir).string()}};
-  write_atomic(cell_record(dir, cell), cli::json_document(record));
+  write_text_file(cell_record(dir, cell).string(), cli::json_document(record));
   return record;
 }
 
@@ -477,7 +446,7 @@ cli::OrderedJson merge(const MatrixOptions& o, const std::vector<Cell>& cells) {
   cli::OrderedJson results{{"version", kReferenceVersion}, {"width", o.width}, {"height", o.height},
                            {"spp_reference", o.spp_reference}, {"glossy_samples", o.glossy_samples},
                            {"cells", list}};
-  write_atomic(dir / "results.json", cli::json_document(results));
+  write_text_file((dir / "results.json").string(), cli::json_document(results));
   return results;
 }
 

@@ -65,7 +65,5 @@ nlohmann::ordered_json merge(const MatrixOptions& o, const std::vector<Cell>& ce
 std::filesystem::path cell_image(const std::filesystem::path& dir, const Cell& cell);
 std::filesystem::path cell_record(const std::filesystem::path& dir, const Cell& cell);
 
-// Writes `text` to `path` through a temporary file renamed into place (no half-written file).
-void write_atomic(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace speculum::matrix

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/image_metrics.h"
+#include "core/output_file.h"
 
 namespace speculum::cli {
 namespace {
@@ -150,7 +151,7 @@ int check_golden(const CommandOptions& o, const std::vector<matrix::Cell>& cells
       }
     }
     xml += "  </testsuite>\n</testsuites>\n";
-    matrix::write_atomic(o.junit, xml);
+    write_text_file(o.junit, xml);
   }
   for (const Case& k : cases)
     if (!k.failure.empty())
