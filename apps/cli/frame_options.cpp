@@ -92,18 +92,26 @@ Scene load_frame_scene(const FrameOptions& o, bool quiet) {
   return scene;
 }
 
-std::map<std::string, double> check_frame_options(const FrameOptions& o) {
-  const Technique& technique = find_technique(o.technique);
-  // The technique's sample limit bounds memory (rasterized frames keep every sample) or time
-  // (reference and yu-lod keep pixels); see Technique::max_samples.
-  const double samples = double(o.width) * double(o.height) * double(o.spp);
+namespace {
+
+// The technique's sample limit bounds memory (rasterized frames keep every sample) or time
+// (reference and yu-lod keep pixels); see Technique::max_samples.
+void check_sample_count(const Technique& technique, int width, int height, int spp) {
+  const double samples = double(width) * double(height) * double(spp);
   if (samples > technique.max_samples)
     throw InputError("--width/--height/--spp",
-                     std::to_string(o.width) + "×" + std::to_string(o.height) + " at " + std::to_string(o.spp) +
+                     std::to_string(width) + "×" + std::to_string(height) + " at " + std::to_string(spp) +
                          " spp is " + std::to_string(static_cast<long long>(samples)) + " samples; " +
                          technique.name + " takes at most " +
                          std::to_string(static_cast<long long>(technique.max_samples)) + " (2^" +
                          std::to_string(std::ilogb(technique.max_samples)) + ")");
+}
+
+}  // namespace
+
+std::map<std::string, double> check_frame_options(const FrameOptions& o) {
+  const Technique& technique = find_technique(o.technique);
+  check_sample_count(technique, o.width, o.height, o.spp);
   std::map<std::string, double> params;
   for (const std::string& item : o.params) {
     const auto eq = item.find('=');
@@ -140,8 +148,8 @@ FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
     else f.height = side(o.width / double(f.camera.aspect));
     f.camera = resolve_camera(scene, o.camera, float(f.width) / float(f.height));
   }
-  if (double(f.width) * f.height * o.spp > double(1 << 26))
-    throw InputError("--width/--height/--spp", "more than 67M samples");
+  // The side a camera's aspect ratio derived counts against the same limit.
+  check_sample_count(find_technique(o.technique), f.width, f.height, o.spp);
   f.supersample = k;
   f.spp = o.spp;
   f.seed = o.seed;
