@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
+#include "tests/apps/headless_page.h"
 #include "tests/apps/speculum_run.h"
 
 namespace speculum {
@@ -145,43 +146,6 @@ TEST(Inspect, BadInputExitsTwo) {
   fs::remove_all(dir);
 }
 
-// What the page's own script wrote into #inspect-status after the load event.
-struct PageStatus {
-  std::string state, failed;
-  int images = -1, loaded = -1;
-  std::string console;  // Chromium's CONSOLE log lines (any is an error: the page logs nothing)
-};
-
-std::string attribute(const std::string& tag, const std::string& name) {
-  std::smatch m;
-  if (std::regex_search(tag, m, std::regex(" " + name + "=\"([^\"]*)\""))) return m[1];
-  return "";
-}
-
-PageStatus open_in_chromium(const fs::path& page, const fs::path& work) {
-  const fs::path profile = work / ("chromium-profile-" + std::to_string(std::rand()));
-  const std::string cmd =
-      "timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking "
-      "--disable-component-update --disable-sync --no-first-run --no-default-browser-check "
-      "--user-data-dir=" + sh_quote(profile.string()) +
-      " --enable-logging=stderr --v=0 --dump-dom " + sh_quote("file://" + fs::absolute(page).string());
-  const auto r = run_shell(cmd, work);
-  fs::remove_all(profile);
-  PageStatus s;
-  std::smatch m;
-  if (std::regex_search(r.out, m, std::regex("<p id=\"inspect-status\"[^>]*>"))) {
-    const std::string tag = m[0];
-    s.state = attribute(tag, "data-state");
-    s.failed = attribute(tag, "data-failed");
-    const std::string images = attribute(tag, "data-images"), loaded = attribute(tag, "data-loaded");
-    if (!images.empty()) s.images = std::stoi(images);
-    if (!loaded.empty()) s.loaded = std::stoi(loaded);
-  }
-  std::istringstream err(r.err);
-  for (std::string line; std::getline(err, line);)
-    if (line.find(":CONSOLE") != std::string::npos) s.console += line + "\n";
-  return s;
-}
 
 TEST(Inspect, EveryImageLoadsInHeadlessChromium) {
   if (run_shell("command -v chromium", fs::temp_directory_path()).status != 0)
@@ -203,7 +167,7 @@ TEST(Inspect, EveryImageLoadsInHeadlessChromium) {
       }
   ASSERT_GT(pictures, 10);
 
-  const PageStatus good = open_in_chromium(out / "index.html", dir);
+  const test::PageStatus good = test::open_in_chromium(out / "index.html", dir, "inspect-status");
   EXPECT_EQ(good.state, "ok") << "failed: " << good.failed;
   EXPECT_EQ(good.images, pictures);
   EXPECT_EQ(good.loaded, pictures);
@@ -211,7 +175,7 @@ TEST(Inspect, EveryImageLoadsInHeadlessChromium) {
 
   // The check must notice a missing picture.
   fs::remove(out / first_png);
-  const PageStatus broken = open_in_chromium(out / "index.html", dir);
+  const test::PageStatus broken = test::open_in_chromium(out / "index.html", dir, "inspect-status");
   EXPECT_EQ(broken.state, "error");
   EXPECT_EQ(broken.loaded, pictures - 1);
   EXPECT_NE(broken.failed.find(first_png), std::string::npos) << broken.failed;

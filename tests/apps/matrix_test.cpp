@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "headless_page.h"
 #include "speculum_run.h"
 
 namespace speculum::test {
@@ -272,42 +273,6 @@ TEST(Matrix, PlanRunByGnuParallelEqualsOneProcess) {
   fs::remove_all(dir);
 }
 
-// What the atlas's own script wrote into #atlas-status after the load event, and Chromium's
-// console lines (the page logs nothing, so any is an error).
-struct AtlasStatus {
-  std::string state, failed, console;
-  int images = -1, loaded = -1;
-};
-
-std::string attribute(const std::string& tag, const std::string& name) {
-  std::smatch m;
-  if (std::regex_search(tag, m, std::regex(" " + name + "=\"([^\"]*)\""))) return m[1];
-  return "";
-}
-
-AtlasStatus open_in_chromium(const fs::path& page, const fs::path& work) {
-  const fs::path profile = work / "chromium-profile";
-  const CommandResult r = run_shell(
-      "timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking "
-      "--disable-component-update --disable-sync --no-first-run --no-default-browser-check --user-data-dir=" +
-          sh_quote(profile.string()) + " --enable-logging=stderr --v=0 --dump-dom " +
-          sh_quote("file://" + fs::absolute(page).string()),
-      work);
-  fs::remove_all(profile);
-  AtlasStatus s;
-  std::smatch m;
-  if (std::regex_search(r.out, m, std::regex("<p id=\"atlas-status\"[^>]*>"))) {
-    const std::string tag = m[0];
-    s.state = attribute(tag, "data-state");
-    s.failed = attribute(tag, "data-failed");
-    if (!attribute(tag, "data-images").empty()) s.images = std::stoi(attribute(tag, "data-images"));
-    if (!attribute(tag, "data-loaded").empty()) s.loaded = std::stoi(attribute(tag, "data-loaded"));
-  }
-  std::istringstream err(r.err);
-  for (std::string line; std::getline(err, line);)
-    if (line.find(":CONSOLE") != std::string::npos) s.console += line + "\n";
-  return s;
-}
 
 // index.html loads in headless Chromium with every image (each cell's image and two heat
 // maps, one gnuplot chart per scene) and no console error; a missing image is noticed.
@@ -318,7 +283,7 @@ TEST(Matrix, AtlasLoadsInHeadlessChromium) {
   const CommandResult r = run_speculum(kSmall + " -q -o " + sh_quote((dir / "m").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const int expected = 4 * 3 + 2;
-  const AtlasStatus good = open_in_chromium(dir / "m" / "index.html", dir);
+  const PageStatus good = open_in_chromium(dir / "m" / "index.html", dir, "atlas-status");
   EXPECT_EQ(good.state, "ok") << good.failed;
   EXPECT_EQ(good.images, expected);
   EXPECT_EQ(good.loaded, expected);
@@ -328,7 +293,7 @@ TEST(Matrix, AtlasLoadsInHeadlessChromium) {
   EXPECT_NE(slurp(dir / "m" / "charts" / "bowl.svg").find("<svg"), std::string::npos);
 
   fs::remove(dir / "m" / "charts" / "bowl.svg");
-  const AtlasStatus broken = open_in_chromium(dir / "m" / "index.html", dir);
+  const PageStatus broken = open_in_chromium(dir / "m" / "index.html", dir, "atlas-status");
   EXPECT_EQ(broken.state, "error");
   EXPECT_EQ(broken.loaded, expected - 1);
   EXPECT_NE(broken.failed.find("charts/bowl.svg"), std::string::npos) << broken.failed;
