@@ -131,6 +131,19 @@ glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv) {
   return s.base_color * ((1.0f - s.metallic) * (1.0f - s.transmission) * (1.0f - e) / kPi);
 }
 
+LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u) {
+  const float alpha = s.roughness * s.roughness;
+  const Onb frame(n);
+  const glm::vec3 v_local(glm::dot(v, frame.t), glm::dot(v, frame.b), glm::dot(v, n));
+  if (!(v_local.z > 0.0f)) return {};
+  const glm::vec3 h = frame.to_world(sample_ggx_visible_normal(v_local, alpha, u));
+  const float cos_vh = glm::dot(v, h);
+  const glm::vec3 wi = glm::normalize(2.0f * cos_vh * h - v);
+  const float w = ggx_sample_weight(glm::dot(wi, n), v_local.z, alpha);
+  if (!(w > 0.0f)) return {};
+  return {wi, fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w};
+}
+
 BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s) {
   BrdfParams p;
   p.base_color = s.base_color;

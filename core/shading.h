@@ -105,6 +105,16 @@ glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec
                       const LightSample& light);
 // The BRDF inputs shade_light uses (roughness clamped to kMinPunctualRoughness).
 BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s);
+// A direction from the GGX specular lobe of s about the unit normal n for a viewer at v
+// (visible normals, α = roughness², from two uniform numbers u) and its weight
+// f_spec cos / p = F(V·H) G2/G1 (core/brdf.h); weight 0 when v or the sample lies below the
+// surface. The estimator of the reference tracer and of the exact specular reference.
+struct LobeSample {
+  glm::vec3 direction{0.0f};
+  glm::vec3 weight{0.0f};
+};
+LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u);
+
 // The diffuse part alone, for irradiance from many directions (environment, ambient): the
 // weight of incident irradiance, (1 - metallic)(1 - transmission)(1 - E_dielectric(N·V))
 // base_color / π (1/sr), exact for uniform incident light.

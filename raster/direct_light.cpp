@@ -8,6 +8,23 @@
 
 namespace speculum::raster {
 
+glm::vec3 shade_surface(const Scene& scene, const SurfaceParams& s, const glm::vec3& p, glm::vec3 n,
+                        const glm::vec3& v, const std::vector<ShadowMap>& shadows, const EnvironmentMap& env) {
+  if (glm::dot(n, v) < 0.0f) n = -n;  // refractors seen from inside: light the near side
+  glm::vec3 radiance = s.emissive;
+  for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+    const LightSample ls = sample_light(scene.lights[k], p);
+    if (ls.irradiance == glm::vec3(0.0f) || glm::dot(n, ls.direction) <= 0.0f) continue;
+    const float lit = k < shadows.size() ? shadows[k].visibility(p, n, ls.direction) : 1.0f;
+    if (lit > 0.0f) radiance += lit * shade_light(s, n, v, ls);
+  }
+  radiance += diffuse_albedo_over_pi(s, glm::dot(n, v)) * env.irradiance(n);
+  // The specular lobe of a surface too rough for a reflection pass (core/shading.h).
+  if (s.has_rough_specular_lobe())
+    radiance += specular_reflectance(s, glm::dot(n, v)) * env.radiance(reflect(-v, n), s.phong_exponent);
+  return radiance;
+}
+
 ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,
                        const Camera& camera, const std::vector<ShadowMap>& shadows,
                        const EnvironmentMap& env) {
@@ -21,22 +38,9 @@ ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffe
         out.pixels[i] = glm::vec4(env.radiance(ray.direction, 1e6f), 1.0f);
         continue;
       }
-      const SurfaceParams& s = g.surface.pixels[i];
-      const glm::vec3 p = g.position.pixels[i], v = g.view_direction(i);
-      glm::vec3 n = g.normal.pixels[i];
-      if (glm::dot(n, v) < 0.0f) n = -n;  // refractors seen from inside: light the near side
-      glm::vec3 radiance = s.emissive;
-      for (std::size_t k = 0; k < scene.lights.size(); ++k) {
-        const LightSample ls = sample_light(scene.lights[k], p);
-        if (ls.irradiance == glm::vec3(0.0f) || glm::dot(n, ls.direction) <= 0.0f) continue;
-        const float lit = k < shadows.size() ? shadows[k].visibility(p, n, ls.direction) : 1.0f;
-        if (lit > 0.0f) radiance += lit * shade_light(s, n, v, ls);
-      }
-      radiance += diffuse_albedo_over_pi(s, glm::dot(n, v)) * env.irradiance(n);
-      // The specular lobe of a surface too rough for a reflection pass (core/shading.h).
-      if (s.has_rough_specular_lobe())
-        radiance += specular_reflectance(s, glm::dot(n, v)) * env.radiance(reflect(-v, n), s.phong_exponent);
-      out.pixels[i] = glm::vec4(radiance, 1.0f);
+      out.pixels[i] = glm::vec4(shade_surface(scene, g.surface.pixels[i], g.position.pixels[i],
+                                              g.normal.pixels[i], g.view_direction(i), shadows, env),
+                                1.0f);
     }
   });
   return out;

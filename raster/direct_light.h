@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/scene.h"
+#include "core/shading.h"
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
 #include "raster/environment.h"
@@ -13,6 +14,15 @@
 #include "raster/shadow_map.h"
 
 namespace speculum::raster {
+
+// The radiance a surface point sends towards v (unit, towards the viewer): emission, every
+// light × its shadow-map visibility, the environment's SH irradiance on the diffuse lobe and,
+// on surfaces too rough for a reflection pass, the prefiltered environment along R
+// (core/shading.h). n is the unit shading normal, turned here to face v. What direct_light
+// computes for each G-buffer sample, and what a traced hit gets when it must be shaded the
+// same way.
+glm::vec3 shade_surface(const Scene& scene, const SurfaceParams& s, const glm::vec3& p, glm::vec3 n,
+                        const glm::vec3& v, const std::vector<ShadowMap>& shadows, const EnvironmentMap& env);
 
 // `camera` is the one the G-buffer was rendered with (for background directions).
 // `shadows` may be empty: lights are then unshadowed.

@@ -23,25 +23,6 @@ namespace {
 
 constexpr std::uint32_t kDimsPerBounce = 8;  // random dimensions reserved per depth level
 
-// A direction from the GGX specular lobe of s (visible normals, α = roughness²) and its
-// weight f_spec cos / p = F(V·H) G2/G1; weight 0 when the sample leaves below the surface.
-struct LobeSample {
-  glm::vec3 direction{0.0f};
-  glm::vec3 weight{0.0f};
-};
-LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u) {
-  const float alpha = s.roughness * s.roughness;
-  const Onb frame(n);
-  const glm::vec3 v_local(glm::dot(v, frame.t), glm::dot(v, frame.b), glm::dot(v, n));
-  if (!(v_local.z > 0.0f)) return {};
-  const glm::vec3 h = frame.to_world(sample_ggx_visible_normal(v_local, alpha, u));
-  const float cos_vh = glm::dot(v, h);
-  const glm::vec3 wi = glm::normalize(2.0f * cos_vh * h - v);
-  const float w = ggx_sample_weight(glm::dot(wi, n), v_local.z, alpha);
-  if (!(w > 0.0f)) return {};
-  return {wi, fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w};
-}
-
 struct Tracer {
   const Scene& scene;
   const Bvh& bvh;

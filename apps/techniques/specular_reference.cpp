@@ -11,16 +11,13 @@
 #include <string>
 #include <vector>
 
-#include <glm/geometric.hpp>
-
 #include "apps/techniques/frame_passes.h"
 #include "apps/techniques/gbuffer_rays.h"
 #include "apps/techniques/recipes.h"
-#include "core/brdf.h"
-#include "core/optics.h"
 #include "core/ray_offset.h"
 #include "core/sampling.h"
 #include "core/shading.h"
+#include "raster/direct_light.h"
 #include "trace/bvh.h"
 #include "trace/hit_surface.h"
 #include "trace/secondary_rays.h"
@@ -47,25 +44,16 @@ trace::SecondaryRays glossy_generation(par::Executor& ex, const raster::GBuffer&
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface.pixels[i];
       if (s.is_refractor() || !s.is_glossy_lobe()) continue;
-      const glm::vec3 n_ = g.normal.pixels[i];
-      const glm::vec3 v = g.view_direction(i);
-      const float cos_nv = std::max(glm::dot(n_, v), 0.0f);
-      const float alpha = s.roughness * s.roughness;
-      const Onb frame(n_);
-      const glm::vec3 v_local(glm::dot(v, frame.t), glm::dot(v, frame.b), cos_nv);
       const glm::vec2 u = rotate_unit_square(hamersley(std::uint32_t(sample), std::uint32_t(samples)),
                                              random_float2(std::uint32_t(i), 0, 0, seed));
-      const glm::vec3 h = frame.to_world(sample_ggx_visible_normal(v_local, alpha, u));
-      const float cos_vh = glm::dot(v, h);
-      const glm::vec3 wi = 2.0f * cos_vh * h - v;
-      const float w = ggx_sample_weight(glm::dot(wi, n_), cos_nv, alpha);
-      if (w <= 0.0f) continue;  // below the horizon: contributes 0
+      const LobeSample lobe = sample_specular_lobe(s, g.normal.pixels[i], g.view_direction(i), u);
+      if (lobe.weight == glm::vec3(0.0f)) continue;  // below the horizon: contributes 0
       Ray r;
-      r.origin = offset_ray_origin(g.position.pixels[i], n_);
-      r.direction = glm::normalize(wi);
+      r.origin = offset_ray_origin(g.position.pixels[i], g.normal.pixels[i]);
+      r.direction = lobe.direction;
       out.rays.set(i, r);
       out.active[i] = 1;
-      out.weight[i] = fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w / float(samples);
+      out.weight[i] = lobe.weight / float(samples);
     }
   });
   out.count = 0;
@@ -73,14 +61,14 @@ trace::SecondaryRays glossy_generation(par::Executor& ex, const raster::GBuffer&
   return out;
 }
 
-// A generation's hits shaded exactly as direct_light shades a G-buffer sample (emission,
-// every light × its shadow-map visibility, SH ambient on the diffuse part) and a miss as the
-// environment map gives it, weighted and added to `out`: the hit shading of the
-// feed-forward techniques' reflected images, so only the ray differs. Kernel "shade_hits".
+// A generation's hits shaded exactly as direct_light shades a G-buffer sample
+// (raster::shade_surface) and a miss as the environment map gives it, weighted and added to
+// `out`: the hit shading of the feed-forward techniques' reflected images, so only the ray
+// differs. Kernel "specular_shade_hits".
 void shade_hits_like_direct_light(par::Executor& ex, const Scene& scene, const trace::SecondaryRays& gen,
                                   const trace::HitStream& hits, const raster::ShadowMaps& shadows,
                                   const raster::EnvironmentMap& env, ImageRGBA& out) {
-  ex.parallel_for("shade_hits", gen.active.size(), 1024, [&](std::size_t b, std::size_t e) {
+  ex.parallel_for("specular_shade_hits", gen.active.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (!gen.active[i]) continue;
       const glm::vec3 dir = glm::normalize(gen.rays.get(i).direction);
@@ -90,17 +78,7 @@ void shade_hits_like_direct_light(par::Executor& ex, const Scene& scene, const t
       } else {
         const trace::HitSurface hs =
             trace::hit_surface(scene, trace::Hit{hits.t[i], hits.u[i], hits.v[i], hits.triangle[i]}, dir);
-        const glm::vec3 v = -dir;
-        glm::vec3 n = hs.n;
-        if (glm::dot(n, v) < 0.0f) n = -n;
-        radiance = hs.s.emissive;
-        for (std::size_t k = 0; k < scene.lights.size(); ++k) {
-          const LightSample ls = sample_light(scene.lights[k], hs.p);
-          if (ls.irradiance == glm::vec3(0.0f) || glm::dot(n, ls.direction) <= 0.0f) continue;
-          const float lit = k < shadows.size() ? shadows[k].visibility(hs.p, n, ls.direction) : 1.0f;
-          if (lit > 0.0f) radiance += lit * shade_light(hs.s, n, v, ls);
-        }
-        radiance += diffuse_albedo_over_pi(hs.s, glm::dot(n, v)) * env.irradiance(n);
+        radiance = raster::shade_surface(scene, hs.s, hs.p, hs.n, -dir, shadows, env);
       }
       out.pixels[i] += glm::vec4(gen.weight[i] * radiance, 0.0f);
     }
