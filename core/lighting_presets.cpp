@@ -8,13 +8,9 @@
 #include <glm/geometric.hpp>
 
 #include "core/sampling.h"
+#include "core/shading.h"
 
 namespace speculum {
-
-glm::vec3 equirect_direction(float u, float v) {
-  const float phi = 2.0f * kPi * (u - 0.5f), theta = kPi * v;
-  return {std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)};
-}
 
 bool environment_is_black(const Environment& env) {
   if (!(env.intensity > 0.0f)) return true;
@@ -61,10 +57,7 @@ ImageRGBA clear_sky_equirect(int width, int height, const glm::vec3& toward_sun)
   std::size_t nearest = 0;
   float nearest_cos = -2.0f;
   for (int y = 0; y < height; ++y) {
-    // Solid angle of a pixel of row y: Δφ (cos θ0 − cos θ1).
-    const double row_solid_angle =
-        2.0 * double(kPi) / width *
-        (std::cos(double(kPi) * y / height) - std::cos(double(kPi) * (y + 1) / height));
+    const double row_solid_angle = equirect_pixel_solid_angle(y, width, height);
     for (int x = 0; x < width; ++x) {
       const glm::vec3 d = equirect_direction((x + 0.5f) / width, (y + 0.5f) / height);
       glm::vec3 c = ground;
@@ -84,8 +77,7 @@ ImageRGBA clear_sky_equirect(int width, int height, const glm::vec3& toward_sun)
   if (disk.empty()) {
     disk.push_back(nearest);
     const int y = int(nearest / width);
-    disk_solid_angle = 2.0 * double(kPi) / width *
-                       (std::cos(double(kPi) * y / height) - std::cos(double(kPi) * (y + 1) / height));
+    disk_solid_angle = equirect_pixel_solid_angle(y, width, height);
   }
   const float sun_radiance = float(kSkySunIrradiance / disk_solid_angle);
   for (std::size_t i : disk) img.pixels[i] += glm::vec4(sun_radiance, sun_radiance, sun_radiance, 0.0f);

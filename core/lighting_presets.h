@@ -12,10 +12,6 @@
 
 namespace speculum {
 
-// The direction the equirect pixel centre (u, v) looks along: the inverse of
-// equirect_uv (core/shading.h): φ = 2π(u − ½), θ = πv, d = (sinθ sinφ, cosθ, −sinθ cosφ).
-glm::vec3 equirect_direction(float u, float v);
-
 // True when the environment sends no light: zero intensity, a black constant, or an image
 // with no positive pixel.
 bool environment_is_black(const Environment& environment);

@@ -172,6 +172,16 @@ glm::vec2 equirect_uv(const glm::vec3& d) {
   return {u, v};
 }
 
+glm::vec3 equirect_direction(float u, float v) {
+  const float phi = 2.0f * kPi * (u - 0.5f), theta = kPi * v;
+  return {std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)};
+}
+
+double equirect_pixel_solid_angle(int y, int width, int height) {
+  return 2.0 * double(kPi) / width *
+         (std::cos(double(kPi) * y / height) - std::cos(double(kPi) * (y + 1) / height));
+}
+
 glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d) {
   if (!env.has_image()) return env.constant * env.intensity;
   const glm::vec2 uv = equirect_uv(glm::normalize(d));

@@ -123,6 +123,12 @@ glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv);
 // Equirect mapping (see the header comment) and the environment radiance towards -d
 // (d: unit direction of the ray leaving the scene).
 glm::vec2 equirect_uv(const glm::vec3& d);
+// Its inverse: the direction the equirect point (u, v) looks along, φ = 2π(u − ½), θ = πv,
+// d = (sinθ sinφ, cosθ, −sinθ cosφ).
+glm::vec3 equirect_direction(float u, float v);
+// The solid angle of one pixel of row y of a width × height equirect image:
+// Δφ (cos θ0 − cos θ1).
+double equirect_pixel_solid_angle(int y, int width, int height);
 glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d);
 // The environment's radiance averaged over the sphere (each equirect row weighted by its
 // solid angle); π times it is the irradiance of a constant environment, and the ambient
