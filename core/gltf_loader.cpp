@@ -605,11 +605,13 @@ void check_uris_are_relative(const std::string& path, const nlohmann::json& doc)
   }
 }
 
-// Content this loader cannot read, named before tinygltf parses the file: otherwise a
-// glTF 1.0 file (id-keyed objects where 2.0 has arrays) fails with "no triangles" or a
-// schema complaint, and a Draco or meshopt-compressed one with "invalid bufferView".
-// JSON that does not parse is left to tinygltf, which says where it breaks.
-void check_version_and_required_extensions(const std::string& path, const char* json, std::size_t size,
+// What is checked on the JSON before tinygltf parses it: its nesting depth, the schema's
+// minimums of the byte-locating fields, absolute URIs (unless allowed), and content this
+// loader cannot read, named — otherwise a glTF 1.0 file (id-keyed objects where 2.0 has
+// arrays) fails with "no triangles" or a schema complaint, and a Draco or
+// meshopt-compressed one with "invalid bufferView". JSON that does not parse is left to
+// tinygltf, which says where it breaks.
+void check_before_parsing(const std::string& path, const char* json, std::size_t size,
                                            bool allow_external_files) {
   check_json_depth(path, json, size);
   const nlohmann::json doc = nlohmann::json::parse(json, json + size, nullptr, false);
@@ -691,8 +693,8 @@ struct ExternalFiles {
   }
 };
 
-// Reads and parses the file (JSON .gltf or binary .glb) and rejects glTF 1.0 and required
-// extensions the loader does not implement.
+// Reads and parses the file (JSON .gltf or binary .glb) after check_before_parsing, with
+// external files confined to the scene's folder (ExternalFiles).
 tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
   const bool is_glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
@@ -700,10 +702,10 @@ tinygltf::Model parse_model(const std::string& path, LoadReport* report) {
   if (ext == ".glb" || ext == ".GLB" || is_glb) check_glb_container(path, bytes);
   const bool allow_external = report && report->allow_external_files;
   if (is_glb)
-    check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()) + 20, le32(&bytes[12]),
+    check_before_parsing(path, reinterpret_cast<const char*>(bytes.data()) + 20, le32(&bytes[12]),
                                           allow_external);
   else
-    check_version_and_required_extensions(path, reinterpret_cast<const char*>(bytes.data()), bytes.size(),
+    check_before_parsing(path, reinterpret_cast<const char*>(bytes.data()), bytes.size(),
                                           allow_external);
 
   tinygltf::TinyGLTF parser;
