@@ -2,57 +2,58 @@
 #include "raster/planar_mirror.h"
 
 #include <cmath>
+#include <optional>
 
 #include "core/shading.h"
 #include "raster/direct_light.h"
+#include "raster/distance_map_reflect.h"
 #include "raster/envmap_reflect.h"
 #include "raster/visibility.h"
 
 namespace speculum::raster {
 
+std::optional<Plane> planar_mirror_plane(const Scene& scene, std::uint32_t o, float tolerance) {
+  const TriangleMesh& m = scene.mesh;
+  const Object& obj = scene.objects[o];
+  if (obj.triangle_count == 0) return std::nullopt;
+  // Every triangle must be a mirror (not only the first): a mixed object is not a mirror.
+  glm::vec3 area_normal(0.0f);
+  Bounds box;
+  for (std::uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t) {
+    const std::uint32_t mat = m.triangle_material[t];
+    const SurfaceParams s = surface_params(scene.materials[mat < scene.materials.size() ? mat : 0]);
+    if (s.is_refractor() || !s.is_mirror_lobe()) return std::nullopt;
+    const glm::vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
+                    c = m.positions[m.indices[3 * t + 2]];
+    area_normal += glm::cross(b - a, c - a);
+    box.grow(a);
+    box.grow(b);
+    box.grow(c);
+  }
+  const float len = glm::length(area_normal);
+  if (!(len > 0.0f)) return std::nullopt;
+  Plane plane;
+  plane.normal = area_normal / len;
+  double offset = 0.0;
+  std::size_t n = 0;
+  for (std::uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t)
+    for (int k = 0; k < 3; ++k, ++n) offset += glm::dot(plane.normal, m.positions[m.indices[3 * t + k]]);
+  plane.offset = static_cast<float>(offset / static_cast<double>(n));
+  const float limit = tolerance * glm::length(box.extent());
+  for (std::uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t)
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(plane.signed_distance(m.positions[m.indices[3 * t + k]])) > limit) return std::nullopt;
+  return plane;
+}
+
 std::vector<PlanarMirror> find_planar_mirrors(const Scene& scene, float tolerance) {
   std::vector<PlanarMirror> mirrors;
-  const TriangleMesh& m = scene.mesh;
   for (std::uint32_t o = 0; o < scene.objects.size(); ++o) {
-    const Object& obj = scene.objects[o];
-    if (obj.triangle_count == 0) continue;
-    // Every triangle must be a mirror (not only the first): a mixed object is not a mirror.
-    bool all_mirror = true;
-    glm::vec3 area_normal(0.0f);
-    Bounds box;
-    for (std::uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t) {
-      const std::uint32_t mat = m.triangle_material[t];
-      const SurfaceParams s =
-          surface_params(scene.materials[mat < scene.materials.size() ? mat : 0]);
-      if (s.is_refractor() || !s.is_mirror_lobe()) {
-        all_mirror = false;
-        break;
-      }
-      const glm::vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
-                      c = m.positions[m.indices[3 * t + 2]];
-      area_normal += glm::cross(b - a, c - a);
-      box.grow(a);
-      box.grow(b);
-      box.grow(c);
-    }
-    const float len = glm::length(area_normal);
-    if (!all_mirror || !(len > 0.0f)) continue;
+    const std::optional<Plane> plane = planar_mirror_plane(scene, o, tolerance);
+    if (!plane) continue;
     PlanarMirror mirror;
     mirror.object = o;
-    mirror.plane.normal = area_normal / len;
-    double offset = 0.0;
-    std::size_t n = 0;
-    for (std::uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t)
-      for (int k = 0; k < 3; ++k, ++n)
-        offset += glm::dot(mirror.plane.normal, m.positions[m.indices[3 * t + k]]);
-    mirror.plane.offset = static_cast<float>(offset / static_cast<double>(n));
-    const float limit = tolerance * glm::length(box.extent());
-    bool planar = true;
-    for (std::uint32_t t = obj.first_triangle; planar && t < obj.first_triangle + obj.triangle_count; ++t)
-      for (int k = 0; k < 3; ++k)
-        if (std::abs(mirror.plane.signed_distance(m.positions[m.indices[3 * t + k]])) > limit)
-          planar = false;
-    if (!planar) continue;
+    mirror.plane = *plane;
     mirror.front = clip_scene_to_half_space(scene, mirror.plane, 1.0f, o);
     mirror.back = clip_scene_to_half_space(scene, mirror.plane, -1.0f, o);
     mirrors.push_back(std::move(mirror));
@@ -68,6 +69,7 @@ struct Recursion {
   const std::vector<PlanarMirror>& mirrors;
   const std::vector<ShadowMap>& shadows;
   const EnvironmentMap& env;
+  const ReflectorMaps* curved;
   PlanarMirrorSettings settings;
   PlanarMirrorStats stats;
 
@@ -90,7 +92,8 @@ struct Recursion {
 
   // The specular layer of a view at recursion `level` (0: the camera's own view).
   ImageRGBA reflect(const GBuffer& g, const Camera& camera, int level) {
-    ImageRGBA specular = envmap_reflect(executor, g, env);
+    ImageRGBA specular = curved ? distance_map_reflect(executor, g, env, *curved, DistanceSearchOptions{})
+                                : envmap_reflect(executor, g, env);
     if (level >= settings.depth) return specular;
     for (const PlanarMirror& mirror : mirrors) {
       // Skip mirrors this view does not see (no mirrored render for them).
@@ -131,12 +134,12 @@ struct Recursion {
 ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
                                 const std::vector<PlanarMirror>& mirrors, const GBuffer& g,
                                 const Camera& camera, const std::vector<ShadowMap>& shadows,
-                                const EnvironmentMap& env, const PlanarMirrorSettings& settings,
-                                PlanarMirrorStats* stats) {
+                                const EnvironmentMap& env, const ReflectorMaps* curved,
+                                const PlanarMirrorSettings& settings, PlanarMirrorStats* stats) {
   PlanarMirrorSettings s = settings;
   s.width = g.width;
   s.height = g.height;
-  Recursion r{executor, scene, mirrors, shadows, env, s, {}};
+  Recursion r{executor, scene, mirrors, shadows, env, curved, s, {}};
   ImageRGBA specular = r.reflect(g, camera, 0);
   if (stats) *stats = r.stats;
   return specular;
@@ -150,12 +153,13 @@ PlanarMirrors PlanarMirrorsPass::operator()(par::NodeContext& c) const {
 
 ImageRGBA PlanarMirrorReflectPass::operator()(par::NodeContext& c, const PlanarMirrors& mirrors,
                                              const GBuffer& gbuffer, const ShadowMaps& shadows,
-                                             const EnvironmentMap& environment) const {
+                                             const EnvironmentMap& environment,
+                                             const ReflectorMaps* curved_reflectors) const {
   PlanarMirrorSettings settings;
   settings.depth = depth;
   PlanarMirrorStats stats;
   ImageRGBA specular = planar_mirror_reflect(c.executor(), *scene, mirrors, gbuffer, camera, shadows,
-                                             environment, settings, &stats);
+                                             environment, curved_reflectors, settings, &stats);
   c.count("mirrored_views", stats.mirrored_views);
   c.count("mirror_samples", stats.mirror_samples);
   c.count("views_over_budget", stats.views_over_budget);

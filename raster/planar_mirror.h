@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/scene.h"
@@ -13,6 +14,7 @@
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/mirrored_camera.h"
+#include "raster/reflector_maps.h"
 #include "raster/shadow_map.h"
 
 namespace speculum::raster {
@@ -27,9 +29,13 @@ struct PlanarMirror {
   }
 };
 
-// Objects whose material is a mirror (is_mirror_lobe, not a refractor) and whose vertices
-// all lie within `tolerance` × (bounding-box diagonal) of one plane. The plane normal is
-// the area-weighted mean of the triangle normals.
+// Object `object`'s plane when every triangle's material is a mirror (is_mirror_lobe, not a
+// refractor) and all its vertices lie within `tolerance` × (bounding-box diagonal) of one
+// plane; the plane normal is the area-weighted mean of the triangle normals.
+std::optional<Plane> planar_mirror_plane(const Scene& scene, std::uint32_t object,
+                                         float tolerance = 1e-3f);
+
+// The objects with a planar_mirror_plane, each with its clipped scenes.
 std::vector<PlanarMirror> find_planar_mirrors(const Scene& scene, float tolerance = 1e-3f);
 
 struct PlanarMirrorSettings {
@@ -51,12 +57,15 @@ struct PlanarMirrorStats {
 
 // The specular layer of G-buffer `g` (seen from `camera` in `view_scene`, object ids of
 // `scene`): planar-mirror samples get F(N·V) × the mirrored view's radiance (recursively,
-// `depth` levels; beyond it the environment lookup); every other specular sample gets the
-// environment-map layer (envmap_reflect). `shadows` and `env` are the original scene's.
+// `depth` levels; beyond it the environment lookup); every other specular sample, in the
+// camera's view and in every mirrored view, gets the distance-map search (SURVEY §4.2) in
+// its own cube map in `curved` when it has one, else the environment lookup of envmap_reflect.
+// `shadows` and `env` are the original scene's.
 ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
                                 const std::vector<PlanarMirror>& mirrors, const GBuffer& g,
                                 const Camera& camera, const std::vector<ShadowMap>& shadows,
-                                const EnvironmentMap& env, const PlanarMirrorSettings& settings,
+                                const EnvironmentMap& env, const ReflectorMaps* curved,
+                                const PlanarMirrorSettings& settings,
                                 PlanarMirrorStats* stats = nullptr);
 
 using PlanarMirrors = std::vector<PlanarMirror>;
@@ -74,14 +83,15 @@ struct PlanarMirrorsPass {
 struct PlanarMirrorReflectPass {
   static constexpr const char* description =
       "Each planar mirror's samples get F × the view of the camera reflected about the mirror "
-      "plane (scene clipped at the plane), recursively to depth k; other specular samples the "
-      "environment map (SURVEY §5).";
+      "plane (scene clipped at the plane), recursively to depth k; other specular samples search "
+      "their own distance map, or look up the environment (SURVEY §5, §4.2).";
   const Scene* scene = nullptr;
   Camera camera;
   int depth = 3;
   void parameters(par::Params& p) const { p.set("depth", depth); }
   ImageRGBA operator()(par::NodeContext& c, const PlanarMirrors& mirrors, const GBuffer& gbuffer,
-                       const ShadowMaps& shadows, const EnvironmentMap& environment) const;
+                       const ShadowMaps& shadows, const EnvironmentMap& environment,
+                       const ReflectorMaps* curved_reflectors) const;
 };
 
 }  // namespace speculum::raster

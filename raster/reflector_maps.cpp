@@ -8,6 +8,7 @@
 #include "raster/composite.h"
 #include "raster/direct_light.h"
 #include "raster/envmap_reflect.h"
+#include "raster/planar_mirror.h"
 #include "raster/specular_radiance.h"
 
 namespace speculum::raster {
@@ -46,7 +47,7 @@ float map_lookup_exponent(const Material& material, const SurfaceParams& s) {
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size,
-                                    const GBuffer* camera_view) {
+                                    const GBuffer* camera_view, bool skip_planar_mirrors) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
@@ -67,6 +68,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
       for (int k = 0; k < 3; ++k) b.grow(m.positions[m.indices[3 * t + k]]);
     }
     if (!specular || !b.valid()) continue;
+    if (skip_planar_mirrors && planar_mirror_plane(scene, static_cast<std::uint32_t>(o))) continue;
     glm::vec3 centre = b.center();
     const glm::vec3 e = b.extent();
     const float smallest = std::min({e.x, e.y, e.z}), largest = std::max({e.x, e.y, e.z});
@@ -98,7 +100,8 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
 ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
                                                 const EnvironmentMap& environment,
                                                 const GBuffer& gbuffer) const {
-  ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer);
+  ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
+                                             skip_planar_mirrors);
   c.count("cube_maps", maps.cubes.size());
   return maps;
 }

@@ -33,10 +33,13 @@ struct ReflectorMaps {
 // Specular objects: at least one triangle's material reflects or refracts
 // (is_specular(surface_params(material))).
 // `camera_view` (may be null) is the camera's G-buffer, used for flat reflectors.
+// `skip_planar_mirrors`: planar mirrors (planar_mirror_plane) get no map, for a technique
+// that renders their reflections exactly by another pass.
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
-                                    const GBuffer* camera_view = nullptr);
+                                    const GBuffer* camera_view = nullptr,
+                                    bool skip_planar_mirrors = false);
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {
@@ -45,7 +48,11 @@ struct ReflectorCubeMapsPass {
       "itself left out (SURVEY §3.1, §4.2).";
   const Scene* scene = nullptr;
   int size = 256;
-  void parameters(par::Params& p) const { p.set("size", size); }
+  bool skip_planar_mirrors = false;
+  void parameters(par::Params& p) const {
+    p.set("size", size);
+    if (skip_planar_mirrors) p.set("planar_mirrors", "skipped");
+  }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows,
                            const EnvironmentMap& environment, const GBuffer& gbuffer) const;
 };

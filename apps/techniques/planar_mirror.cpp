@@ -3,6 +3,7 @@
 #include "apps/techniques/frame_passes.h"
 #include "apps/techniques/recipes.h"
 #include "raster/planar_mirror.h"
+#include "raster/reflector_maps.h"
 
 namespace speculum::pipeline {
 
@@ -14,9 +15,14 @@ FrameOutputs add_planar_mirror_passes(par::Graph& g, const Scene* scene, const F
   notes.visibility = "Camera visibility buffer; the mirror samples are the stencil of SURVEY §5.";
   const SurfaceResources s = add_surface_passes(g, scene, f, notes);
   auto mirrors = g.add("planar_mirrors", PlanarMirrorsPass{scene});
+  // Curved and glossy reflectors are not planar mirrors: they get the distance-map search in
+  // cube maps of their own (SURVEY §4.2), in the camera's view and in every mirrored one.
+  auto curved = g.add("reflector_cube_maps",
+                      ReflectorCubeMapsPass{scene, f.cube_map_size, /*skip_planar_mirrors=*/true},
+                      s.shadow_maps, s.environment, s.gbuffer);
   auto specular = g.add("planar_mirror_reflect",
                         PlanarMirrorReflectPass{scene, f.camera, static_cast<int>(f.param("depth"))},
-                        mirrors, s.gbuffer, s.shadow_maps, s.environment);
+                        mirrors, s.gbuffer, s.shadow_maps, s.environment, curved);
   return add_output_passes(g, f, s.direct, specular);
 }
 

@@ -84,7 +84,8 @@ const std::vector<Technique>& techniques() {
         {"bounces", 2, 1, 16, true, "specular hits followed (--bounces raises it)"}}},
       {"planar-mirror",
        "planar mirrors by geometry transformation (SURVEY §5): the camera reflected about each "
-       "mirror plane, scene clipped at the plane, recursive; other specular surfaces as envmap",
+       "mirror plane, scene clipped at the plane, recursive; curved and glossy reflectors by the "
+       "distance-map search in their own cube maps (SURVEY §4)",
        add_planar_mirror_passes,
        // Each level renders the frame again per mirror seen: m mirrors that see each other
        // cost up to (m-1)^depth views, so the depth stays small and the pass renders at most

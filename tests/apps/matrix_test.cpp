@@ -66,7 +66,8 @@ TEST(Matrix, RecordsEveryCellAndReusesTheReferences) {
     EXPECT_EQ(c["options"]["width"], 40);
   }
   // The specular error isolates the technique's own approximation: the planar mirror is
-  // exact but for edges on the corridor's flat mirrors, envmap (no parallax) is far off.
+  // exact but for edges on the corridor's flat mirrors (the glossy torus between them is
+  // searched in its distance map), envmap (no parallax) is far off.
   auto cell = [&](const std::string& id) {
     for (const auto& c : a["cells"])
       if (c["id"] == id) return c;
@@ -76,7 +77,7 @@ TEST(Matrix, RecordsEveryCellAndReusesTheReferences) {
   ASSERT_TRUE(mirror.contains("specular"));
   EXPECT_GT(mirror["specular"]["pixels"].get<int>(), 100);
   EXPECT_EQ(mirror["specular"]["pixels"], envmap["specular"]["pixels"]);  // one G-buffer, one mask
-  EXPECT_LT(mirror["specular"]["mae8"].get<double>(), 2.0);
+  EXPECT_LT(mirror["specular"]["mae8"].get<double>(), 1.0);
   EXPECT_GT(envmap["specular"]["mae8"].get<double>(), 5.0 * mirror["specular"]["mae8"].get<double>());
   EXPECT_EQ(mirror["specular_reference"]["bounces"], 3);  // planar-mirror's depth
   EXPECT_EQ(envmap["specular_reference"]["bounces"], 1);

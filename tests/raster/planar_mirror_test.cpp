@@ -265,7 +265,7 @@ TEST(PlanarMirror, MirrorsThatSeeEachOtherStopAtTheViewBudget) {
     settings.width = 24;
     settings.height = 16;
     settings.max_views = max_views;
-    return planar_mirror_reflect(ex, s, mirrors, g, c, {}, env, settings, &stats);
+    return planar_mirror_reflect(ex, s, mirrors, g, c, {}, env, nullptr, settings, &stats);
   };
   par::Executor one(1), two(2);
   PlanarMirrorStats free_stats, budget_stats, budget_stats2;
