@@ -13,6 +13,7 @@
 #include "apps/cli/json_output.h"
 #include "apps/inspect/inspect_images.h"
 #include "apps/inspect/inspect_report.h"
+#include "apps/inspect/inspect_run.h"
 #include "apps/techniques/render_frame.h"
 #include "apps/cli/progress.h"
 #include "core/error.h"
@@ -49,16 +50,18 @@ std::string shell_quote(const std::string& s) {
 
 bool have_graphviz() { return std::system("command -v dot >/dev/null 2>&1") == 0; }
 
-void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
-  const pipeline::Technique& technique = pipeline::find_technique(o.frame.technique);
-  Scene scene = pipeline::load_frame_scene(o.frame, global.quiet);
-  const pipeline::FrameSettings settings = pipeline::make_frame_settings(o.frame, scene);
-  for (const std::string& warning : pipeline::apply_light_options(o.frame, scene, settings.camera))
+}  // namespace
+
+fs::path write_inspect_report(const pipeline::FrameOptions& options, const fs::path& dir,
+                              const GlobalOptions& global, bool svg) {
+  const pipeline::Technique& technique = pipeline::find_technique(options.technique);
+  Scene scene = pipeline::load_frame_scene(options, global.quiet);
+  const pipeline::FrameSettings settings = pipeline::make_frame_settings(options, scene);
+  for (const std::string& warning : pipeline::apply_light_options(options, scene, settings.camera))
     if (!global.quiet) std::fprintf(stderr, "%s\n", warning.c_str());
-  const fs::path dir = o.output;
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw InputError(o.output, "cannot create the output directory");
+  if (ec || !fs::is_directory(dir)) throw InputError(dir.string(), "cannot create the output directory");
 
   // The same recipe as render_frame builds, compiled but not run: names, ports,
   // parameters and descriptions in execution order.
@@ -152,7 +155,7 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
   report.dot = "graph.dot";
   write_text(dir / report.dot, meta.to_dot());
   report.files.push_back(report.dot);
-  if (!o.no_svg && have_graphviz()) {
+  if (svg && have_graphviz()) {
     const std::string cmd = "dot -Tsvg " + shell_quote((dir / "graph.dot").string()) + " -o " +
                             shell_quote((dir / "graph.svg").string()) + " >/dev/null 2>&1";
     if (std::system(cmd.c_str()) == 0 && fs::exists(dir / "graph.svg")) {
@@ -170,7 +173,14 @@ void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
     std::fprintf(stderr, "speculum: inspect %s %s: %zu passes, %zu files in %.1f ms\n",
                  technique.name.c_str(), scene.name.c_str(), report.nodes.size(), report.files.size(),
                  report.frame_ms);
-  std::printf("%s\n", fs::absolute(dir / "index.html").string().c_str());
+  return dir / "index.html";
+}
+
+namespace {
+
+void run_inspect(const InspectOptions& o, const GlobalOptions& global) {
+  const fs::path index = write_inspect_report(o.frame, o.output, global, !o.no_svg);
+  std::printf("%s\n", fs::absolute(index).string().c_str());
 }
 
 }  // namespace

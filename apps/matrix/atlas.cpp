@@ -181,9 +181,15 @@ void write_atlas(const fs::path& dir, const nlohmann::ordered_json& results, boo
         << html_escape(c["specular_heat_map"].get<std::string>())
         << "\" alt=\"specular difference\" title=\"against specular-reference\"></span><br>"
         << fixed(c["ms"].get<double>(), 1) << " ms<br>frame mae8 " << fixed(c["frame"]["mae8"].get<double>(), 2)
-        << "<br>specular mae8 " << fixed(c["specular"]["mae8"].get<double>(), 2) << "<br><code title=\"the "
-        << "cell's passes, one by one\">speculum inspect " << html_escape(s) << " -t " << html_escape(t)
-        << "</code></td>";
+        << "<br>specular mae8 " << fixed(c["specular"]["mae8"].get<double>(), 2) << "<br>";
+      // The cell's passes, one by one: a link when the run wrote them (--inspect), else the
+      // command that writes them.
+      if (c.contains("inspect"))
+        h << "<a href=\"" << html_escape(c["inspect"].get<std::string>()) << "\">inspect</a>";
+      else
+        h << "<code title=\"the cell's passes, one by one\">speculum inspect " << html_escape(s) << " -t "
+          << html_escape(t) << "</code>";
+      h << "</td>";
     }
     h << "</tr>\n";
   }

@@ -12,6 +12,7 @@
 
 #include "apps/cli/frame_options.h"
 #include "apps/cli/json_output.h"
+#include "apps/inspect/inspect_run.h"
 #include "apps/matrix/atlas.h"
 #include "apps/techniques/render_frame.h"
 #include "core/did_you_mean.h"
@@ -103,12 +104,6 @@ std::uint64_t fnv1a(const std::string& s) {
   return h;
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -415,8 +410,24 @@ cli::OrderedJson run_cell(const MatrixOptions& o, const Cell& cell, par::Executo
                           {"image", fs::relative(cell_image(dir, cell), dir).string()},
                           {"frame_heat_map", fs::relative(frame_heat, dir).string()},
                           {"specular_heat_map", fs::relative(specular_heat, dir).string()}};
+  if (o.inspect) {
+    // Every pass of the cell, one by one: the same page `speculum inspect` writes for these
+    // options (its frame is not the timed one, so the times above are unaffected).
+    const fs::path page = cli::write_inspect_report(frame_options(o, cell.scene, cell.technique),
+                                                    dir / "cells" / (cell.id() + ".inspect"),
+                                                    cli::GlobalOptions{executor.threads(), executor.lanes(), true},
+                                                    /*svg=*/true);
+    record["inspect"] = fs::relative(page, dir).string();
+  }
   write_text_file(cell_record(dir, cell).string(), cli::json_document(record));
   return record;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
 }
 
 cli::OrderedJson merge(const MatrixOptions& o, const std::vector<Cell>& cells) {

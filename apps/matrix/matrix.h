@@ -31,6 +31,7 @@ struct MatrixOptions {
   std::uint32_t seed = 0;
   std::vector<std::string> params;  // technique:name=value
   std::string output;
+  bool inspect = false;  // also write each cell's inspect report into DIR/cells/ID.inspect/
 };
 
 struct Cell {
@@ -60,6 +61,9 @@ Cell find_cell(const MatrixOptions& o, const std::string& id);
 
 // results.json from DIR/cells (written atomically); InputError naming the missing cells.
 nlohmann::ordered_json merge(const MatrixOptions& o, const std::vector<Cell>& cells);
+
+// The whole of a text file ("" when it cannot be read).
+std::string read_text(const std::filesystem::path& path);
 
 // Path of a cell's image and record.
 std::filesystem::path cell_image(const std::filesystem::path& dir, const Cell& cell);

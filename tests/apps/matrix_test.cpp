@@ -210,9 +210,50 @@ TEST(Matrix, GoldenImagesAndJUnit) {
   EXPECT_EQ(j.failed, std::vector<std::string>{"planar-mirror@mirror-corridor"});
   EXPECT_NE(fail.err.find("planar-mirror@mirror-corridor: mae8"), std::string::npos) << fail.err;
 
+  // Per-cell bounds: the changed cell's own entry lets it pass, a technique entry covers
+  // every scene of it, and the cells a file does not name stay at --max-mae8.
+  const fs::path loose = dir / "loose.json", strict = dir / "strict.json", misspelt = dir / "misspelt.json";
+  { std::ofstream(loose) << R"({"planar-mirror@mirror-corridor": 255})"; }
+  { std::ofstream(strict) << R"({"planar-mirror": 0, "distance-map@bowl": 255})"; }
+  { std::ofstream(misspelt) << R"({"planar-mirror@mirror-coridor": 255})"; }
+  const std::string changed = run + " --param planar-mirror:depth=1 --golden " + golden + " --max-mae8 0 --junit " + sh_quote(junit);
+  const CommandResult loosened = run_speculum(changed + " --bounds " + sh_quote(loose.string()), dir);
+  EXPECT_EQ(loosened.status, 0) << loosened.err;
+  EXPECT_EQ(parse_junit(slurp(junit)).failures, 0);
+  const CommandResult by_technique = run_speculum(changed + " --bounds " + sh_quote(strict.string()), dir);
+  EXPECT_EQ(by_technique.status, 1) << by_technique.err;
+  EXPECT_EQ(parse_junit(slurp(junit)).failed, std::vector<std::string>{"planar-mirror@mirror-corridor"});
+  // A key that names no cell is bad input, before any cell runs.
+  const CommandResult typo = run_speculum(changed + " --bounds " + sh_quote(misspelt.string()), dir);
+  EXPECT_EQ(typo.status, 2) << typo.err;
+  EXPECT_EQ(line_count(typo.err), 1u) << typo.err;
+  EXPECT_NE(typo.err.find("did you mean 'mirror-corridor'"), std::string::npos) << typo.err;
+
   // A golden directory that does not exist is bad input.
   const CommandResult bad = run_speculum(run + " --golden " + sh_quote((dir / "none").string()), dir);
   EXPECT_EQ(bad.status, 2) << bad.err;
+  fs::remove_all(dir);
+}
+
+// --inspect writes each cell's inspect page beside it (the same passes the cell ran) and
+// the atlas links to it.
+TEST(Matrix, InspectPagesAreLinkedFromTheAtlas) {
+  const auto dir = scratch_dir();
+  const CommandResult r = run_speculum("-q --threads 2 matrix --techniques planar-mirror --scenes mirror-corridor "
+                                       "--width 40 --height 30 --repeat 1 --spp-reference 2 --glossy-samples 4 "
+                                       "--inspect -o " + sh_quote((dir / "m").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto record = nlohmann::json::parse(slurp(dir / "m" / "cells" / "planar-mirror@mirror-corridor.json"));
+  ASSERT_TRUE(record.contains("inspect"));
+  const std::string page = record["inspect"];
+  EXPECT_EQ(page, "cells/planar-mirror@mirror-corridor.inspect/index.html");
+  ASSERT_TRUE(fs::exists(dir / "m" / page));
+  EXPECT_NE(slurp(dir / "m" / "index.html").find("href=\"" + page + "\""), std::string::npos);
+  const auto manifest = nlohmann::json::parse(slurp(dir / "m" / "cells" / "planar-mirror@mirror-corridor.inspect" / "manifest.json"));
+  std::vector<std::string> cell_nodes, page_nodes;
+  for (const auto& n : record["nodes"]) cell_nodes.push_back(n["name"]);
+  for (const auto& n : manifest["nodes"]) page_nodes.push_back(n["name"]);
+  EXPECT_EQ(page_nodes, cell_nodes);
   fs::remove_all(dir);
 }
 
