@@ -12,7 +12,8 @@ DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_
 std::string describe_search(const DistanceSearchOptions& o) {
   return "parallax=" + (o.parallax ? std::to_string(o.parallax_steps) : std::string("off")) +
          " linear=" + (o.linear ? std::to_string(o.linear_steps) : std::string("off")) +
-         " secant=" + (o.secant ? std::to_string(o.secant_steps) : std::string("off"));
+         " secant=" + (o.secant ? std::to_string(o.secant_steps) : std::string("off")) +
+         " lobe=" + std::to_string(o.lobe_directions);
 }
 
 }  // namespace speculum::raster

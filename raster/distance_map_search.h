@@ -26,6 +26,8 @@ struct DistanceSearchOptions {
   int linear_steps = 16;   // N
   bool secant = true;      // eq.5 refinement of the bracket (or of the parallax guesses)
   int secant_steps = 4;
+  // Searches per glossy lobe (distance_map_reflect): 1 searches along the lobe's axis only.
+  int lobe_directions = 8;
 };
 
 // "parallax=1 linear=16 secant=4" (a step count, or "off" for a disabled search): the

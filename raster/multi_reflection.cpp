@@ -17,6 +17,9 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
   next.map_of_object = current.map_of_object;
   next.centres = current.centres;
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
+  // Reflectors seen in a cube face are a few texels wide: one search along each lobe's axis.
+  DistanceSearchOptions face_search = options;
+  face_search.lobe_directions = 1;
   for (std::size_t o = 0; o < current.map_of_object.size(); ++o) {
     const int m = current.map_of_object[o];
     if (m < 0) continue;
@@ -29,7 +32,7 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
     next.cubes.push_back(render_cube_map(
         executor, scene, current.centres[m], opt, [&](const GBuffer& g, const Camera& cam) {
           return composite(executor, direct_light(executor, scene, g, cam, shadows, env),
-                           distance_map_reflect(executor, g, env, current, options, stats));
+                           distance_map_reflect(executor, g, env, current, face_search, stats));
         }));
   }
   // map_of_object numbers maps in object order, as render_reflector_maps does.

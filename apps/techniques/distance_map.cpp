@@ -16,6 +16,7 @@ DistanceSearchOptions distance_search_options(const FrameSettings& f) {
   o.parallax_steps = static_cast<int>(f.param("parallax_steps"));
   o.linear_steps = static_cast<int>(f.param("linear_steps"));
   o.secant_steps = static_cast<int>(f.param("secant_steps"));
+  o.lobe_directions = static_cast<int>(f.param("lobe_directions"));
   return o;
 }
 

@@ -23,7 +23,8 @@ std::vector<TechniqueParam> search_params() {
           {"secant", 1, 0, 1, true, "1: secant refinement of the bracket (eq.5)"},
           {"parallax_steps", 1, 1, 16, true, "parallax iterations (converged long before 16)"},
           {"linear_steps", 16, 1, 256, true, "linear search steps (256: under a texel of a 256² face)"},
-          {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"}};
+          {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
+          {"lobe_directions", 8, 1, 64, true, "searches per glossy lobe, each a sub-lobe (1: along R only)"}};
 }
 
 std::vector<TechniqueParam> concat(std::vector<TechniqueParam> a, const std::vector<TechniqueParam>& b) {
