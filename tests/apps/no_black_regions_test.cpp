@@ -3,13 +3,22 @@
 // 1) must be black in the reference too — at its full specular depth or at one bounce (a
 // first-order technique is not asked to show a mirror inside a mirror). At most 0.5 % of the
 // pixels may break this, per technique × scene, except the cells listed in kOpenCells.
+// Each cell's frame error (mae8 against the same reference) is also held to its bound in
+// tests/data/frame_error_bounds.json, set from the output with a small margin: a regression
+// in any cell fails, and a bound may only be lowered.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/techniques/render_frame.h"
 #include "apps/techniques/technique_table.h"
+#include "core/image_metrics.h"
 #include "core/scene_loader.h"
 #include "parallel/executor.h"
 #include "raster/composite.h"
@@ -43,6 +52,16 @@ struct OpenCell {
 };
 constexpr OpenCell kOpenCells[] = {{"yu-lod", "living-room", 124}, {"ray-hierarchy", "living-room", 35}};
 
+const nlohmann::json& frame_error_bounds() {
+  static const nlohmann::json bounds = [] {
+    std::ifstream in(SPECULUM_TEST_DATA "/frame_error_bounds.json");
+    std::stringstream text;
+    text << in.rdbuf();
+    return nlohmann::json::parse(text.str());
+  }();
+  return bounds;
+}
+
 class NoBlackRegions : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(NoBlackRegions, EveryTechniqueAgainstTheReference) {
@@ -66,6 +85,16 @@ TEST_P(NoBlackRegions, EveryTechniqueAgainstTheReference) {
     for (const OpenCell& c : kOpenCells)
       if (t.name == c.technique && GetParam() == c.scene) bound = c.max_black;
     EXPECT_LE(wrong, bound) << t.name << " on " << GetParam() << ": " << wrong << " black pixels the reference lacks";
+
+    const std::string id = t.name + "@" + GetParam();
+    const double mae8 = image_error(full, img).mae8;
+    const nlohmann::json& bounds = frame_error_bounds();
+    if (!bounds.contains(id)) {
+      ADD_FAILURE() << "no frame-error bound for " << id << " in tests/data/frame_error_bounds.json: measured "
+                    << mae8 << ", suggested \"" << id << "\": " << std::ceil((mae8 * 1.02 + 0.05) * 100.0) / 100.0;
+      continue;
+    }
+    EXPECT_LE(mae8, bounds[id].get<double>()) << id << ": frame mae8 against the reference";
   }
 }
 
