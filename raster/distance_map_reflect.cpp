@@ -1,6 +1,7 @@
 // The `distance_map_reflect` node: see distance_map_reflect.h.
 #include "raster/distance_map_reflect.h"
 
+#include <cmath>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -48,6 +49,7 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
         ++st.searches;
         st.lookups += hit.lookups;
         st.bracketed += hit.bracketed;
+        st.missed += !std::isfinite(hit.d);
         return maps.maps[m].radiance(glm::normalize(hit.direction), exponent);
       };
       const auto lookup = [&](const glm::vec3& d, float exponent) {
@@ -75,6 +77,7 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
       stats->searches += c.searches;
       stats->lookups += c.lookups;
       stats->bracketed += c.bracketed;
+      stats->missed += c.missed;
     }
   return out;
 }
@@ -87,6 +90,7 @@ ImageRGBA DistanceMapReflectPass::operator()(par::NodeContext& c, const GBuffer&
   c.count("searches", st.searches);
   c.count("distance_lookups", st.lookups);
   c.count("bracketed", st.bracketed);
+  c.count("fallback_search_missed", st.missed);
   return specular;
 }
 

@@ -20,6 +20,7 @@ struct DistanceReflectStats {
   std::uint64_t searches = 0;  // searched rays (R and T)
   std::uint64_t lookups = 0;   // distance-map reads over all searches
   std::uint64_t bracketed = 0; // searches whose linear search found an undershoot/overshoot pair
+  std::uint64_t missed = 0;    // searches that found no surface: read along the ray (environment)
 };
 
 // The specular layer (zero on diffuse samples). Works on any G-buffer, including a cube

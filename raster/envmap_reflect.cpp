@@ -45,6 +45,10 @@ ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const
 
 ImageRGBA RefractorEnvironmentPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
                                                const EnvironmentMap& environment) const {
+  std::uint64_t refractor_samples = 0;
+  for (std::size_t i = 0; i < gbuffer.surface.size(); ++i)
+    refractor_samples += gbuffer.covered(i) && gbuffer.surface.pixels[i].is_refractor();
+  c.count("fallback_refractor_environment", refractor_samples);
   return refractor_environment(c.executor(), gbuffer, environment);
 }
 

@@ -272,6 +272,7 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
   if (glm::dot(n, r) > 0.0f) n = -n;
   const glm::vec3 reflected = reflect(r, n);
   const glm::vec3 f = specular_reflectance(s, -glm::dot(n, r));
+  stats.depth_exhausted += depth >= o.bounces;
   const glm::vec3 incoming = depth < o.bounces
                                  ? trace_layered(map, env, map.centre + l, reflected, o, depth + 1, stats)
                                  : env.radiance(reflected, 1e6f);
@@ -305,6 +306,7 @@ ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const Layer
       stats->rays += c.rays;
       stats->lookups += c.lookups;
       stats->misses += c.misses;
+      stats->depth_exhausted += c.depth_exhausted;
     }
   return out;
 }
@@ -321,7 +323,8 @@ ImageRGBA LayeredReflectPass::operator()(par::NodeContext& c, const GBuffer& gbu
   ImageRGBA specular = layered_reflect(c.executor(), gbuffer, map, environment, options, &st);
   c.count("searches", st.rays);
   c.count("distance_lookups", st.lookups);
-  c.count("misses", st.misses);
+  c.count("fallback_search_missed", st.misses);
+  c.count("fallback_depth_exhausted", st.depth_exhausted);
   return specular;
 }
 

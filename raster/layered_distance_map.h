@@ -57,6 +57,7 @@ struct LayeredTraceStats {
   std::uint64_t rays = 0;
   std::uint64_t lookups = 0;
   std::uint64_t misses = 0;  // rays that found no layer hit (environment used)
+  std::uint64_t depth_exhausted = 0;  // specular hits past the last bounce (environment used)
 };
 
 // Radiance arriving at x from direction r (unit) through the layered map.

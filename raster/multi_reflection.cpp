@@ -68,6 +68,7 @@ ReflectorMaps MultiReflectionMapsPass::operator()(par::NodeContext& c, const Sha
   c.count("cube_maps", maps.cubes.size());
   c.count("searches", st.searches);
   c.count("distance_lookups", st.lookups);
+  c.count("fallback_search_missed", st.missed);
   return maps;
 }
 

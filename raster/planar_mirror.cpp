@@ -72,6 +72,7 @@ struct Recursion {
   const ReflectorMaps* curved;
   PlanarMirrorSettings settings;
   PlanarMirrorStats stats;
+  DistanceReflectStats search;  // the curved reflectors' searches, in every view
 
   // Radiance of a mirrored view: the whole per-view pipeline (visibility → G-buffer →
   // direct light → specular layer) for `camera` in the clipped scene.
@@ -92,9 +93,14 @@ struct Recursion {
 
   // The specular layer of a view at recursion `level` (0: the camera's own view).
   ImageRGBA reflect(const GBuffer& g, const Camera& camera, int level) {
-    ImageRGBA specular = curved ? distance_map_reflect(executor, g, env, *curved, DistanceSearchOptions{})
+    ImageRGBA specular = curved ? distance_map_reflect(executor, g, env, *curved, DistanceSearchOptions{}, &search)
                                 : envmap_reflect(executor, g, env);
-    if (level >= settings.depth) return specular;
+    if (level >= settings.depth) {
+      // The mirrors seen here are not rendered again: they keep the environment lookup.
+      for (std::size_t i = 0; i < g.object.size(); ++i)
+        for (const PlanarMirror& mirror : mirrors) stats.depth_exhausted += g.object.pixels[i] == mirror.object;
+      return specular;
+    }
     for (const PlanarMirror& mirror : mirrors) {
       // Skip mirrors this view does not see (no mirrored render for them).
       bool seen = false;
@@ -139,8 +145,9 @@ ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
   PlanarMirrorSettings s = settings;
   s.width = g.width;
   s.height = g.height;
-  Recursion r{executor, scene, mirrors, shadows, env, curved, s, {}};
+  Recursion r{executor, scene, mirrors, shadows, env, curved, s, {}, {}};
   ImageRGBA specular = r.reflect(g, camera, 0);
+  r.stats.search_missed = r.search.missed;
   if (stats) *stats = r.stats;
   return specular;
 }
@@ -163,6 +170,8 @@ ImageRGBA PlanarMirrorReflectPass::operator()(par::NodeContext& c, const PlanarM
   c.count("mirrored_views", stats.mirrored_views);
   c.count("mirror_samples", stats.mirror_samples);
   c.count("views_over_budget", stats.views_over_budget);
+  c.count("fallback_depth_exhausted", stats.depth_exhausted);
+  c.count("fallback_search_missed", stats.search_missed);
   return specular;
 }
 

@@ -53,6 +53,8 @@ struct PlanarMirrorStats {
   std::uint64_t mirrored_views = 0;     // visibility + shading passes of mirrored cameras
   std::uint64_t mirror_samples = 0;     // samples that received a mirrored image
   std::uint64_t views_over_budget = 0;  // mirrored views not rendered (max_views reached)
+  std::uint64_t depth_exhausted = 0;    // mirror samples of the deepest views: environment lookup
+  std::uint64_t search_missed = 0;      // curved reflectors' distance-map searches that found nothing
 };
 
 // The specular layer of G-buffer `g` (seen from `camera` in `view_scene`, object ids of

@@ -63,6 +63,7 @@ struct ShadeHitsPass {
   const Scene* scene = nullptr;
   int width = 0, height = 0;
   int bounce = 1;
+  bool last = false;  // the last generation: specular hits end here (counted)
   void parameters(par::Params& p) const { p.set("bounce", bounce); }
   ImageRGBA operator()(par::NodeContext& c, const SecondaryRays& rays, const HitStream& hits,
                        const ShadowHits& shadows, const ImageRGBA* earlier_bounces) const;

@@ -35,7 +35,7 @@ FrameOutputs add_ray_hierarchy_passes(par::Graph& g, const Scene* scene, const F
                       rays, hierarchy);
     auto shadows = g.add("shadow_rays" + suffix, trace::ShadowRaysPass{scene, traverse, width, height},
                          rays, hits);
-    specular = g.add("shade_hits" + suffix, trace::ShadeHitsPass{scene, width, height, b}, rays, hits,
+    specular = g.add("shade_hits" + suffix, trace::ShadeHitsPass{scene, width, height, b, b == bounces}, rays, hits,
                      shadows, specular);
     if (b < bounces)
       rays = g.add("bounce_rays_" + std::to_string(b + 1), trace::BounceRaysPass{scene, b + 1}, rays, hits);

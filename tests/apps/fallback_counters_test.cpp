@@ -1,0 +1,84 @@
+// The fallback counters count exactly the samples that fell back: a sample whose specular
+// path a technique stops at depth k is the sample that depth k + 1 follows. Each test checks
+// the counter of one depth against the work of the next.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "apps/techniques/render_frame.h"
+#include "apps/techniques/technique_table.h"
+#include "core/scene_loader.h"
+#include "parallel/executor.h"
+
+namespace speculum::pipeline {
+namespace {
+
+double counter(const FrameResult& r, const std::string& node, const std::string& name) {
+  for (const auto& n : r.report.nodes)
+    if (n.name == node) {
+      const auto it = n.counters.find(name);
+      if (it != n.counters.end()) return it->second;
+    }
+  ADD_FAILURE() << "no counter " << node << "/" << name;
+  return -1.0;
+}
+
+FrameResult render(const Scene& s, const std::string& technique, const std::string& param, int value,
+                   int bounces = 0) {
+  const Technique& t = find_technique(technique);
+  FrameSettings f;
+  f.width = 80;
+  f.height = 60;
+  f.camera = s.cameras.front();
+  f.cube_map_size = 64;
+  f.shadow_map_size = 128;
+  f.bounces = bounces;
+  if (!param.empty()) f.params[param] = value;
+  f = t.with_defaults(f);
+  par::Executor ex(2);
+  return render_frame(s, t, f, ex);
+}
+
+// Planar mirrors: the mirror samples of the depth-k views (environment lookups) are those
+// that depth k + 1 composites a mirrored view into, beyond the ones depth k already did.
+TEST(FallbackCounters, PlanarMirrorDepthExhaustedIsWhatTheNextDepthRenders) {
+  const Scene s = load_scene("mirror-corridor:size=3000");
+  for (int k = 0; k <= 2; ++k) {
+    SCOPED_TRACE(k);
+    const FrameResult at = render(s, "planar-mirror", "depth", k), next = render(s, "planar-mirror", "depth", k + 1);
+    const double exhausted = counter(at, "planar_mirror_reflect", "fallback_depth_exhausted");
+    EXPECT_GT(exhausted, 0.0);  // the corridor's mirrors face each other: every depth stops somewhere
+    EXPECT_EQ(exhausted, counter(next, "planar_mirror_reflect", "mirror_samples") -
+                             counter(at, "planar_mirror_reflect", "mirror_samples"));
+  }
+}
+
+// Ray hierarchy: the specular hits of the last generation are the rays of the next one.
+TEST(FallbackCounters, RayHierarchyDepthExhaustedIsTheNextGeneration) {
+  const Scene s = load_scene("mirror-corridor:size=3000");
+  for (int b = 1; b <= 2; ++b) {
+    SCOPED_TRACE(b);
+    const FrameResult at = render(s, "ray-hierarchy", "", 0, b), next = render(s, "ray-hierarchy", "", 0, b + 1);
+    const std::string last = b == 1 ? "shade_hits" : "shade_hits_" + std::to_string(b);
+    const double exhausted = counter(at, last, "fallback_depth_exhausted");
+    EXPECT_GT(exhausted, 0.0);  // mirrors facing each other: every generation meets a mirror
+    EXPECT_EQ(exhausted, counter(next, "bounce_rays_" + std::to_string(b + 1), "rays"));
+  }
+}
+
+// Layered distance map: each specular hit past the last bounce is one more search at the
+// next bounce count.
+TEST(FallbackCounters, LayeredDepthExhaustedIsTheNextBouncesSearches) {
+  const Scene s = load_scene("mirror-corridor:size=3000");
+  for (int b = 1; b <= 2; ++b) {
+    SCOPED_TRACE(b);
+    const FrameResult at = render(s, "layered-distance-map", "bounces", b),
+                      next = render(s, "layered-distance-map", "bounces", b + 1);
+    const double exhausted = counter(at, "layered_reflect", "fallback_depth_exhausted");
+    EXPECT_GT(exhausted, 0.0);
+    EXPECT_EQ(exhausted, counter(next, "layered_reflect", "searches") - counter(at, "layered_reflect", "searches"));
+  }
+}
+
+}  // namespace
+}  // namespace speculum::pipeline
