@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include "apps/cli/frame_options.h"
 #include "apps/techniques/render_frame.h"
 #include "core/error.h"
@@ -25,7 +27,7 @@ constexpr const char* kModels = "/usr/share/assimp/models";
 constexpr std::uintmax_t kMaxBytes = 20u << 20;
 
 TEST(AssimpModelsRender, EveryLoadableModelRendersNonBlackWithTheDefaults) {
-  if (!std::filesystem::exists(kModels)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(kModels), "the Debian package assimp-testmodels");
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::recursive_directory_iterator(kModels)) {
     std::string ext = e.path().extension().string();

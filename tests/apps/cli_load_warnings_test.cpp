@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include "speculum_run.h"
 
 namespace speculum::test {
@@ -73,7 +75,7 @@ TEST(CliLoadWarnings, StrictMakesAMissingTextureAnInputError) {
 
 TEST(CliLoadWarnings, RecomputedNormalsReachRender) {
   const std::string file = "/usr/share/assimp/models/glTF2/BoxBadNormals-glTF-Binary/BoxBadNormals.glb";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(file), "the Debian package assimp-testmodels");
   const auto dir = scratch_dir();
   const CommandResult r = run_speculum("render " + sh_quote(file) + kSmall + " -o " + sh_quote((dir / "o.png").string()), dir);
   EXPECT_EQ(r.status, 0) << r.err;

@@ -14,6 +14,7 @@
 #include "core/scene_loader.h"
 #include "tests/apps/headless_page.h"
 #include "tests/apps/speculum_run.h"
+#include "tests/test_dependency.h"
 
 namespace speculum {
 namespace {
@@ -148,8 +149,8 @@ TEST(Inspect, BadInputExitsTwo) {
 
 
 TEST(Inspect, EveryImageLoadsInHeadlessChromium) {
-  if (run_shell("command -v chromium", fs::temp_directory_path()).status != 0)
-    GTEST_SKIP() << "chromium is not installed (Debian package `chromium`; .ci/setup.sh installs it)";
+  SPECULUM_REQUIRE(run_shell("command -v chromium", fs::temp_directory_path()).status == 0,
+                   "the Debian package chromium");
   const fs::path dir = test::scratch_dir();
   const fs::path out = dir / "insp";
   const auto r = run_speculum("-q inspect " + std::string(kScene) + " " + kSmall + " -o " +

@@ -12,6 +12,8 @@
 
 #include <expat.h>
 #include <gtest/gtest.h>
+
+#include "tests/test_dependency.h"
 #include <nlohmann/json.hpp>
 
 #include "headless_page.h"
@@ -298,7 +300,7 @@ std::map<std::string, std::string> images(const fs::path& dir) {
 // results.json (times aside) and the same image bytes as one `speculum matrix` process.
 TEST(Matrix, PlanRunByGnuParallelEqualsOneProcess) {
   const auto dir = scratch_dir();
-  ASSERT_EQ(run_shell("command -v parallel", dir).status, 0) << "GNU parallel is not installed (.ci/setup.sh)";
+  SPECULUM_REQUIRE(run_shell("command -v parallel", dir).status == 0, "the Debian package parallel");
   const std::string selection = "matrix --techniques envmap,ray-hierarchy --scenes sphere-in-room,glass-sphere "
                                 "--width 40 --height 30 --repeat 1 --spp-reference 2 --glossy-samples 4 --param "
                                 "ray-hierarchy:block=16";
@@ -349,8 +351,8 @@ TEST(Matrix, PlanRunByGnuParallelEqualsOneProcess) {
 // maps, one gnuplot chart per scene) and no console error; a missing image is noticed.
 TEST(Matrix, AtlasLoadsInHeadlessChromium) {
   const auto dir = scratch_dir();
-  ASSERT_EQ(run_shell("{ command -v chromium && command -v gnuplot; }", dir).status, 0)
-      << "chromium and gnuplot are needed (.ci/setup.sh installs them)";
+  SPECULUM_REQUIRE(run_shell("{ command -v chromium && command -v gnuplot; }", dir).status == 0,
+                   "the Debian packages chromium and gnuplot-nox");
   const CommandResult r = run_speculum(kSmall + " -q -o " + sh_quote((dir / "m").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const int expected = 4 * 3 + 2;

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include "core/error.h"
 #include "core/scene_loader.h"
 
@@ -16,7 +18,7 @@ constexpr const char* kModels = "/usr/share/assimp/models/glTF2";
 constexpr std::uintmax_t kMaxBytes = 50u << 20;
 
 TEST(AssimpGltfSweep, EachFileLoadsOrIsRejectedCleanly) {
-  if (!std::filesystem::exists(kModels)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(kModels), "the Debian package assimp-testmodels");
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::recursive_directory_iterator(kModels)) {
     const std::string ext = e.path().extension().string();
@@ -54,7 +56,7 @@ TEST(AssimpGltfSweep, EachFileLoadsOrIsRejectedCleanly) {
 
 // The known-broken files of the set must be rejected, not silently accepted.
 TEST(AssimpGltfSweep, KnownBrokenFilesAreRejected) {
-  if (!std::filesystem::exists(kModels)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(kModels), "the Debian package assimp-testmodels");
   for (const char* rel : {"IndexOutOfRange/IndexOutOfRange.gltf",
                           "IndexOutOfRange/AllIndicesOutOfRange.gltf", "MissingBin/BoxTextured.gltf",
                           "RecursiveNodes/RecursiveNodes.gltf",

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include "core/error.h"
 #include "core/scene_loader.h"
 
@@ -80,7 +82,7 @@ TEST(BadInput, SpecificProblemsAreNamed) {
 
 TEST(BadInput, AssimpGltf1AndDracoFilesNameTheUnsupportedContent) {
   const std::string models = "/usr/share/assimp/models/";
-  if (!std::filesystem::exists(models + "glTF")) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(models + "glTF"), "the Debian package assimp-testmodels");
   auto problem = [](const std::string& file) {
     try {
       (void)load_scene(file);

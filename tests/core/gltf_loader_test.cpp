@@ -6,6 +6,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "tests/test_dependency.h"
 #include <glm/gtc/constants.hpp>
 
 #include "core/error.h"
@@ -47,7 +49,7 @@ TEST(GltfLoader, TriangleGltfAndGlbAgree) {
 }
 
 TEST(GltfLoader, BoxTexturedVariantsAgreeAndTextureIsLinear) {
-  if (!std::filesystem::exists(kAssimp)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(kAssimp), "the Debian package assimp-testmodels");
   const Scene sep = load_scene(kAssimp + "BoxTextured-glTF/BoxTextured.gltf");
   const Scene emb = load_scene(kAssimp + "BoxTextured-glTF-Embedded/BoxTextured.gltf");
   const Scene glb = load_scene(kAssimp + "BoxTextured-glTF-Binary/BoxTextured.glb");
@@ -70,7 +72,7 @@ TEST(GltfLoader, BoxTexturedVariantsAgreeAndTextureIsLinear) {
 }
 
 TEST(GltfLoader, StripsAndFansBecomeTheSameQuad) {
-  if (!std::filesystem::exists(kAssimp)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(kAssimp), "the Debian package assimp-testmodels");
   const std::string dir = kAssimp + "glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_";
   const Scene ref = load_scene(dir + "06.gltf");  // plain triangles
   const double area = testing::total_area(ref);
@@ -212,7 +214,7 @@ TEST(GltfLoader, MaterialsLightsCamerasAndExtensions) {
 }
 
 TEST(GltfLoader, AssimpCamerasFileGivesPerspectiveCamera) {
-  if (!std::filesystem::exists(kAssimp)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(kAssimp), "the Debian package assimp-testmodels");
   const Scene s = load_scene(kAssimp + "cameras/Cameras.gltf");
   ASSERT_FALSE(s.cameras.empty());
   for (const auto& c : s.cameras) {
@@ -255,7 +257,7 @@ TEST(KhrTextureTransform, KhronosTextureTransformTestUvs) {
   // Khronos' TextureTransformTest: the arrow of "Rotation" and "All" must point at the
   // green marker, which needs the spec's rotation direction. Expected values by hand.
   const std::string file = kAssimp + "textureTransform/TextureTransformTest.gltf";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(file), "the Debian package assimp-testmodels");
   const Scene s = load_scene(file);
   auto material = [&](const std::string& name) -> const Material& {
     for (const Material& m : s.materials)

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include "core/image.h"
 #include "core/obj_loader.h"
 #include "core/scene_loader.h"
@@ -90,7 +92,7 @@ TEST(ObjMtl, QuadMaterialsTextureAndUvs) {
 TEST(ObjMtl, AssimpSpiderCarriesItsTextures) {
   // spider.mtl names its maps with Windows separators (map_Kd .\SpiderTex.jpg).
   const std::string dir = "/usr/share/assimp/models/OBJ/";
-  if (!std::filesystem::exists(dir + "spider.obj")) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(std::filesystem::exists(dir + "spider.obj"), "the Debian package assimp-testmodels");
   LoadReport report;
   SceneOptions o;
   o.report = &report;

@@ -5,6 +5,8 @@
 // their shared (manifold) edges and vertices, across the surface, never miss.
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -185,7 +187,7 @@ class RealMesh : public ::testing::TestWithParam<std::tuple<const char*, int>> {
 TEST_P(RealMesh, BothLayoutsAnyHitAndPacketsMatchOracle) {
   const auto [rel, min_triangles] = GetParam();
   const Mesh m = load(rel);
-  if (m.indices.empty()) GTEST_SKIP() << "assimp-testmodels not installed (" << rel << ")";
+  SPECULUM_REQUIRE(!m.indices.empty(), std::string("the Debian package assimp-testmodels (") + rel + ")");
   ASSERT_GE(static_cast<int>(m.triangles()), min_triangles) << rel;
   // Rays scaled so the all-pairs oracle stays cheap on the big models.
   const int budget = static_cast<int>(std::clamp<std::size_t>(8'000'000 / m.triangles(), 60, 1200));
@@ -352,7 +354,7 @@ TEST(RealMeshWatertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
       EXPECT_GT(cast, static_cast<int>(m.triangles())) << rel;  // most features were aimed at
     }
   }
-  if (meshes == 0) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(meshes > 0, "the Debian package assimp-testmodels");
 }
 
 }  // namespace

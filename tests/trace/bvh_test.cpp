@@ -3,6 +3,8 @@
 // build is byte-identical for any thread count; refit and streams agree with the oracle.
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include <cstring>
 
 #include "core/error.h"
@@ -139,7 +141,7 @@ TEST(Bvh, AxisAlignedRaysOnBoxFacesMatchOracle) {
 
 TEST(Bvh, RealMeshMatchesOracle) {
   const Soup s = testing::read_off("/usr/share/assimp/models/OFF/Wuson.off");
-  if (s.indices.empty()) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(!s.indices.empty(), "the Debian package assimp-testmodels");
   par::Executor ex(2);
   const Bvh bvh = Bvh::build(s.positions, s.indices, ex);
   std::vector<Ray> rays;

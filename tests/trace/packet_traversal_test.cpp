@@ -5,6 +5,8 @@
 // thread count and any stream length (partial last packet).
 #include <gtest/gtest.h>
 
+#include "tests/test_dependency.h"
+
 #include <cstring>
 
 #include "core/camera_rays.h"
@@ -100,7 +102,7 @@ TEST(PacketTraversal, DegenerateSoupMatchesOracle) {
 
 TEST(PacketTraversal, RealMeshMatchesOracle) {
   const Soup s = testing::read_off("/usr/share/assimp/models/OFF/Wuson.off");
-  if (s.indices.empty()) GTEST_SKIP() << "assimp-testmodels not installed";
+  SPECULUM_REQUIRE(!s.indices.empty(), "the Debian package assimp-testmodels");
   par::Executor ex(2);
   const Bvh bvh = Bvh::build(s.positions, s.indices, ex);
   glm::vec3 lo(3e38f), hi(-3e38f);
