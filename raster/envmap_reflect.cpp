@@ -38,18 +38,22 @@ ImageRGBA envmap_reflect(par::Executor& executor, const GBuffer& g, const Enviro
   }, [](const SurfaceParams& s) { return is_specular(s); });
 }
 
-ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env) {
-  return reflect_with(executor, g, [&](std::uint32_t) -> const EnvironmentMap& { return env; },
-                      [](const SurfaceParams& s) { return s.is_refractor(); });
+ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
+                                const ReflectorMaps* refractors) {
+  return reflect_with(executor, g, [&](std::uint32_t object) -> const EnvironmentMap& {
+    const EnvironmentMap* own = refractors ? refractors->for_object(object) : nullptr;
+    return own ? *own : env;
+  }, [](const SurfaceParams& s) { return s.is_refractor(); });
 }
 
 ImageRGBA RefractorEnvironmentPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
-                                               const EnvironmentMap& environment) const {
+                                               const EnvironmentMap& environment,
+                                               const ReflectorMaps* refractor_maps) const {
   std::uint64_t refractor_samples = 0;
   for (std::size_t i = 0; i < gbuffer.surface.size(); ++i)
     refractor_samples += gbuffer.covered(i) && gbuffer.surface.pixels[i].is_refractor();
   c.count("fallback_refractor_environment", refractor_samples);
-  return refractor_environment(c.executor(), gbuffer, environment);
+  return refractor_environment(c.executor(), gbuffer, environment, refractor_maps);
 }
 
 ImageRGBA EnvmapReflectPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,

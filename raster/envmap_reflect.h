@@ -30,17 +30,20 @@ struct EnvmapReflectPass {
 };
 
 // The fallback of techniques that do not follow refraction (yu-lod traces reflections only):
-// refractor samples get the environment along R and T as envmap_reflect computes them, every
+// refractor samples get the light along R and T as envmap_reflect computes them — from the
+// refractor's own cube map in `refractors` when it has one, else the environment — every
 // other sample 0.
-ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env);
+ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
+                                const ReflectorMaps* refractors = nullptr);
 
 // Pass "refractor_environment".
 struct RefractorEnvironmentPass {
   static constexpr const char* description =
-      "Refractor samples only: the environment along the reflected and refracted directions, "
-      "Fresnel-weighted (SURVEY §3.1) — the documented fallback of a technique that traces "
-      "reflections only, so glass is never black.";
-  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const EnvironmentMap& environment) const;
+      "Refractor samples only: the refractor's own cube map (or the environment) along the "
+      "reflected and refracted directions, Fresnel-weighted (SURVEY §3.1) — the documented "
+      "fallback of a technique that traces reflections only, so glass is never black.";
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const EnvironmentMap& environment,
+                       const ReflectorMaps* refractor_maps) const;
 };
 
 }  // namespace speculum::raster

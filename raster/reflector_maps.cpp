@@ -44,17 +44,25 @@ float map_lookup_exponent(const Material& material, const SurfaceParams& s) {
 
 }  // namespace
 
+const char* to_string(ReflectorSelection which) {
+  switch (which) {
+    case ReflectorSelection::not_planar_mirrors: return "all but planar mirrors";
+    case ReflectorSelection::refractors: return "refractors";
+    default: return "all";
+  }
+}
+
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size,
-                                    const GBuffer* camera_view, bool skip_planar_mirrors) {
+                                    const GBuffer* camera_view, ReflectorSelection which) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   const TriangleMesh& m = scene.mesh;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
-    bool specular = false;
+    bool specular = false, refracts = false;
     float widest_lobe = 1e6f;  // smallest Phong exponent the map is read with
     Bounds b;
     for (std::uint32_t t = object.first_triangle; t < object.first_triangle + object.triangle_count;
@@ -63,12 +71,15 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
       const SurfaceParams s = surface_params(material);
       if (is_specular(s)) {
         specular = true;
+        refracts = refracts || s.is_refractor();
         widest_lobe = std::min(widest_lobe, map_lookup_exponent(material, s));
       }
       for (int k = 0; k < 3; ++k) b.grow(m.positions[m.indices[3 * t + k]]);
     }
     if (!specular || !b.valid()) continue;
-    if (skip_planar_mirrors && planar_mirror_plane(scene, static_cast<std::uint32_t>(o))) continue;
+    if (which == ReflectorSelection::not_planar_mirrors && planar_mirror_plane(scene, static_cast<std::uint32_t>(o)))
+      continue;
+    if (which == ReflectorSelection::refractors && !refracts) continue;
     glm::vec3 centre = b.center();
     const glm::vec3 e = b.extent();
     const float smallest = std::min({e.x, e.y, e.z}), largest = std::max({e.x, e.y, e.z});
@@ -101,7 +112,7 @@ ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const Shado
                                                 const EnvironmentMap& environment,
                                                 const GBuffer& gbuffer) const {
   ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
-                                             skip_planar_mirrors);
+                                             which);
   c.count("cube_maps", maps.cubes.size());
   return maps;
 }

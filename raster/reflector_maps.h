@@ -30,16 +30,20 @@ struct ReflectorMaps {
   }
 };
 
+enum class ReflectorSelection { all, not_planar_mirrors, refractors };
+const char* to_string(ReflectorSelection which);
+
 // Specular objects: at least one triangle's material reflects or refracts
 // (is_specular(surface_params(material))).
 // `camera_view` (may be null) is the camera's G-buffer, used for flat reflectors.
-// `skip_planar_mirrors`: planar mirrors (planar_mirror_plane) get no map, for a technique
-// that renders their reflections exactly by another pass.
+// `which` selects the reflectors that get a map: every specular object; all but the planar
+// mirrors (planar_mirror_plane), for a technique that renders those exactly by another pass;
+// or the refractors only, for a technique that traces reflections but not refraction.
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
                                     const GBuffer* camera_view = nullptr,
-                                    bool skip_planar_mirrors = false);
+                                    ReflectorSelection which = ReflectorSelection::all);
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {
@@ -48,10 +52,10 @@ struct ReflectorCubeMapsPass {
       "itself left out (SURVEY §3.1, §4.2).";
   const Scene* scene = nullptr;
   int size = 256;
-  bool skip_planar_mirrors = false;
+  ReflectorSelection which = ReflectorSelection::all;
   void parameters(par::Params& p) const {
     p.set("size", size);
-    if (skip_planar_mirrors) p.set("planar_mirrors", "skipped");
+    p.set("reflectors", to_string(which));
   }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows,
                            const EnvironmentMap& environment, const GBuffer& gbuffer) const;

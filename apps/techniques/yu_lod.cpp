@@ -5,6 +5,7 @@
 #include "apps/techniques/recipes.h"
 #include "raster/composite.h"
 #include "raster/envmap_reflect.h"
+#include "raster/reflector_maps.h"
 
 namespace speculum::pipeline {
 
@@ -39,8 +40,13 @@ FrameOutputs add_yu_lod_passes_cached(par::Graph& g, const Scene* scene, const F
   lod_options.alpha = f.alpha;
   auto hits = g.add("lod_trace", trace::LodTracePass{lod_options}, bvh, lod, rays);
   auto specular = g.add("hit_radiance", trace::HitRadiancePass{scene}, lod, lighting, rays, hits);
-  // YU traces reflections only; refractors fall back to the environment (never black).
-  auto refractors = g.add("refractor_environment", raster::RefractorEnvironmentPass{}, s.gbuffer, s.environment);
+  // YU traces reflections only; refractors fall back to cube maps of their own, which see the
+  // room around them (SURVEY §3.1), so glass is never black.
+  auto refractor_maps = g.add("refractor_cube_maps",
+                              raster::ReflectorCubeMapsPass{scene, f.cube_map_size, raster::ReflectorSelection::refractors},
+                              s.shadow_maps, s.environment, s.gbuffer);
+  auto refractors = g.add("refractor_environment", raster::RefractorEnvironmentPass{}, s.gbuffer, s.environment,
+                          refractor_maps);
   auto direct = g.add("direct_and_refractors", raster::CompositePass{}, s.direct, refractors);
   return add_output_passes(g, one, direct, specular);
 }
