@@ -47,6 +47,7 @@ struct BenchTraceOptions {
   bool json = false;
   bool no_embree = false;
   std::string kernel = "packet";
+  int image_width = 0;  // --image-width (0: detected, see camera_image_width)
 };
 
 double median(std::vector<double> v) {
@@ -153,10 +154,11 @@ Checksum checksum(const trace::HitStream& h) {
 struct EmbreeFigures {
   double build_ms = 0, mrays1 = 0, mrays16 = 0;
   double build_cpu_ms = 0, trace1_cpu_ms = 0;  // medians of process CPU time
-  Checksum sum;
+  Checksum sum, sum16;  // rtcIntersect1's and rtcIntersect16's hits
 };
 
-EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int repeat, par::Executor& ex) {
+EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int image_width, int repeat,
+                         par::Executor& ex) {
   EmbreeFigures fig;
   const std::string config = "threads=" + std::to_string(ex.threads());
   RTCDevice device = rtcNewDevice(config.c_str());
@@ -225,17 +227,35 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
     t1_cpu.push_back(cpu_ms() - c0);
   }
   fig.sum = checksum(hits);
+  // rtcIntersect16 is fed as Embree's own programs feed it: rays of a camera image (one per
+  // pixel, row-major, image_width wide) in 4x4 pixel blocks, whose rays share a node path;
+  // other ray sets in runs of 16 consecutive rays. slots[16 p + l]: the ray of lane l of
+  // packet p, or -1 for an idle lane.
+  std::vector<std::int64_t> slots;
+  if (image_width > 0) {
+    const std::size_t w = static_cast<std::size_t>(image_width), h = n / w;
+    for (std::size_t by = 0; by < h; by += 4)
+      for (std::size_t bx = 0; bx < w; bx += 4)
+        for (std::size_t dy = 0; dy < 4; ++dy)
+          for (std::size_t dx = 0; dx < 4; ++dx)
+            slots.push_back(by + dy < h && bx + dx < w ? static_cast<std::int64_t>((by + dy) * w + bx + dx) : -1);
+  } else {
+    for (std::size_t i = 0; i < (n + 15) / 16 * 16; ++i) slots.push_back(i < n ? static_cast<std::int64_t>(i) : -1);
+  }
+  const std::size_t packets = slots.size() / 16;
   for (int k = 0; k < repeat; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
-    ex.parallel_for("embree_intersect16", n, trace::kRayChunk, [&](std::size_t b, std::size_t e) {
+    ex.parallel_for("embree_intersect16", packets, trace::kRayChunk / 16, [&](std::size_t b, std::size_t e) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
-      for (std::size_t p = b; p < e; p += 16) {
+      if (image_width > 0) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      for (std::size_t p = b; p < e; ++p) {
         alignas(64) RTCRayHit16 rh;
         alignas(64) int valid[16];
         for (int l = 0; l < 16; ++l) {
-          const std::size_t i = std::min(p + l, e - 1);
-          valid[l] = p + l < e ? -1 : 0;
+          const std::int64_t slot = slots[16 * p + l];
+          const std::size_t i = slot >= 0 ? static_cast<std::size_t>(slot) : 0;
+          valid[l] = slot >= 0 ? -1 : 0;
           rh.ray.org_x[l] = rays.ox[i]; rh.ray.org_y[l] = rays.oy[i]; rh.ray.org_z[l] = rays.oz[i];
           rh.ray.dir_x[l] = rays.dx[i]; rh.ray.dir_y[l] = rays.dy[i]; rh.ray.dir_z[l] = rays.dz[i];
           rh.ray.tnear[l] = rays.tmin[i]; rh.ray.tfar[l] = active_tfar(i);
@@ -243,15 +263,18 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
           rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect16(valid, rs, &ctx, &rh);
-        for (int l = 0; l < 16 && p + l < e; ++l) {
+        for (int l = 0; l < 16; ++l) {
+          const std::int64_t slot = slots[16 * p + l];
+          if (slot < 0) continue;
           const bool hit = rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
-          hits.triangle[p + l] = hit ? rh.hit.primID[l] : trace::kNoHit;
-          hits.t[p + l] = hit ? rh.ray.tfar[l] : 0.0f;
+          hits.triangle[slot] = hit ? rh.hit.primID[l] : trace::kNoHit;
+          hits.t[slot] = hit ? rh.ray.tfar[l] : 0.0f;
         }
       }
     });
     t16.push_back(ms_since(t0));
   }
+  fig.sum16 = checksum(hits);
   fig.mrays1 = static_cast<double>(n) / (std::max(median(t1), 1e-6) * 1e3);
   fig.trace1_cpu_ms = median(t1_cpu);
   fig.mrays16 = static_cast<double>(n) / (std::max(median(t16), 1e-6) * 1e3);
@@ -260,6 +283,23 @@ EmbreeFigures run_embree(const Scene& scene, const trace::RayStream& rays, int r
   return fig;
 }
 #endif
+
+// The width of the camera image the rays are, one per pixel in row-major order, or 0 when
+// they are not: --image-width when given (its rows must divide the ray count), else
+// --width when the count is --width x --height and every ray leaves one point (a pinhole
+// camera's primary rays, as --emit-rays primary writes them).
+int camera_image_width(const BenchTraceOptions& o, const trace::RayStream& rays) {
+  const std::size_t n = rays.size();
+  if (o.image_width > 0) {
+    if (n % static_cast<std::size_t>(o.image_width) != 0)
+      throw InputError("--image-width", std::to_string(n) + " rays are not rows of " + std::to_string(o.image_width));
+    return o.image_width;
+  }
+  if (n == 0 || n != static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height)) return 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (rays.ox[i] != rays.ox[0] || rays.oy[i] != rays.oy[0] || rays.oz[i] != rays.oz[0]) return 0;
+  return o.width;
+}
 
 Camera bench_camera(const BenchTraceOptions& o, const Scene& scene) {
   const Bounds b = scene.bounds();
@@ -340,11 +380,15 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
               {"layouts_ms", rounded(st.layouts_ms, 1)}};
 #ifdef SPECULUM_HAVE_EMBREE
   if (!o.no_embree) {
-    const EmbreeFigures e = run_embree(scene, rays, repeat, ex);
+    const int image_width = camera_image_width(o, rays);
+    const EmbreeFigures e = run_embree(scene, rays, image_width, repeat, ex);
     j["embree"] = {{"version", std::to_string(RTC_VERSION_MAJOR) + "." + std::to_string(RTC_VERSION_MINOR) + "." +
                                    std::to_string(RTC_VERSION_PATCH)},
                    {"build_ms", rounded(e.build_ms, 3)}, {"mrays_per_s_intersect1", rounded(e.mrays1, 3)},
-                   {"mrays_per_s_intersect16", rounded(e.mrays16, 3)}, {"hits", e.sum.hits},
+                   {"mrays_per_s_intersect16", rounded(e.mrays16, 3)},
+                   {"intersect16_packets", image_width > 0 ? "4x4 pixels" : "16 consecutive rays"},
+                   {"intersect16_hits", e.sum16.hits}, {"intersect16_t_sum", rounded(e.sum16.t_sum, 6)},
+                   {"hits", e.sum.hits},
                    {"prim_sum", e.sum.prim_sum}, {"t_sum", rounded(e.sum.t_sum, 6)}};
     j["ratio_vs_intersect1"] = rounded(mrays / std::max(e.mrays1, 1e-9), 3);
     j["ratio_vs_intersect16"] = rounded(mrays / std::max(e.mrays16, 1e-9), 3);
@@ -383,6 +427,10 @@ void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global) {
   cmd->add_option("--fov", opt->fov, "Vertical field of view, degrees")->check(CLI::Range(0.01, 179.0))->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Seed of the secondary ray directions")->capture_default_str();
   cmd->add_flag("--no-embree", opt->no_embree, "Skip the Embree comparison");
+  cmd->add_option("--image-width", opt->image_width,
+                  "The rays are a camera image this wide (one per pixel, row-major): Embree's rtcIntersect16\n"
+                  "gets 4x4 pixel packets. Default: detected (--width x --height rays from one origin)")
+      ->check(CLI::Range(1, 65536));
   cmd->add_option("--kernel", opt->kernel,
                   "Our closest-hit kernel: packet (8-ray packets, single-ray fallback when incoherent) or single")
       ->capture_default_str();
