@@ -69,6 +69,28 @@ struct Traversal {
     return true;
   }
 
+  // A leaf's ray can hit triangle `t` only if it moves towards the triangle's plane from where
+  // it starts: a ray leaving a reflector is on the front side of its own triangle and of
+  // its neighbours and moves away from them, so these pairs are dropped before the exact
+  // test (ROGER §3.3 keeps them as candidates). The test is exact up to a tolerance that
+  // only keeps pairs: an origin within 1e-5 of the scene's scale of the plane is kept,
+  // whatever its side, so rounding can never drop a true hit (the exact watertight test
+  // decides those).
+  bool ray_can_reach_plane(std::size_t leaf, std::uint32_t t) const {
+    const std::size_t i = (leaf / std::size_t(h.side)) * std::size_t(h.width) + leaf % std::size_t(h.side);
+    const glm::vec3 o(rays.ox[i], rays.oy[i], rays.oz[i]), d(rays.dx[i], rays.dy[i], rays.dz[i]);
+    const std::uint32_t* tr = &indices[3 * std::size_t(t)];
+    const glm::vec3 a = positions[tr[0]];
+    const glm::vec3 normal = glm::cross(positions[tr[1]] - a, positions[tr[2]] - a);
+    const float side = glm::dot(normal, o - a), towards = glm::dot(normal, d);
+    const float scale = std::max({1.0f, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z), std::fabs(a.x),
+                                  std::fabs(a.y), std::fabs(a.z)});
+    const float tolerance = 1e-5f * scale * glm::length(normal);
+    if (side > tolerance) return towards < 0.0f;
+    if (side < -tolerance) return towards > 0.0f;
+    return true;
+  }
+
   // Level l -> l+1 of the descent: one kernel tests each (node, triangle) pair's sphere
   // against the node's 4 children, then the surviving (child, triangle) pairs replace
   // node/tri, compacted in order.
@@ -79,6 +101,7 @@ struct Traversal {
     const auto& sn = h.sin_alpha[l + 1];
     const auto& cs = h.cos_alpha[l + 1];
     keep.resize(4 * m);
+    const bool leaves = l + 1 == h.levels;
     auto t_test = std::chrono::steady_clock::now();
     ex.parallel_for("hierarchy_level_" + std::to_string(l), m, kPairChunk, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
@@ -86,7 +109,8 @@ struct Traversal {
         const BoundingSphere& s = spheres[tri[k]];
         for (int j = 0; j < 4; ++j) {
           const std::size_t c = (2 * y + std::size_t(j >> 1)) * row + 2 * x + std::size_t(j & 1);
-          keep[4 * k + j] = !child[c].empty() && cone_sphere_intersects(child[c], sn[c], cs[c], s);
+          keep[4 * k + j] = !child[c].empty() && cone_sphere_intersects(child[c], sn[c], cs[c], s) &&
+                            (!leaves || ray_can_reach_plane(c, tri[k]));
         }
       }
     });

@@ -206,6 +206,34 @@ TEST(RayHierarchy, RandomRaysEqualOracleWithLog2LevelPasses) {
   EXPECT_EQ(r.stats.candidates, r.stats.pairs_per_level[5]);
 }
 
+// A ray that starts in front of a triangle's plane and moves away from it (a reflected ray
+// leaving its own triangle) is no candidate of that triangle; one that moves towards it is,
+// and hits it. The quad below every ray: rays up leave it, rays down hit it (the oracle).
+TEST(RayHierarchy, RaysLeavingATrianglesPlaneAreNoCandidatesOfIt) {
+  testing::Soup soup;
+  soup.add({-2, 0, -2}, {2, 0, -2}, {2, 0, 2});
+  soup.add({-2, 0, -2}, {2, 0, 2}, {-2, 0, 2});
+  const int w = 8, h = 8;
+  for (const float up : {1.0f, -1.0f}) {
+    SCOPED_TRACE(up);
+    RayStream rays;
+    rays.resize(std::size_t(w) * h);
+    std::vector<std::uint8_t> active(rays.size(), 1);
+    for (std::uint32_t i = 0; i < rays.size(); ++i) {
+      Ray r;
+      r.origin = {rnd(i, 0, 5) * 2.0f - 1.0f, 1e-3f, rnd(i, 1, 5) * 2.0f - 1.0f};
+      r.direction = glm::normalize(glm::vec3(rnd(i, 2, 5) - 0.5f, up, rnd(i, 3, 5) - 0.5f));
+      r.tmin = 0.0f;
+      r.tmax = 1e30f;
+      rays.set(i, r);
+    }
+    const TraceResult r = trace(2, soup, rays, active, w, h, 0);
+    expect_oracle(soup, rays, active, r.hits);
+    if (up > 0.0f) EXPECT_EQ(r.stats.candidates, 0u);
+    else EXPECT_EQ(r.stats.hits, rays.size());
+  }
+}
+
 TEST(RayHierarchy, ReversedShadowRaysShareOneOriginAndEqualOracle) {
   const testing::Soup soup = testing::random_soup(300, 41, 0.25f);
   std::vector<std::uint8_t> active;
