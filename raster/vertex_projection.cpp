@@ -14,6 +14,7 @@
 #include "core/shading.h"
 #include "raster/cube_map.h"
 #include "raster/direct_light.h"
+#include "raster/specular_radiance.h"
 #include "raster/triangle_setup.h"
 #include "raster/visibility.h"
 
@@ -322,14 +323,25 @@ ReflectedLayer rasterize_reflected(par::Executor& executor, const ReflectedGeome
 }
 
 ImageRGBA shade_reflected(par::Executor& executor, const Scene& scene, const ReflectedGeometry& geometry,
-                          const ReflectedLayer& layer, const GBuffer& g, const ShadowMaps& shadows,
-                          const EnvironmentMap& env, const ImageRGBA& fallback) {
+                          const ReflectedLayer& layer, const ReflectorParams& params, const GBuffer& g,
+                          const ShadowMaps& shadows, const EnvironmentMap& env, const ImageRGBA& fallback) {
   ImageRGBA out = fallback;
   const TriangleMesh& m = geometry.mesh;
+  std::vector<std::uint8_t> projected;  // by object id: has a parameterization
+  for (const ReflectorParam& p : params.reflectors) {
+    if (projected.size() <= p.object) projected.resize(p.object + 1, 0);
+    projected[p.object] = 1;
+  }
   executor.parallel_for("vertex_projection_shade.shade", out.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const std::uint32_t t = layer.triangle.pixels[i];
-      if (t == kNoId) continue;
+      if (t == kNoId) {
+        const std::uint32_t o = g.object.pixels[i];
+        if (o == kNoId || o >= projected.size() || !projected[o] || !vertex_projection_sample(g, i)) continue;
+        const auto sky = [&](const glm::vec3& d, float exponent) { return env.radiance(d, exponent); };
+        out.pixels[i] = glm::vec4(specular_radiance(g.surface.pixels[i], g.normal.pixels[i], g.view_direction(i), sky), 1.0f);
+        continue;
+      }
       const std::uint32_t* idx = &m.indices[3 * std::size_t(t)];
       const glm::vec2 bc = layer.bary.pixels[i];
       const float b0 = 1.0f - bc.x - bc.y;
@@ -407,14 +419,15 @@ ReflectedLayer ReflectedTrianglesPass::operator()(par::NodeContext& c, const Ref
 }
 
 ImageRGBA VertexProjectionShadePass::operator()(par::NodeContext& c, const ReflectedLayer& layer,
-                                                const ReflectedGeometry& geometry, const GBuffer& gbuffer,
+                                                const ReflectedGeometry& geometry, const ReflectorParams& params,
+                                                const GBuffer& gbuffer,
                                                 const ShadowMaps& shadows, const EnvironmentMap& environment,
                                                 const ImageRGBA& fallback) const {
   std::uint64_t fallback_samples = 0;
   for (std::size_t i = 0; i < layer.triangle.size(); ++i)
     fallback_samples += layer.triangle.pixels[i] == kNoId && vertex_projection_sample(gbuffer, i);
-  c.count("fallback_samples", double(fallback_samples));
-  return shade_reflected(c.executor(), *scene, geometry, layer, gbuffer, shadows, environment, fallback);
+  c.count("environment_samples", double(fallback_samples));
+  return shade_reflected(c.executor(), *scene, geometry, layer, params, gbuffer, shadows, environment, fallback);
 }
 
 }  // namespace speculum::raster

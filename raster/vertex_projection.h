@@ -108,10 +108,13 @@ ReflectedLayer rasterize_reflected(par::Executor& executor, const ReflectedGeome
                                    const GBuffer& gbuffer, ReflectedTriangleStats* stats = nullptr);
 
 // The specular layer: mirror samples covered by a reflected triangle get
-// F(n·v at P) × shade_surface(V, towards P); every other sample keeps `fallback`.
+// F(n·v at P) × shade_surface(V, towards P); mirror samples of a projected reflector that no
+// reflected triangle covers see past the scene, so they get F × the distant environment
+// (`env`: not a cube map of the scene, whose geometry the projection already placed); every
+// other sample keeps `fallback`.
 ImageRGBA shade_reflected(par::Executor& executor, const Scene& scene, const ReflectedGeometry& geometry,
-                          const ReflectedLayer& layer, const GBuffer& gbuffer, const ShadowMaps& shadows,
-                          const EnvironmentMap& env, const ImageRGBA& fallback);
+                          const ReflectedLayer& layer, const ReflectorParams& params, const GBuffer& gbuffer,
+                          const ShadowMaps& shadows, const EnvironmentMap& env, const ImageRGBA& fallback);
 
 // Pass "tessellate".
 struct TessellatePass {
@@ -169,11 +172,11 @@ struct ReflectedTrianglesPass {
 struct VertexProjectionShadePass {
   static constexpr const char* description =
       "Shades each reflected sample as the scene at V lit directly and seen from P, times "
-      "the reflector's Fresnel at P (ROGER §2.2.3); other specular samples keep the "
-      "environment-map layer.";
+      "the reflector's Fresnel at P (ROGER §2.2.3); uncovered reflector samples see the distant "
+      "environment; other specular samples keep the environment-map layer.";
   const Scene* scene = nullptr;
   ImageRGBA operator()(par::NodeContext& c, const ReflectedLayer& layer, const ReflectedGeometry& geometry,
-                       const GBuffer& gbuffer, const ShadowMaps& shadows, const EnvironmentMap& environment,
+                       const ReflectorParams& params, const GBuffer& gbuffer, const ShadowMaps& shadows, const EnvironmentMap& environment,
                        const ImageRGBA& fallback) const;
 };
 

@@ -12,8 +12,8 @@ using namespace speculum::raster;
 
 FrameOutputs add_vertex_projection_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   const SurfaceResources s = add_surface_passes(g, scene, f);
-  // Samples the projection does not cover (glossy reflectors, reflectors that are not
-  // star-shaped, nothing reflected there) keep the environment-map layer.
+  // Specular samples the projection does not handle (glossy reflectors, reflectors that are
+  // not star-shaped) keep the environment-map layer.
   auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size},
                     s.shadow_maps, s.environment, s.gbuffer);
   auto fallback = g.add("envmap_reflect", EnvmapReflectPass{}, s.gbuffer, s.environment, maps);
@@ -25,7 +25,7 @@ FrameOutputs add_vertex_projection_passes(par::Graph& g, const Scene* scene, con
   fermat.residual = f.param("residual");
   auto projected = g.add("vertex_project", VertexProjectPass{f.camera, fermat}, geometry, param, s.gbuffer);
   auto layer = g.add("reflected_triangles", ReflectedTrianglesPass{}, geometry, projected, param, s.gbuffer);
-  auto specular = g.add("vertex_projection_shade", VertexProjectionShadePass{scene}, layer, geometry, s.gbuffer,
+  auto specular = g.add("vertex_projection_shade", VertexProjectionShadePass{scene}, layer, geometry, param, s.gbuffer,
                         s.shadow_maps, s.environment, fallback);
   return add_output_passes(g, f, s.direct, specular);
 }
