@@ -165,6 +165,9 @@ ReflectorParams build_reflector_params(par::Executor& executor, const Scene& sce
         }
       });
     }
+    for (const ImageF& face : p.radius)
+      for (float r : face.pixels)
+        if (std::isfinite(r)) p.max_radius = std::max(p.max_radius, double(r));
     out.reflectors.push_back(std::move(p));
   }
   return out;
@@ -247,6 +250,28 @@ ProjectedVertices project_vertices(par::Executor& executor, const ReflectedGeome
 
 namespace {
 
+// Whether the ray p + t d (t > 0) meets the reflector again: marched in 64 steps over twice
+// the largest radius, a hit where the point falls outside r(u) along a direction the
+// reflector covers.
+bool hits_itself(const ReflectorParam& param, const glm::dvec3& p, const glm::dvec3& d, glm::dvec3& hit,
+                 glm::dvec3& normal) {
+  const double reach = 2.0 * param.max_radius + glm::length(p - param.centre);
+  constexpr int kSteps = 64;
+  for (int k = 1; k <= kSteps; ++k) {
+    const glm::dvec3 x = p + (reach * k / kSteps) * d;
+    const glm::dvec3 q = x - param.centre;
+    const double l = glm::length(q);
+    if (!(l > 0.0)) continue;
+    const ReflectorSample s = param(q / l);
+    if (s.valid && l >= glm::length(s.point - param.centre)) {
+      hit = s.point;
+      normal = s.normal;
+      return true;
+    }
+  }
+  return false;
+}
+
 bool vertex_projection_sample(const GBuffer& g, std::size_t i) {
   const SurfaceParams& s = g.surface.pixels[i];
   return g.covered(i) && !s.is_refractor() && s.is_mirror_lobe();
@@ -327,18 +352,27 @@ ImageRGBA shade_reflected(par::Executor& executor, const Scene& scene, const Ref
                           const ShadowMaps& shadows, const EnvironmentMap& env, const ImageRGBA& fallback) {
   ImageRGBA out = fallback;
   const TriangleMesh& m = geometry.mesh;
-  std::vector<std::uint8_t> projected;  // by object id: has a parameterization
-  for (const ReflectorParam& p : params.reflectors) {
-    if (projected.size() <= p.object) projected.resize(p.object + 1, 0);
-    projected[p.object] = 1;
+  std::vector<int> projected;  // by object id: its parameterization's index, −1: none
+  for (std::size_t k = 0; k < params.reflectors.size(); ++k) {
+    const std::uint32_t o = params.reflectors[k].object;
+    if (projected.size() <= o) projected.resize(o + 1, -1);
+    projected[o] = int(k);
   }
   executor.parallel_for("vertex_projection_shade.shade", out.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const std::uint32_t t = layer.triangle.pixels[i];
       if (t == kNoId) {
         const std::uint32_t o = g.object.pixels[i];
-        if (o == kNoId || o >= projected.size() || !projected[o] || !vertex_projection_sample(g, i)) continue;
-        const auto sky = [&](const glm::vec3& d, float exponent) { return env.radiance(d, exponent); };
+        if (o == kNoId || o >= projected.size() || projected[o] < 0 || !vertex_projection_sample(g, i)) continue;
+        const ReflectorParam& param = params.reflectors[std::size_t(projected[o])];
+        const auto sky = [&](const glm::vec3& d, float exponent) {
+          // A concave reflector (O on its mirror side) may see itself: the secondary
+          // reflection ROGER §2.3.3 leaves empty, shaded here as the reflector lit directly.
+          glm::dvec3 hit, normal;
+          if (param.orientation < 0 && hits_itself(param, glm::dvec3(g.position.pixels[i]), glm::dvec3(d), hit, normal))
+            return shade_surface(scene, g.surface.pixels[i], glm::vec3(hit), glm::vec3(normal), -d, shadows, env);
+          return env.radiance(d, exponent);
+        };
         out.pixels[i] = glm::vec4(specular_radiance(g.surface.pixels[i], g.normal.pixels[i], g.view_direction(i), sky), 1.0f);
         continue;
       }

@@ -48,6 +48,7 @@ struct ReflectorParam {
   glm::dvec3 centre{0.0};
   int orientation = 1;  // +1: O behind the surface (convex side out); −1: O on the mirror side
   int size = 0;
+  double max_radius = 0.0;  // the largest finite r
   std::array<ImageF, 6> radius;
   std::array<Buffer2D<glm::vec3>, 6> normal;
   ReflectorSample operator()(const glm::dvec3& u) const;
