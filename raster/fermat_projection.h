@@ -15,6 +15,9 @@
 // β = ((a·b)(a·c) − a²(b·c))/δ; D = αA + βB + (1−α−β)C normalized back onto the direction
 // sphere (so P(D) is on the reflector) replaces the sample with the largest |g|. δ ≈ 0
 // backtracks: the last discarded sample replaces the worst sample other than the newest.
+// Safeguards (ours): a step is at most max_step radians; a D no better than the sample it
+// would replace is pulled towards the best sample, and if that fails the triangle contracts
+// towards the best sample instead.
 // Start: A = radial direction of V, B = of E, C completing an equilateral triangle off the
 // plane OEV. Stop (ROGER appendix A.2.2, tightened): the longest edge of the projected
 // triangle P(A)P(B)P(C) is under `pixel_tolerance` pixels AND the smallest |g| is under
@@ -55,6 +58,10 @@ struct FermatSettings {
   double pixel_tolerance = 1.0;  // longest projected edge of ABC, pixels
   double residual = 1e-3;        // |g| at the best sample (dimensionless: g is a sum of unit vectors)
   double max_step = 0.5;         // radians a secant step may move from the best sample
+  // Longest side of the starting triangle (radians): B is pulled towards A when farther. A
+  // concave reflector seen from its mirror side has several stationary points per vertex;
+  // a small triangle at V's radial projection finds the one nearest V (the near zone's).
+  double max_start_side = 4.0;
 };
 
 struct FermatResult {
@@ -65,6 +72,7 @@ struct FermatResult {
   glm::dvec3 direction{0.0};
   int iterations = 0;      // secant steps (new samples D)
   int backtracks = 0;
+  int contractions = 0;    // steps that shrank the triangle instead of adding D
   double residual = 0.0;   // |g| at P
 };
 
@@ -133,6 +141,11 @@ FermatResult fermat_project(const Reflector& reflector, const glm::dvec3& centre
   if (side < 1e-3) {
     side = 1e-2;
     ub = glm::normalize(ua + side * glm::cross(axis, ua));
+  }
+  if (side > settings.max_start_side) {
+    const double keep = 2.0 * std::asin(std::min(1.0, settings.max_start_side / 2.0));  // chord → angle
+    ub = std::cos(keep) * ua + std::sin(keep) * glm::normalize(glm::cross(axis, ua));
+    side = glm::length(ua - ub);
   }
   side = std::min(side, 1.0);
   const glm::dvec3 mid = 0.5 * (ua + ub);
@@ -213,6 +226,23 @@ FermatResult fermat_project(const Reflector& reflector, const glm::dvec3& centre
       if (!half.valid) break;
       sd = half;
     }
+    if (sd.gn >= s[worst].gn) {
+      // Still no better: g is far from linear over the triangle (a vertex almost touching
+      // the reflector). Contract the other samples halfway towards the best one, so the
+      // linear model is asked again over a smaller triangle.
+      ++out.contractions;
+      for (int k = 0; k < 3; ++k) {
+        if (k == best) continue;
+        const Sample half = eval(glm::normalize(s[k].u + s[best].u));
+        if (half.valid) s[k] = half;
+      }
+      discarded = Sample{};
+      newest = -1;
+      continue;
+    }
+#ifdef FERMAT_TRACE
+    std::printf("it %d: |g| %.3g %.3g %.3g D |g| %.3g a %.3g b %.3g delta %.3g u %.3f %.3f %.3f\n", out.iterations, s[0].gn, s[1].gn, s[2].gn, sd.gn, alpha, beta, delta, sd.u.x, sd.u.y, sd.u.z);
+#endif
     discarded = s[worst];
     s[worst] = sd;
     newest = worst;

@@ -198,11 +198,13 @@ ProjectedVertices project_vertices(par::Executor& executor, const ReflectedGeome
   out.iterations.assign(reflectors, std::vector<std::uint8_t>(n, 0));
   for (std::size_t r = 0; r < reflectors; ++r) {
     const ReflectorParam& param = params.reflectors[r];
+    FermatSettings own = settings;
+    if (param.orientation < 0) own.max_start_side = std::min(own.max_start_side, 0.1);
     executor.parallel_for("vertex_project.secant", n, 256, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
         if (vertex_object[v] == param.object || vertex_object[v] == kNoId) continue;
         const glm::dvec3 vertex(m.positions[v]);
-        const FermatResult f = fermat_project(param, param.centre, eye, vertex, project, settings);
+        const FermatResult f = fermat_project(param, param.centre, eye, vertex, project, own);
         ProjectionStatus status = f.status;
         glm::vec4 clip(0.0f, 0.0f, 0.0f, 1.0f);
         if (status == ProjectionStatus::Converged) {

@@ -76,12 +76,23 @@ glm::dvec3 normal_focus(const HalfedgeMesh& m) {
 }
 
 StarShape choose_star_centre(const HalfedgeMesh& m) {
-  StarShape s = star_shape_about(m, area_centroid(m));
+  const glm::dvec3 centroid = area_centroid(m);
+  Bounds b;
+  for (const auto vh : m.vertices()) b.grow(glm::vec3(to_glm(m.point(vh))));
+  const double diagonal = glm::length(glm::dvec3(b.extent()));
+  // The normal focus first: from the centre of a sphere or bowl every ray meets the surface
+  // head-on (r constant, ∇ln r = 0), where from the centroid of a bowl the rim is grazing.
+  // Not when it lies farther than the mesh's size (a nearly flat mirror): seen from there the
+  // surface spans a narrow cone of directions.
+  const glm::dvec3 focus = normal_focus(m);
+  if (glm::length(focus - centroid) <= diagonal) {
+    StarShape f = star_shape_about(m, focus);
+    f.centre_rule = "normal focus";
+    if (f.star_shaped) return f;
+  }
+  StarShape s = star_shape_about(m, centroid);
   s.centre_rule = "area centroid";
-  if (s.star_shaped) return s;
-  StarShape f = star_shape_about(m, normal_focus(m));
-  f.centre_rule = "normal focus";
-  return f.star_shaped ? f : s;
+  return s;
 }
 
 }  // namespace speculum::mesh

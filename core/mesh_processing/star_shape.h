@@ -34,8 +34,9 @@ glm::dvec3 area_centroid(const HalfedgeMesh& m);
 // sphere or of a spherical bowl exactly, the centre of an ellipsoid by symmetry.
 glm::dvec3 normal_focus(const HalfedgeMesh& m);
 
-// Tries the area centroid, then the normal focus, and returns the first about which the mesh
-// is star-shaped (or the area centroid's result, failing, if neither is).
+// Tries the normal focus (when it lies within the mesh's bounding-box diagonal of the area
+// centroid), then the area centroid, and returns the first about which the mesh is
+// star-shaped (or the area centroid's result, failing, if neither is).
 StarShape choose_star_centre(const HalfedgeMesh& m);
 
 }  // namespace speculum::mesh

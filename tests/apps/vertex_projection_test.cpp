@@ -100,12 +100,13 @@ TEST(VertexProjection, AgreesWithTheExactSpecularReference) {
   };
   auto spec = [&](const std::string& id) { return cell(id)["specular"]["mae8"].get<double>(); };
   // Measured: ellipsoid 1.01, sphere-in-room 5.74 (its glossy ball is envmap in both, against
-  // a 16-sample glossy reference), bowl 27.6; envmap 38.9, 30.8 and 58.1.
+  // a 16-sample glossy reference), bowl 5.3; envmap 38.9, 30.8 and 58.1.
   EXPECT_LT(spec("vertex-projection@ellipsoid"), 1.5);
   EXPECT_LT(spec("vertex-projection@sphere-in-room"), 6.5);
   EXPECT_LT(spec("vertex-projection@ellipsoid") * 20.0, spec("envmap@ellipsoid"));
   EXPECT_LT(spec("vertex-projection@sphere-in-room") * 4.0, spec("envmap@sphere-in-room"));
-  EXPECT_LT(spec("vertex-projection@bowl") * 1.5, spec("envmap@bowl"));
+  EXPECT_LT(spec("vertex-projection@bowl"), 7.0);
+  EXPECT_LT(spec("vertex-projection@bowl") * 5.0, spec("envmap@bowl"));
 
   // Iterations over a whole scene (ROGER §2.3.2): nearly every vertex converges, most in 5–8
   // steps, almost none needs more than 20.
@@ -119,14 +120,14 @@ TEST(VertexProjection, AgreesWithTheExactSpecularReference) {
   EXPECT_LT(counter(room, "vertex_project/middle_zone_vertices"), 0.01 * converged);
   EXPECT_LT(counter(room, "vertex_projection_shade/environment_samples"), 50.0);
 
-  // The bowl: the ball in the near zone reflects upright (minima), what lies beyond the
-  // centre upside down (maxima); triangles across the middle zone are counted, not drawn.
+  // The bowl: the ball lies in the near zone and reflects upright (minima of the path);
+  // stationary points of the middle zone (saddles) are counted and their triangles dropped.
+  // (The far zone's maxima: FermatProjection.ConcaveBowlZones.)
   const nlohmann::json bowl = cell("vertex-projection@bowl");
   EXPECT_GT(counter(bowl, "vertex_project/minima"), 100.0);
-  EXPECT_GT(counter(bowl, "vertex_project/maxima"), 100.0);
   EXPECT_GT(counter(bowl, "vertex_project/middle_zone_vertices"), 0.0);
   EXPECT_GT(counter(bowl, "reflected_triangles/triangles_middle_zone"), 0.0);
-  EXPECT_GT(counter(bowl, "reflected_triangles/reflected_samples"), 100.0);
+  EXPECT_GT(counter(bowl, "reflected_triangles/reflected_samples"), 300.0);
 }
 
 }  // namespace

@@ -201,6 +201,15 @@ TEST(FermatProjection, ConcaveBowlZones) {
   const FermatResult far = fermat_project(bowl, o, eye, glm::dvec3(-0.2, 1.9, 0.3), fine, tight());
   EXPECT_EQ(far.status, ProjectionStatus::Converged);
   EXPECT_EQ(far.extremum, PathExtremum::Maximum);
+  // The small starting triangle the renderer uses on concave reflectors finds the same points.
+  FermatSettings small = tight();
+  small.max_start_side = 0.1;
+  const FermatResult near_small = fermat_project(bowl, o, eye, glm::dvec3(0.3, -1.7, 0.1), fine, small);
+  EXPECT_EQ(near_small.extremum, PathExtremum::Minimum);
+  EXPECT_LT(glm::length(near_small.point - near.point), 1e-6);
+  const FermatResult far_small = fermat_project(bowl, o, eye, glm::dvec3(-0.2, 1.9, 0.3), fine, small);
+  EXPECT_EQ(far_small.extremum, PathExtremum::Maximum);
+  EXPECT_LT(glm::length(far_small.point - far.point), 1e-6);
 }
 
 }  // namespace
