@@ -253,23 +253,28 @@ ProjectedVertices project_vertices(par::Executor& executor, const ReflectedGeome
 namespace {
 
 // Whether the ray p + t d (t > 0) meets the reflector again: marched in 64 steps over twice
-// the largest radius, a hit where the point falls outside r(u) along a direction the
-// reflector covers.
+// the largest radius plus |p − O|.
 bool hits_itself(const ReflectorParam& param, const glm::dvec3& p, const glm::dvec3& d, glm::dvec3& hit,
                  glm::dvec3& normal) {
   const double reach = 2.0 * param.max_radius + glm::length(p - param.centre);
   constexpr int kSteps = 64;
+  // A hit is a crossing from inside r(u) to outside it: a ray leaving the mirror's outer
+  // (convex) side starts outside and meets nothing.
+  bool inside = false;
   for (int k = 1; k <= kSteps; ++k) {
     const glm::dvec3 x = p + (reach * k / kSteps) * d;
     const glm::dvec3 q = x - param.centre;
     const double l = glm::length(q);
     if (!(l > 0.0)) continue;
     const ReflectorSample s = param(q / l);
-    if (s.valid && l >= glm::length(s.point - param.centre)) {
+    if (!s.valid) continue;
+    const bool now_inside = l < glm::length(s.point - param.centre);
+    if (inside && !now_inside) {
       hit = s.point;
       normal = s.normal;
       return true;
     }
+    inside = now_inside;
   }
   return false;
 }
