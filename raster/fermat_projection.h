@@ -56,12 +56,22 @@ enum class PathExtremum : std::uint8_t { Minimum, Maximum, Saddle };
 struct FermatSettings {
   int max_iterations = 32;
   double pixel_tolerance = 1.0;  // longest projected edge of ABC, pixels
-  double residual = 1e-3;        // |g| at the best sample (dimensionless: g is a sum of unit vectors)
+  // |g| at the best sample (dimensionless: g is a sum of unit vectors). A bilinearly looked
+  // up parameterization leaves |g| ≈ 1e-3 at the true point, so the bound sits above that.
+  double residual = 3e-3;
   double max_step = 0.5;         // radians a secant step may move from the best sample
   // Longest side of the starting triangle (radians): B is pulled towards A when farther. A
   // concave reflector seen from its mirror side has several stationary points per vertex;
   // a small triangle at V's radial projection finds the one nearest V (the near zone's).
   double max_start_side = 4.0;
+  // Classify the stationary point by its Hessian (two more lookups). Off for a reflector
+  // known to be convex, whose every reflection is a minimum: a bilinear lookup's kinks
+  // would otherwise read a few points as saddles.
+  bool classify = true;
+  // A closed reflector is seen from outside only: E and V must both lie outside the tangent
+  // plane at P (on the side away from the centre O). An open one (a bowl, a shell) reflects
+  // on both sides: E and V on one side of it.
+  bool closed = false;
 };
 
 struct FermatResult {
@@ -251,9 +261,15 @@ FermatResult fermat_project(const Reflector& reflector, const glm::dvec3& centre
   // Both E and V must see P from the reflector's side: otherwise the stationary path passes
   // through the reflector (V behind it, or P beyond the silhouette seen from E).
   const double se = glm::dot(eye - out.point, out.normal), sv = glm::dot(vertex - out.point, out.normal);
-  if (!(se * sv > 0.0)) out.status = ProjectionStatus::Hidden;
+  const double outward = glm::dot(out.point - centre, out.normal) >= 0.0 ? 1.0 : -1.0;
+  if (settings.closed ? !(se * outward > 0.0 && sv * outward > 0.0) : !(se * sv > 0.0))
+    out.status = ProjectionStatus::Hidden;
   // The stationary point's kind from the Hessian of ℓ/r in a tangent basis at u, by forward
   // differences of g (two more samples).
+  if (!settings.classify) {
+    out.extremum = PathExtremum::Minimum;
+    return out;
+  }
   const glm::dvec3 t1 = fermat_detail::any_perpendicular(out.direction);
   const glm::dvec3 t2 = glm::cross(out.direction, t1);
   constexpr double h = 1e-4;

@@ -9,6 +9,7 @@
 
 #include "core/camera_rays.h"
 #include "core/mesh_processing/halfedge_mesh.h"
+#include "core/mesh_processing/mean_curvature.h"
 #include "core/mesh_processing/star_shape.h"
 #include "core/mesh_processing/subdivision.h"
 #include "core/shading.h"
@@ -137,6 +138,12 @@ ReflectorParams build_reflector_params(par::Executor& executor, const Scene& sce
     p.centre = star.centre;
     p.orientation = star.orientation;
     p.size = size;
+    p.closed = std::none_of(om.mesh.vertices_begin(), om.mesh.vertices_end(),
+                            [&](auto vh) { return om.mesh.is_boundary(vh); });
+    if (p.orientation > 0) {
+      const std::vector<double> h = mesh::mean_curvature(om.mesh);
+      p.convex = std::all_of(h.begin(), h.end(), [](double v) { return v > 0.0; });
+    }
     RasterOptions options;
     options.excluded_objects.assign(scene.objects.size(), 1);
     options.excluded_objects[o] = 0;
@@ -200,6 +207,8 @@ ProjectedVertices project_vertices(par::Executor& executor, const ReflectedGeome
     const ReflectorParam& param = params.reflectors[r];
     FermatSettings own = settings;
     if (param.orientation < 0) own.max_start_side = std::min(own.max_start_side, 0.1);
+    if (param.convex) own.classify = false;
+    own.closed = param.closed;
     executor.parallel_for("vertex_project.secant", n, 256, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
         if (vertex_object[v] == param.object || vertex_object[v] == kNoId) continue;

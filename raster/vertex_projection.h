@@ -47,6 +47,10 @@ struct ReflectorParam {
   std::uint32_t object = kNoId;
   glm::dvec3 centre{0.0};
   int orientation = 1;  // +1: O behind the surface (convex side out); −1: O on the mirror side
+  // Mean curvature (core/mesh_processing) positive at every vertex with normals facing away
+  // from O: a convex mirror, where every reflection is a path-length minimum.
+  bool convex = false;
+  bool closed = false;  // no boundary edges: seen from outside only
   int size = 0;
   double max_radius = 0.0;  // the largest finite r
   std::array<ImageF, 6> radius;

@@ -102,7 +102,7 @@ const std::vector<Technique>& techniques() {
         {"param_size", 256, 8, 2048, true, "reflector parameterization cube face side (2048: 6 × 4M texels, ~400 MB)"},
         {"max_iterations", 32, 1, 32, true, "secant iterations per vertex and reflector (ROGER: ≤ 20 at silhouettes)"},
         {"pixel_tolerance", 1, 0.01, 16, false, "stop when the sample triangle's longest projected edge is under this (pixels)"},
-        {"residual", 1e-3, 1e-9, 1, false, "and the path-length gradient |g| at the best sample is under this"}}},
+        {"residual", 3e-3, 1e-9, 1, false, "and the path-length gradient |g| at the best sample is under this"}}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",
