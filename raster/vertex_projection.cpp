@@ -312,8 +312,11 @@ ReflectedLayer rasterize_reflected(par::Executor& executor, const ReflectedGeome
     bool seen = false;
     for (std::size_t i = 0; i < gbuffer.object.size() && !seen; ++i) seen = gbuffer.object.pixels[i] == param.object;
     if (!seen) continue;
-    // The triangles whose three vertices have a visible reflection of one kind: all minima
-    // (a convex reflector, a bowl's near zone) or all maxima (a bowl's far zone).
+    // The triangles whose three vertices have a visible reflection. On a reflector seen from
+    // its centre's side (a bowl) they must also be of one kind — all minima (the near zone)
+    // or all maxima (the far zone), §2.3.3; a closed reflector's saddles are ordinary
+    // reflections in its saddle-shaped parts.
+    const bool zoned = param.orientation < 0;
     std::vector<std::uint32_t> indices, original;
     for (std::size_t t = 0; t < m.triangle_count(); ++t) {
       if (m.triangle_object[t] == param.object) continue;
@@ -324,8 +327,8 @@ ReflectedLayer rasterize_reflected(par::Executor& executor, const ReflectedGeome
         const auto s = static_cast<ProjectionStatus>(projected.status[r][idx[k]]);
         if (s == ProjectionStatus::Hidden) hidden = true;
         else if (s != ProjectionStatus::Converged) unprojected = true;
-        else if (projected.extremum[r][idx[k]] != e0 ||
-                 projected.extremum[r][idx[k]] == static_cast<std::uint8_t>(PathExtremum::Saddle))
+        else if (zoned && (projected.extremum[r][idx[k]] != e0 ||
+                           projected.extremum[r][idx[k]] == static_cast<std::uint8_t>(PathExtremum::Saddle)))
           middle = true;
       }
       if (unprojected) ++local.unprojected;
