@@ -131,35 +131,4 @@ ObjectMesh build_object_mesh(const Scene& scene, std::uint32_t object, Weld weld
   return out;
 }
 
-void append_object(const HalfedgeMesh& m, const std::string& name, std::uint32_t material, Scene& out) {
-  TriangleMesh& soup = out.mesh;
-  const auto base = static_cast<std::uint32_t>(soup.positions.size());
-  const bool has_uv1 = !soup.uvs1.empty();
-  const bool has_tangents = !soup.tangents.empty();
-  for (const auto vh : m.vertices()) {
-    const auto p = m.point(vh);
-    auto n = m.normal(vh);
-    const double l = n.norm();
-    n = l > 0.0 ? n / l : OpenMesh::Vec3d(0, 0, 1);
-    const auto uv = m.texcoord2D(vh);
-    soup.positions.emplace_back(p[0], p[1], p[2]);
-    soup.normals.push_back(glm::normalize(glm::vec3(n[0], n[1], n[2])));
-    soup.uvs.emplace_back(uv[0], uv[1]);
-    if (has_uv1) soup.uvs1.emplace_back(0.0f);
-    if (has_tangents) soup.tangents.emplace_back(1.0f, 0.0f, 0.0f, 1.0f);
-  }
-  Object o;
-  o.name = name;
-  o.material = material;
-  o.first_triangle = static_cast<std::uint32_t>(soup.triangle_count());
-  const auto object = static_cast<std::uint32_t>(out.objects.size());
-  for (const auto fh : m.faces()) {
-    for (const auto vh : m.fv_range(fh)) soup.indices.push_back(base + static_cast<std::uint32_t>(vh.idx()));
-    soup.triangle_material.push_back(material);
-    soup.triangle_object.push_back(object);
-  }
-  o.triangle_count = static_cast<std::uint32_t>(soup.triangle_count()) - o.first_triangle;
-  out.objects.push_back(o);
-}
-
 }  // namespace speculum::mesh

@@ -62,10 +62,6 @@ struct ObjectMesh {
 ObjectMesh build_object_mesh(const Scene& scene, std::uint32_t object, Weld weld = Weld::Positions,
                              double tolerance = 1e-6);
 
-// Appends `m` to `out` as a new object (material `material`, name `name`): positions,
-// normals and uvs from the mesh's vertex attributes.
-void append_object(const HalfedgeMesh& m, const std::string& name, std::uint32_t material, Scene& out);
-
 inline glm::dvec3 to_glm(const OpenMesh::Vec3d& p) { return {p[0], p[1], p[2]}; }
 
 }  // namespace speculum::mesh

@@ -157,6 +157,13 @@ TEST(MeshProcessing, SceneMeanCurvatureIsPerSoupVertex) {
     const double want = s.mesh.positions[v].x > 2.5f ? 2.0 : 0.5;
     EXPECT_NEAR(h[v], want, 0.05 * want) << v;
   }
+  // Per pixel: the triangle's barycentric blend, as a G-buffer reads it.
+  for (std::uint32_t t = 0; t < s.mesh.triangle_count(); t += 97) {
+    const std::uint32_t* i = &s.mesh.indices[3 * t];
+    EXPECT_FLOAT_EQ(interpolate_at(s.mesh, h, t, 0.0f, 0.0f), h[i[0]]);
+    EXPECT_FLOAT_EQ(interpolate_at(s.mesh, h, t, 1.0f, 0.0f), h[i[1]]);
+    EXPECT_NEAR(interpolate_at(s.mesh, h, t, 0.25f, 0.5f), 0.25f * h[i[0]] + 0.25f * h[i[1]] + 0.5f * h[i[2]], 1e-6);
+  }
 }
 
 TEST(MeshProcessing, StarShapedAboutTheChosenCentre) {
