@@ -107,6 +107,16 @@ MeshData sphere(const glm::vec3& center, float radius, int rings) {
   return m;
 }
 
+MeshData ellipsoid(const glm::vec3& center, const glm::vec3& radii, int rings) {
+  MeshData m = parametric_grid(2 * rings, rings, [&](float u, float v) {
+    return center + radii * unit_direction(u, v);
+  });
+  m.normals.reserve(m.positions.size());
+  // ∇ of Σ (x_i/a_i)²: the normal of the implicit surface.
+  for (const auto& p : m.positions) m.normals.push_back(glm::normalize((p - center) / (radii * radii)));
+  return m;
+}
+
 MeshData bumpy_sphere(const glm::vec3& center, float radius, float amplitude, float n, int rings) {
   MeshData m = parametric_grid(2 * rings, rings, [&](float u, float v) {
     const glm::vec3 d = unit_direction(u, v);

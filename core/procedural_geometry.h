@@ -35,6 +35,8 @@ MeshData quad(const glm::vec3& origin, const glm::vec3& edge_u, const glm::vec3&
 MeshData box(const glm::vec3& lo, const glm::vec3& hi, int n, bool inward, float uv_scale = 1.0f);
 // UV sphere with `rings` latitude bands and 2*rings longitude segments (~4 rings^2 tris).
 MeshData sphere(const glm::vec3& center, float radius, int rings);
+// Axis-aligned ellipsoid centre + radii · (unit direction), with its analytic normals.
+MeshData ellipsoid(const glm::vec3& center, const glm::vec3& radii, int rings);
 // Sphere displaced radially by amplitude*cos(n x)cos(n y) of the unit direction (x, y).
 MeshData bumpy_sphere(const glm::vec3& center, float radius, float amplitude, float n, int rings);
 // Spherical cap below the centre, opening upward: a concave reflector (~4 rings^2 tris).

@@ -1,4 +1,4 @@
-// The seven built-in scenes (see procedural_scenes.h). Each divides its triangle budget
+// The eight built-in scenes (see procedural_scenes.h). Each divides its triangle budget
 // among its objects by fixed fractions, so triangle counts track the size parameter.
 #include "core/procedural_scenes.h"
 
@@ -103,6 +103,29 @@ Scene sphere_in_room(const BuiltinParams& p) {
   b.add_object("box", blue, box({-3.2f, 0, -2.0f}, {-2.0f, 1.2f, -0.8f}, cells_for(share(p, 0.05) / 6), false));
   Scene s = b.take();
   s.cameras.push_back(camera("main", {3.8f, 3.0f, 4.6f}, {0, 1.3f, 0}, 60.0f, 30.0f));
+  s.lights.push_back(point_light("ceiling light", {0, 5.5f, 0}, 60.0f));
+  s.environment.constant = glm::vec3(0.05f);
+  return s;
+}
+
+// The same room around a mirror ellipsoid: a smooth star-shaped reflector whose reflection
+// points leave the plane through its centre, eye and vertex (ROGER §2.2.3's general case).
+Scene ellipsoid_in_room(const BuiltinParams& p) {
+  SceneBuilder b("ellipsoid");
+  const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
+                                      {0.8f, 0.8f, 0.8f}, {0.1f, 0.1f, 0.12f}, 8);
+  const auto walls = checker_material(b, diffuse("wall checker", glm::vec3(1.0f)),
+                                      {0.75f, 0.3f, 0.25f}, {0.9f, 0.85f, 0.7f}, 8);
+  const auto ceiling = b.add_material(diffuse("ceiling", glm::vec3(0.9f)));
+  const auto chrome = b.add_material(mirror("mirror ellipsoid"));
+  const auto blue = b.add_material(diffuse("blue box", {0.2f, 0.3f, 0.8f}));
+  const auto red = b.add_material(diffuse("red ball", {0.8f, 0.15f, 0.1f}));
+  room(b, {-5, 0, -5}, {5, 6, 5}, share(p, 0.25), floor, walls, ceiling);
+  b.add_object("mirror ellipsoid", chrome, ellipsoid({0, 1.3f, 0}, {1.9f, 1.1f, 1.2f}, rings_for(share(p, 0.6))));
+  b.add_object("red ball", red, sphere({2.6f, 0.6f, 1.6f}, 0.6f, rings_for(share(p, 0.1))));
+  b.add_object("box", blue, box({-3.2f, 0, -2.0f}, {-2.0f, 1.2f, -0.8f}, cells_for(share(p, 0.05) / 6), false));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {3.8f, 3.0f, 4.6f}, {0, 1.2f, 0}, 60.0f, 30.0f));
   s.lights.push_back(point_light("ceiling light", {0, 5.5f, 0}, 60.0f));
   s.environment.constant = glm::vec3(0.05f);
   return s;
@@ -265,6 +288,8 @@ constexpr BuiltinScene kScenes[] = {
     {"bowl", "a concave spherical mirror bowl with a ball inside", 20000, "", bowl_scene},
     {"bumpy-sphere", "a mirror sphere displaced by cos(n x) cos(n y)", 40000,
      "n=8 (bump frequency), amplitude=0.06 (relative to the radius)", bumpy_sphere_scene},
+    {"ellipsoid", "a mirror ellipsoid (radii 1.9, 1.1, 1.2) in the textured box room", 20000, "",
+     ellipsoid_in_room},
 };
 
 }  // namespace

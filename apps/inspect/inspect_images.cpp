@@ -14,6 +14,7 @@
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
+#include "raster/vertex_projection.h"
 #include "raster/shadow_map.h"
 #include "raster/visibility.h"
 
@@ -307,6 +308,16 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
     d.size = std::to_string(maps->cubes.size()) + " cube maps";
     for (std::size_t m = 0; m < maps->cubes.size() && m < kMaxListed; ++m)
       draw_cube(d, "map" + std::to_string(m) + ".", maps->cubes[m], executor);
+  } else if (const auto* params = o.as<raster::ReflectorParams>()) {
+    // Vertex projection's parameterization: r(u) of each reflector as a cube cross.
+    d.size = std::to_string(params->reflectors.size()) + " reflectors";
+    for (std::size_t m = 0; m < params->reflectors.size() && m < kMaxListed; ++m)
+      if (has_faces(params->reflectors[m].radius))
+        d.views.push_back(distance_cross_view("radius" + std::to_string(m), params->reflectors[m].radius));
+  } else if (const auto* layer = o.as<raster::ReflectedLayer>()) {
+    d.size = dims(layer->width, layer->height);
+    d.views.push_back(scalar_view("iterations", layer->iterations));
+    d.views.push_back(id_view("triangle", layer->triangle));
   } else if (!draw_trace_output(o, executor, d)) {
     d.drawable = false;
   }

@@ -118,6 +118,19 @@ const std::vector<Technique>& techniques() {
        {{"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
         {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
        double(1 << 22)},  // ~770 bytes per pixel of ray streams and hierarchy: ~3.3 GB at the limit
+      {"vertex-projection",
+       "ROGER ch.2 vertex projection: each scene vertex moved to its Fermat reflection point on "
+       "each star-shaped mirror (2-D secant iteration), triangles rasterized between them; "
+       "other specular surfaces as envmap",
+       add_vertex_projection_passes,
+       // Every reflected vertex costs up to max_iterations reflector lookups per reflector;
+       // edge splitting multiplies the vertices by about (1/edge)² and stops at 2^22.
+       {{"edge", 1.0 / 64.0, 0, 1, false,
+         "split reflected edges longer than this fraction of the scene diagonal (0: off; vertices ≤ 2^22)"},
+        {"param_size", 256, 8, 2048, true, "reflector parameterization cube face side (2048: 6 × 4M texels, ~400 MB)"},
+        {"max_iterations", 32, 1, 32, true, "secant iterations per vertex and reflector (ROGER: ≤ 20 at silhouettes)"},
+        {"pixel_tolerance", 1, 0.01, 16, false, "stop when the sample triangle's longest projected edge is under this (pixels)"},
+        {"residual", 3e-3, 1e-9, 1, false, "and the path-length gradient |g| at the best sample is under this"}}},
   };
   return table;
 }

@@ -76,12 +76,15 @@ void expect_complete_manifest(const fs::path& dir, const std::string& technique)
   EXPECT_TRUE(display_drawn);
 }
 
-// The trace-side outputs (apps/inspect/inspect_trace_images.h) a technique must draw: each is
-// drawable, lists PNGs, and every PNG loads with the output's content.
+// The technique-specific outputs (apps/inspect/inspect_trace_images.h and the vertex
+// projection's in inspect_images.cpp) a technique must draw: each is drawable, lists PNGs,
+// and every PNG loads with the output's content.
 const std::map<std::string, std::vector<std::string>> kTraceOutputs = {
     {"ray-hierarchy", {"secondary_rays", "ray_hierarchy", "hierarchy_traverse", "shadow_rays"}},
     {"yu-lod", {"glossy_rays", "lod_trace"}},
-    {"layered-distance-map", {"layered_distance_map"}}};
+    {"layered-distance-map", {"layered_distance_map"}},
+    // The parameterization cube, the iteration-count image and the reflected layer.
+    {"vertex-projection", {"reflector_param", "reflected_triangles", "vertex_projection_shade"}}};
 
 void expect_trace_outputs_drawn(const fs::path& dir, const std::string& technique) {
   const auto wanted = kTraceOutputs.find(technique);
