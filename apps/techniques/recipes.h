@@ -31,6 +31,8 @@ FrameOutputs add_layered_distance_map_passes(par::Graph& graph, const Scene* sce
 FrameOutputs add_refraction_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // planar-mirror (SURVEY §5): planar_mirrors → planar_mirror_reflect.
 FrameOutputs add_planar_mirror_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
+// soff (SOFF §3): soff_clusters → soff_cameras → soff_depth_images → soff_intersect.
+FrameOutputs add_soff_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // yu-lod (YU §3): bvh_build → radiance_bake → lod_build; glossy_rays → lod_trace → hit_radiance.
 // One sample per pixel: settings.spp is N, the glossy rays per pixel.
 FrameOutputs add_yu_lod_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
