@@ -519,6 +519,7 @@ SoffWalkResult soff_walk(const SoffCamera& cam, const float* inv_z, const glm::v
         res.kind = SoffWalkResult::Hit;
         res.sx = a.x + dx * s_hit;
         res.sy = a.y + dy * s_hit;
+        res.inv_z = a.z + (b.z - a.z) * s_hit;
         return res;
       }
       hidden = true;
@@ -572,6 +573,7 @@ ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffCl
       const float* inv_z = images.inv_z.data() + images.offsets[c];
       const glm::vec3* colour = images.colour.data() + images.offsets[c];
       bool disoccluded = false;
+      const bool fade = cam.glossy && settings.glossy_fade;
       // The radiance a reflected ray from this sample finds in the depth image, or the
       // environment (a miss, a disocclusion, a direction the camera cannot frame).
       const auto trace = [&](const glm::vec3& d) {
@@ -581,7 +583,14 @@ ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffCl
         if (r.steps <= 1) ++st.planar_lookups;
         if (r.kind == SoffWalkResult::Hit) {
           ++st.hits;
-          return bilinear(colour, cam.width, cam.height, r.sx, r.sy);
+          const glm::vec3 hit = bilinear(colour, cam.width, cam.height, r.sx, r.sy);
+          if (!fade) return hit;
+          // SOFF §3.5: a glossy reflection fades as the reflected surface nears the pulled-in
+          // far plane, here over the last quarter of the depth range, towards what a ray
+          // beyond the far plane gets (the environment), so nothing pops at the plane.
+          const float z = 1.0f / r.inv_z;
+          const float weight = std::clamp((cam.far_dist - z) / (0.25f * (cam.far_dist - cam.near_dist)), 0.0f, 1.0f);
+          return weight * hit + (1.0f - weight) * env.radiance(d, 1e6f);
         }
         ++st.env_fallback;
         if (r.kind == SoffWalkResult::Disoccluded) ++st.disoccluded_rays, disoccluded = true;

@@ -70,7 +70,8 @@ struct SoffCameraSettings {
   float scene_diameter = 1.0f;  // D: the far plane's distance from the image plane (mirrors)
   float image_scale = 1.0f;     // depth-image resolution × this (SOFF Table 5's ½, 1, 2)
   int max_image_side = 1024;    // a bound on each depth image's side (counted when hit)
-  float glossy_far = 1.0f;      // glossy clusters: far plane at D × this (§3.5; 1: not pulled in)
+  float glossy_far = 1.0f;      // glossy clusters: far plane at D × this (§3.5; 1: not pulled in),
+                                // the reflection fading over the last quarter before it
 };
 
 struct SoffCamera {
@@ -88,7 +89,6 @@ struct SoffCamera {
   float l = 0, r = 0, b = 0, t = 0;                  // frame on the near plane (u, v units)
   int width = 0, height = 0;
   float cone = 0.0f;  // glossy widening, radians
-  float far_fade = 0.0f;  // glossy: the hit distance from which the reflection fades (0: none)
 
   glm::mat4 view_projection() const;
   // (x, y) in depth-image pixels (pixel centres at +0.5) and 1/z of world point p.
@@ -155,6 +155,7 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
 struct SoffWalkResult {
   enum Kind : std::uint8_t { Hit, Miss, Disoccluded, Unrepresentable } kind = Miss;
   float sx = 0.0f, sy = 0.0f;  // the hit in depth-image pixels
+  float inv_z = 0.0f;          // the ray's 1/z at the hit
   std::uint32_t steps = 0;
 };
 
@@ -169,6 +170,7 @@ SoffWalkResult soff_walk(const SoffCamera& camera, const float* inv_z, const glm
 
 struct SoffIntersectSettings {
   int glossy_rays = 8;
+  bool glossy_fade = false;  // glossy clusters' far plane is pulled in: fade before it (§3.5)
   std::uint32_t seed = 0;
 };
 

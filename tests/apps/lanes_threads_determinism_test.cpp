@@ -46,5 +46,9 @@ TEST(LanesThreadsDeterminism, EnvmapSameBytesForEveryWidthAndThreadCount) {
   expect_same_bytes_for_every_width_and_thread_count("envmap");
 }
 
+TEST(LanesThreadsDeterminism, SoffSameBytesForEveryWidthAndThreadCount) {
+  expect_same_bytes_for_every_width_and_thread_count("soff");
+}
+
 }  // namespace
 }  // namespace speculum
