@@ -28,6 +28,8 @@ constexpr float kMaxCone = 1.3f;
 // one object (procedural and loaded meshes store neighbours together, so the groups' boxes
 // are tight): a box test per group, then only the kept groups' vertices are transformed.
 constexpr std::uint32_t kCullGroup = 128;
+// Depth-image pixels per cluster sample at image_scale 1 (see soff_camera's step 5).
+constexpr double kMaxPixelsPerSample = 4.0;
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -277,6 +279,15 @@ SoffCamera soff_camera(const glm::vec3& eye, const std::vector<glm::vec3>& posit
     }
   if (!(p > 0.0f)) p = std::max({size.x, size.y, 1e-4f * H}) / 2.0f;
   p /= settings.image_scale;
+  // Bounded work: a depth image holds at most kMaxPixelsPerSample × image_scale² pixels per
+  // cluster sample (a curved cluster's frame spans the whole solid angle its rays reach, and
+  // its finest spacing would otherwise ask for far more pixels than it has rays).
+  {
+    const double cap = double(kMaxPixelsPerSample) * double(settings.image_scale) * double(settings.image_scale) *
+                       double(std::max<std::size_t>(n, 4));
+    const double pixels = double(size.x + 2.0f * p) * double(size.y + 2.0f * p) / (double(p) * double(p));
+    if (pixels > cap) p *= float(std::sqrt(pixels / cap));
+  }
   // One pixel of overlap on every side so that neighbouring clusters' images meet (SOFF
   // §4.1.1: clusters overlap slightly, so the reflection has no gaps).
   frame.lo -= glm::vec2(p), frame.hi += glm::vec2(p);

@@ -16,7 +16,7 @@ namespace speculum {
 namespace {
 
 TEST(ProceduralScenes, AllSevenAreListedAndDefaultExists) {
-  EXPECT_EQ(builtin_scenes().size(), 7u);
+  EXPECT_EQ(builtin_scenes().size(), 8u);
   for (const char* name : {"sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",
                            "glass-sphere", "bowl", "bumpy-sphere"})
     EXPECT_NE(find_builtin_scene(name), nullptr) << name;
