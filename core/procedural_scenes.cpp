@@ -353,8 +353,9 @@ Camera CameraPath::at(int frame) const {
   const std::size_t k = std::min(keys.size() - 2, static_cast<std::size_t>(s));
   const float t = s - float(k);
   Camera c = keys.front();
-  c.eye = keys[k].eye + (keys[k + 1].eye - keys[k].eye) * t;
-  c.target = keys[k].target + (keys[k + 1].target - keys[k].target) * t;
+  // (1 − t) a + t b: exactly the keys at t = 0 and t = 1.
+  c.eye = keys[k].eye * (1.0f - t) + keys[k + 1].eye * t;
+  c.target = keys[k].target * (1.0f - t) + keys[k + 1].target * t;
   return c;
 }
 
