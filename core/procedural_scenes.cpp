@@ -180,6 +180,30 @@ Scene living_room(const BuiltinParams& p) {
   b.add_object("silver bowl", silver, bowl({-2.5f, 0.6f, 1.2f}, 0.6f, 70.0f, rings_for(share(p, 0.12))));
   b.add_object("vase", satin, lathe({2.8f, 0, -2.2f}, vase_profile, rings_for(share(p, 0.13))));
   b.add_object("bumpy ball", bumpy, bumpy_sphere({-2.8f, 0.5f, -2.0f}, 0.45f, 0.06f, 10.0f, rings_for(share(p, 0.15))));
+  // reflectors=N (SOFF §4's living room has 25): the eight above plus N − 8 small ones on the
+  // side walls — chrome and gold balls, copper rings and mirror tiles, 1% of the budget each.
+  const int extra = static_cast<int>(p.get("reflectors", 8.0)) - 8;
+  if (extra > 0) {
+    const auto gold = b.add_material(glossy("gold trinket", {1.0f, 0.78f, 0.34f}, 0.2f));
+    for (int k = 0; k < extra; ++k) {
+      const float side = k % 2 ? 3.75f : -3.75f;
+      const int j = k / 2;
+      const glm::vec3 at{side, 0.9f + 0.6f * float(j / 8), -2.1f + 0.6f * float(j % 8)};
+      const std::string name = "trinket " + std::to_string(k);
+      const std::uint64_t budget = share(p, 0.01);
+      switch (k % 4) {
+        case 0: b.add_object(name, chrome, sphere(at, 0.14f, rings_for(budget))); break;
+        case 1: b.add_object(name, copper, torus(at, 0.14f, 0.045f, rings_for(budget * 2))); break;
+        case 2: b.add_object(name, gold, sphere(at, 0.12f, rings_for(budget))); break;
+        default: {
+          // A mirror tile on the wall, facing into the room.
+          const float inward = side > 0.0f ? -1.0f : 1.0f;
+          const glm::vec3 o = at + glm::vec3(0.2f * inward, -0.15f, 0.15f * inward);
+          b.add_object(name, wall_mirror, quad(o, {0, 0, -0.3f * inward}, {0, 0.3f, 0}, cells_for(budget), cells_for(budget)));
+        }
+      }
+    }
+  }
   Scene s = b.take();
   s.cameras.push_back(camera("main", {3.3f, 1.8f, 2.7f}, {-0.6f, 0.9f, -1.0f}, 60.0f, 30.0f));
   s.cameras.push_back(camera("mirror view", {0.0f, 1.5f, 2.8f}, {0.0f, 1.4f, -3.0f}, 50.0f, 30.0f));
@@ -326,7 +350,7 @@ constexpr BuiltinScene kScenes[] = {
     {"mirror-corridor", "two facing planar mirrors with objects between (inter-reflections)",
      20000, "", mirror_corridor},
     {"living-room", "a room with many reflectors: wall mirror, chrome, glass, copper, bowl", 50000,
-     "", living_room},
+     "reflectors=8 (8..40: small chrome, gold, copper and mirror pieces added; SOFF's room has 25)", living_room},
     {"glass-sphere", "a refracting glass sphere (ior 1.5) over a plane, lit by a point light",
      20000, "", glass_sphere},
     {"bowl", "a concave spherical mirror bowl with a ball inside", 20000, "", bowl_scene},

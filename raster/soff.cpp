@@ -533,6 +533,7 @@ SoffWalkResult soff_walk(const SoffCamera& cam, const float* inv_z, const glm::v
         res.inv_z = a.z + (b.z - a.z) * s_hit;
         return res;
       }
+      if (!hidden) res.sx = a.x + dx * (float(k - 1) / float(steps)), res.sy = a.y + dy * (float(k - 1) / float(steps));
       hidden = true;
     }
     prev_jump = jump;
@@ -583,12 +584,12 @@ ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffCl
       const SoffCamera& cam = cameras[c];
       const float* inv_z = images.inv_z.data() + images.offsets[c];
       const glm::vec3* colour = images.colour.data() + images.offsets[c];
-      bool disoccluded = false;
+      int disoccluded = 0, rays = 0;
       const bool fade = cam.glossy && settings.glossy_fade;
       // The radiance a reflected ray from this sample finds in the depth image, or the
       // environment (a miss, a disocclusion, a direction the camera cannot frame).
       const auto trace = [&](const glm::vec3& d) {
-        ++st.rays;
+        ++st.rays, ++rays;
         const SoffWalkResult r = soff_walk(cam, inv_z, g.position.pixels[i], d);
         st.steps += r.steps;
         if (r.steps <= 1) ++st.planar_lookups;
@@ -604,7 +605,11 @@ ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffCl
           return weight * hit + (1.0f - weight) * env.radiance(d, 1e6f);
         }
         ++st.env_fallback;
-        if (r.kind == SoffWalkResult::Disoccluded) ++st.disoccluded_rays, disoccluded = true;
+        if (r.kind == SoffWalkResult::Disoccluded) {
+          ++st.disoccluded_rays, ++disoccluded;
+          // The depth image's sample just before the silhouette the ray passed behind.
+          if (settings.fill_disocclusions) return bilinear(colour, cam.width, cam.height, r.sx, r.sy);
+        }
         return env.radiance(d, 1e6f);
       };
       glm::vec3 radiance(0.0f);
@@ -624,7 +629,9 @@ ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffCl
       } else {
         radiance = specular_radiance(s, n, v, [&](const glm::vec3& d, float) { return trace(d); });
       }
-      if (disoccluded) ++st.disoccluded_samples;
+      // A sample is disoccluded when most of its rays are (a mirror's one ray; a glossy
+      // lobe's majority), so the count compares with SOFF's per-pixel figure.
+      if (2 * disoccluded > rays) ++st.disoccluded_samples;
       out.pixels[i] = glm::vec4(radiance, 1.0f);
     }
   });

@@ -165,12 +165,16 @@ struct SoffWalkResult {
 // to behind; first hit wins. A crossing where the stored depth jumps in front of the ray
 // (the ray passes behind a silhouette) is a disocclusion: the walk goes on, and ends
 // Disoccluded if nothing is hit later. A ray whose direction leaves the frustum backwards is
-// Unrepresentable.
+// Unrepresentable. A Disoccluded result's (sx, sy) is the last step before the first
+// silhouette.
 SoffWalkResult soff_walk(const SoffCamera& camera, const float* inv_z, const glm::vec3& p, const glm::vec3& d);
 
 struct SoffIntersectSettings {
   int glossy_rays = 8;
   bool glossy_fade = false;  // glossy clusters' far plane is pulled in: fade before it (§3.5)
+  // A disoccluded ray takes the environment (SOFF §4.1.1), or with this the depth image's
+  // sample just before the silhouette it passed behind (the nearest captured surface).
+  bool fill_disocclusions = false;
   std::uint32_t seed = 0;
 };
 
@@ -180,7 +184,7 @@ struct SoffIntersectStats {
   std::uint64_t hits = 0;
   std::uint64_t env_fallback = 0;       // rays that got the environment map (any reason)
   std::uint64_t disoccluded_rays = 0;
-  std::uint64_t disoccluded_samples = 0;  // samples with at least one disoccluded ray
+  std::uint64_t disoccluded_samples = 0;  // samples most of whose rays were disoccluded
   std::uint64_t unclustered_samples = 0;  // specular samples without a valid camera
   std::uint64_t planar_lookups = 0;       // rays that projected to a point (one lookup)
 };

@@ -40,8 +40,8 @@ struct SoffExperimentOptions {
   bool json = false;
 };
 
-// SOFF's scenes (§4): the living room at ~290K triangles and the bathroom at ~90K.
-const std::vector<std::string> kScenes = {"living-room:size=290000", "bathroom"};
+// SOFF's scenes (§4): the living room with 25 reflectors at ~290K triangles and the bathroom at ~90K.
+const std::vector<std::string> kScenes = {"living-room:size=240000:reflectors=25", "bathroom"};
 
 double ms_of(const par::RunReport& r, const char* node) {
   const par::NodeRecord* n = r.find(node);
@@ -270,7 +270,7 @@ void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global)
       "bins / output size / depth-image scale / glossy rays trends (Tables 3, 4, 5, 8).\n"
       "Example: speculum experiment soff --quick --json");
   cmd->add_option("--scenes", o->scenes,
-                  "Scenes with camera paths (default: living-room:size=290000, bathroom)")
+                  "Scenes with camera paths (default: living-room:size=240000:reflectors=25, bathroom)")
       ->delimiter(',');
   cmd->add_option("--paths", o->paths, "Path names (default: every path of each scene)")->delimiter(',');
   cmd->add_option("--frames", o->frames, "Frames per path, spread evenly over it")

@@ -29,6 +29,7 @@ FrameOutputs add_soff_passes(par::Graph& g, const Scene* scene, const FrameSetti
   isect.glossy_rays = static_cast<int>(f.param("glossy_rays"));
   isect.seed = f.seed;
   isect.glossy_fade = cam.glossy_far < 1.0f;
+  isect.fill_disocclusions = f.param("fill") != 0.0;
   auto specular = g.add("soff_intersect", SoffIntersectPass{isect}, s.gbuffer, clusters, cameras, images,
                         s.environment);
   return add_output_passes(g, f, s.direct, specular);

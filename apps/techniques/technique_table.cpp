@@ -103,7 +103,8 @@ const std::vector<Technique>& techniques() {
         {"image_scale", 1, 0.125, 4, false, "depth-image resolution × this (SOFF Table 5)"},
         {"max_image_side", 1024, 16, 4096, true, "largest depth-image side (clamped images are counted)"},
         {"glossy_rays", 8, 1, 64, true, "reflected rays per glossy sample (SOFF §3.5: 8 to 49)"},
-        {"glossy_far", 1, 0.05, 1, false, "glossy clusters' far plane at this × the scene diameter (§3.5)"}}},
+        {"glossy_far", 1, 0.05, 1, false, "glossy clusters' far plane at this × the scene diameter (§3.5)"},
+        {"fill", 0, 0, 1, true, "disoccluded rays: 0 the environment (SOFF), 1 the depth image beside the silhouette"}}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",
