@@ -355,5 +355,19 @@ TEST(SoffIntersect, SpecularErrorAgainstTheExactSpecularReference) {
   }
 }
 
+// SOFF §3.5: glossy samples average several lobe rays walked through a depth image widened
+// by the cone; more rays bring the glossy floor closer to the converged lobe, and both stay
+// far below environment mapping's error.
+TEST(SoffIntersect, GlossyRaysConvergeTowardsTheReference) {
+  const Scene s = load_scene("glossy-plane");
+  const ImageRGBA ref = render_display(s, "specular-reference", 160, 120, {{"glossy_samples", 256}});
+  const double few = specular_mae8(s, render_display(s, "soff", 160, 120, {{"glossy_rays", 8}}), ref);
+  const double many = specular_mae8(s, render_display(s, "soff", 160, 120, {{"glossy_rays", 49}}), ref);
+  const double envmap = specular_mae8(s, render_display(s, "envmap", 160, 120), ref);
+  EXPECT_LT(many, 0.75 * few) << "8 rays " << few << ", 49 rays " << many;
+  EXPECT_LT(few, 0.5 * envmap) << "8 rays " << few << ", envmap " << envmap;
+  EXPECT_LE(many, 4.0);
+}
+
 }  // namespace
 }  // namespace speculum::raster
