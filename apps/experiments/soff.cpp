@@ -60,20 +60,28 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Mean absolute 8-bit difference over the pixels whose centre sample is specular.
-double specular_mae8(const Scene& scene, const Camera& camera, const ImageRGBA& a, const ImageRGBA& b,
-                     par::Executor& ex) {
+// Mean absolute 8-bit difference over the pixels whose centre sample is specular: all of
+// them, the mirror ones and the glossy ones.
+struct SpecularError {
+  double all = 0.0, mirror = 0.0, glossy = 0.0;
+};
+SpecularError specular_mae8(const Scene& scene, const Camera& camera, const ImageRGBA& a, const ImageRGBA& b,
+                            par::Executor& ex) {
   const raster::VisibilityBuffer vis = raster::render_visibility(ex, scene, camera, a.width, a.height);
   const raster::GBuffer g = raster::resolve_gbuffer(ex, scene, vis, camera.eye);
-  double sum = 0.0;
-  std::size_t n = 0;
+  double sum[3] = {0.0, 0.0, 0.0};
+  std::size_t n[3] = {0, 0, 0};
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
-    if (!g.covered(i) || !raster::is_specular(g.surface.pixels[i])) continue;
-    for (int ch = 0; ch < 3; ++ch)
-      sum += std::abs(display_to_8bit(a.pixels[i][ch]) - display_to_8bit(b.pixels[i][ch]));
-    ++n;
+    const SurfaceParams& s = g.surface.pixels[i];
+    if (!g.covered(i) || !raster::is_specular(s)) continue;
+    double e = 0.0;
+    for (int ch = 0; ch < 3; ++ch) e += std::abs(display_to_8bit(a.pixels[i][ch]) - display_to_8bit(b.pixels[i][ch]));
+    const int kind = s.is_refractor() ? 0 : s.is_glossy_lobe() ? 2 : 1;
+    sum[0] += e, ++n[0];
+    if (kind) sum[kind] += e, ++n[kind];
   }
-  return n ? sum / (3.0 * double(n)) : 0.0;
+  const auto mean = [&](int k) { return n[k] ? sum[k] / (3.0 * double(n[k])) : 0.0; };
+  return {mean(0), mean(1), mean(2)};
 }
 
 struct Frame {
@@ -101,7 +109,8 @@ pipeline::FrameResult run(const Scene& scene, const std::string& technique, cons
 void path_row(const Scene& scene, const std::string& scene_name, const CameraPath& path,
               const SoffExperimentOptions& o, par::Executor& ex, ResultTable& table, Progress& progress) {
   const int frames = std::max(1, std::min(o.frames, path.frames));
-  std::vector<double> ms, ms_cl, ms_cam, ms_di, ms_is, ms_rebuild, ms_prebuilt, mae, dis, clusters;
+  std::vector<double> ms, ms_cl, ms_cam, ms_di, ms_is, ms_rebuild, ms_prebuilt, mae, mae_mirror, mae_glossy, dis,
+      clusters;
   double mae_frame = -1.0;
   for (int k = 0; k < frames; ++k) {
     // Frames spread evenly over the path (the first and the last key included).
@@ -136,7 +145,8 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
     const pipeline::FrameResult exact =
         run(scene, "specular-reference",
             settings_for(cam, o.width, o.supersample, {{"glossy_samples", o.glossy_samples}}, "specular-reference"), ex);
-    mae.push_back(specular_mae8(scene, cam, soff.display, exact.display, ex));
+    const SpecularError e = specular_mae8(scene, cam, soff.display, exact.display, ex);
+    mae.push_back(e.all), mae_mirror.push_back(e.mirror), mae_glossy.push_back(e.glossy);
     if (k == 0 && o.reference_spp > 0) {
       pipeline::FrameSettings rf = settings_for(cam, o.width, 1, {}, "reference");
       rf.spp = o.reference_spp;
@@ -145,9 +155,12 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
     }
     progress.step(scene_name + " " + path.name);
   }
-  double dis_avg = 0.0, cl_avg = 0.0, mae_avg = 0.0;
-  for (std::size_t k = 0; k < ms.size(); ++k) dis_avg += dis[k], cl_avg += clusters[k], mae_avg += mae[k];
-  dis_avg /= double(ms.size()), cl_avg /= double(ms.size()), mae_avg /= double(ms.size());
+  const auto mean = [](const std::vector<double>& v) {
+    double s = 0.0;
+    for (double x : v) s += x;
+    return v.empty() ? 0.0 : s / double(v.size());
+  };
+  const double dis_avg = mean(dis), cl_avg = mean(clusters), mae_avg = mean(mae);
   const double m = median(ms), rebuild = median(ms_rebuild), prebuilt = median(ms_prebuilt);
   table.cell("row", "path")
       .cell("scene", scene_name)
@@ -157,6 +170,8 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
       .cell("supersample", o.supersample)
       .cell("triangles", std::int64_t(scene.mesh.triangle_count()))
       .cell("mae8_specular", mae_avg, 2)
+      .cell("mae8_mirror", mean(mae_mirror), 2)
+      .cell("mae8_glossy", mean(mae_glossy), 2)
       .cell("mae8_frame", mae_frame, 2)
       .cell("disocclusion_pct_avg", dis_avg, 3)
       .cell("disocclusion_pct_max", *std::max_element(dis.begin(), dis.end()), 3)
