@@ -203,6 +203,30 @@ Scene living_room(const BuiltinParams& p) {
   b.add_object("silver bowl", silver, bowl({-2.5f, 0.6f, 1.2f}, 0.6f, 70.0f, rings_for(share(p, 0.12))));
   b.add_object("vase", satin, lathe({2.8f, 0, -2.2f}, vase_profile, rings_for(share(p, 0.13))));
   b.add_object("bumpy ball", bumpy, bumpy_sphere({-2.8f, 0.5f, -2.0f}, 0.45f, 0.06f, 10.0f, rings_for(share(p, 0.15))));
+  // reflectors=N (SOFF §4's living room has 25): the eight above plus N − 8 small ones on the
+  // side walls — chrome and gold balls, copper rings and mirror tiles, 1% of the budget each.
+  const int extra = static_cast<int>(p.get("reflectors", 8.0)) - 8;
+  if (extra > 0) {
+    const auto gold = b.add_material(glossy("gold trinket", {1.0f, 0.78f, 0.34f}, 0.2f));
+    for (int k = 0; k < extra; ++k) {
+      const float side = k % 2 ? 3.75f : -3.75f;
+      const int j = k / 2;
+      const glm::vec3 at{side, 0.9f + 0.6f * float(j / 8), -2.1f + 0.6f * float(j % 8)};
+      const std::string name = "trinket " + std::to_string(k);
+      const std::uint64_t budget = share(p, 0.01);
+      switch (k % 4) {
+        case 0: b.add_object(name, chrome, sphere(at, 0.14f, rings_for(budget))); break;
+        case 1: b.add_object(name, copper, torus(at, 0.14f, 0.045f, rings_for(budget * 2))); break;
+        case 2: b.add_object(name, gold, sphere(at, 0.12f, rings_for(budget))); break;
+        default: {
+          // A mirror tile on the wall, facing into the room.
+          const float inward = side > 0.0f ? -1.0f : 1.0f;
+          const glm::vec3 o = at + glm::vec3(0.2f * inward, -0.15f, 0.15f * inward);
+          b.add_object(name, wall_mirror, quad(o, {0, 0, -0.3f * inward}, {0, 0.3f, 0}, cells_for(budget), cells_for(budget)));
+        }
+      }
+    }
+  }
   Scene s = b.take();
   s.cameras.push_back(camera("main", {3.3f, 1.8f, 2.7f}, {-0.6f, 0.9f, -1.0f}, 60.0f, 30.0f));
   s.cameras.push_back(camera("mirror view", {0.0f, 1.5f, 2.8f}, {0.0f, 1.4f, -3.0f}, 50.0f, 30.0f));
@@ -255,6 +279,73 @@ Scene bowl_scene(const BuiltinParams& p) {
   return s;
 }
 
+// SOFF §4's second scene: a bathroom of ~90K triangles at the default size with 15
+// reflective objects (Fig. 3): a wall mirror and a cabinet mirror, chrome taps, shower head,
+// towel ring and ball, a glossy tub, basin, sink and soap dish, glossy floor and wall tiles
+// and a satin vase; about half the triangles are non-diffuse, as in SOFF §4.
+Scene bathroom(const BuiltinParams& p) {
+  SceneBuilder b("bathroom");
+  const auto floor_tiles = checker_material(b, glossy("glossy floor tiles", glm::vec3(1.0f), 0.3f),
+                                            {0.75f, 0.75f, 0.78f}, {0.25f, 0.28f, 0.32f}, 12);
+  const auto wall_tiles = checker_material(b, glossy("glossy wall tiles", glm::vec3(1.0f), 0.35f),
+                                           {0.55f, 0.7f, 0.75f}, {0.85f, 0.9f, 0.9f}, 16);
+  const auto paint = checker_material(b, diffuse("painted wall", glm::vec3(1.0f)), {0.9f, 0.86f, 0.78f},
+                                      {0.82f, 0.78f, 0.7f}, 6);
+  const auto ceiling = b.add_material(diffuse("ceiling", glm::vec3(0.92f)));
+  const auto mirror_m = b.add_material(mirror("bathroom mirror", glm::vec3(0.93f)));
+  const auto chrome = b.add_material(mirror("chrome", glm::vec3(0.9f, 0.9f, 0.92f)));
+  const auto ceramic = b.add_material(glossy("white ceramic", glm::vec3(0.92f), 0.12f));
+  const auto enamel = b.add_material(glossy("tub enamel", {0.95f, 0.95f, 0.9f}, 0.2f));
+  const auto satin = b.add_material(glossy("satin vase", {0.3f, 0.45f, 0.7f}, 0.4f));
+  const auto wood = b.add_material(diffuse("cabinet wood", {0.5f, 0.33f, 0.2f}));
+  const auto towel = b.add_material(diffuse("towel", {0.8f, 0.25f, 0.2f}));
+  const auto rug = b.add_material(diffuse("rug", {0.2f, 0.45f, 0.3f}));
+  const auto porcelain = b.add_material(diffuse("matte porcelain", {0.85f, 0.85f, 0.82f}));
+  const glm::vec3 lo{-1.5f, 0.0f, -1.75f}, hi{1.5f, 2.6f, 1.75f};
+  const glm::vec3 d = hi - lo;
+  const int wn = cells_for(share(p, 0.04));
+  b.add_object("floor", floor_tiles, quad(lo, {0, 0, d.z}, {d.x, 0, 0}, cells_for(share(p, 0.06)),
+                                          cells_for(share(p, 0.06)), 2.0f));
+  b.add_object("ceiling", ceiling, quad({lo.x, hi.y, lo.z}, {d.x, 0, 0}, {0, 0, d.z}, cells_for(share(p, 0.02)),
+                                        cells_for(share(p, 0.02))));
+  b.add_object("wall back", paint, quad(lo, {d.x, 0, 0}, {0, d.y, 0}, wn, wn, 2.0f));
+  b.add_object("wall front", paint, quad({hi.x, lo.y, hi.z}, {-d.x, 0, 0}, {0, d.y, 0}, wn, wn, 2.0f));
+  b.add_object("wall left", paint, quad({lo.x, lo.y, hi.z}, {0, 0, -d.z}, {0, d.y, 0}, wn, wn, 2.0f));
+  b.add_object("tiled wall", wall_tiles, quad({hi.x, lo.y, lo.z}, {0, 0, d.z}, {0, d.y, 0}, wn, wn, 2.0f));
+  const int mn = cells_for(share(p, 0.01));
+  b.add_object("wall mirror", mirror_m, quad({-1.25f, 1.1f, -1.74f}, {1.1f, 0, 0}, {0, 0.9f, 0}, mn, mn));
+  b.add_object("cabinet mirror", mirror_m, quad({-1.49f, 1.2f, -1.3f}, {0, 0, 0.8f}, {0, 0.8f, 0}, mn, mn));
+  b.add_object("sink", ceramic, bowl({-0.7f, 1.15f, -1.42f}, 0.28f, 75.0f, rings_for(share(p, 0.08))));
+  b.add_object("sink tap", chrome, torus({-0.7f, 1.2f, -1.66f}, 0.06f, 0.016f, rings_for(share(p, 0.04) * 2)));
+  b.add_object("tap handle", chrome, sphere({-0.52f, 1.0f, -1.66f}, 0.035f, rings_for(share(p, 0.02))));
+  b.add_object("tub", enamel, box({-1.5f, 0.0f, -0.2f}, {-0.72f, 0.55f, 1.75f}, cells_for(share(p, 0.04) / 6), false));
+  b.add_object("tub basin", enamel, bowl({-1.11f, 1.0f, 0.78f}, 0.42f, 62.0f, rings_for(share(p, 0.04))));
+  b.add_object("tub faucet", chrome, torus({-1.11f, 0.95f, 1.62f}, 0.08f, 0.022f, rings_for(share(p, 0.05) * 2)));
+  b.add_object("shower head", chrome, torus({-1.11f, 2.05f, 1.5f}, 0.11f, 0.035f, rings_for(share(p, 0.03) * 2)));
+  b.add_object("towel ring", chrome, torus({1.2f, 1.15f, 0.35f}, 0.2f, 0.02f, rings_for(share(p, 0.04) * 2)));
+  b.add_object("chrome ball", chrome, sphere({0.55f, 0.25f, -0.85f}, 0.25f, rings_for(share(p, 0.08))));
+  b.add_object("soap dish", ceramic, bowl({-0.3f, 1.12f, -1.6f}, 0.09f, 70.0f, rings_for(share(p, 0.04))));
+  b.add_object("vase", satin, lathe({1.2f, 0.8f, -1.52f}, [](float t) {
+    return glm::vec2(0.06f + 0.06f * std::sin(3.1415927f * t), 0.45f * t);
+  }, rings_for(share(p, 0.08))));
+  b.add_object("cabinet", wood, box({0.9f, 0.0f, -1.75f}, {1.5f, 0.8f, -1.3f}, cells_for(share(p, 0.02) / 6), false));
+  b.add_object("towel", towel, box({1.12f, 0.6f, 0.2f}, {1.22f, 1.12f, 0.5f}, cells_for(share(p, 0.01) / 6), false));
+  b.add_object("rug", rug, quad({-0.3f, 0.005f, 1.1f}, {1.0f, 0, 0}, {0, 0, -0.8f}, cells_for(share(p, 0.01)),
+                                cells_for(share(p, 0.01))));
+  b.add_object("toilet", porcelain, lathe({0.3f, 0.0f, -1.4f}, [](float t) {
+    return glm::vec2(0.2f + 0.06f * std::sin(3.1415927f * t), 0.45f * t);
+  }, rings_for(share(p, 0.12))));
+  b.add_object("laundry basket", wood, lathe({1.05f, 0.0f, 1.35f}, [](float t) {
+    return glm::vec2(0.22f - 0.04f * t, 0.55f * t);
+  }, rings_for(share(p, 0.04))));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {1.2f, 1.6f, 1.55f}, {-0.6f, 1.0f, -1.2f}, 60.0f, 20.0f));
+  s.lights.push_back(point_light("ceiling light", {0.0f, 2.5f, 0.0f}, 14.0f, {1.0f, 0.95f, 0.85f}));
+  s.lights.push_back(point_light("mirror light", {-0.7f, 2.2f, -1.3f}, 5.0f));
+  s.environment.constant = glm::vec3(0.03f);
+  return s;
+}
+
 Scene bumpy_sphere_scene(const BuiltinParams& p) {
   SceneBuilder b("bumpy-sphere");
   const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
@@ -282,17 +373,63 @@ constexpr BuiltinScene kScenes[] = {
     {"mirror-corridor", "two facing planar mirrors with objects between (inter-reflections)",
      20000, "", mirror_corridor},
     {"living-room", "a room with many reflectors: wall mirror, chrome, glass, copper, bowl", 50000,
-     "", living_room},
+     "reflectors=8 (8..40: small chrome, gold, copper and mirror pieces added; SOFF's room has 25)", living_room},
     {"glass-sphere", "a refracting glass sphere (ior 1.5) over a plane, lit by a point light",
      20000, "", glass_sphere},
     {"bowl", "a concave spherical mirror bowl with a ball inside", 20000, "", bowl_scene},
+    {"bathroom", "SOFF's bathroom: 15 reflectors (mirrors, chrome, glossy tub, sink and tiles), ~90K tris",
+     90000, "", bathroom},
     {"bumpy-sphere", "a mirror sphere displaced by cos(n x) cos(n y)", 40000,
      "n=8 (bump frequency), amplitude=0.06 (relative to the radius)", bumpy_sphere_scene},
     {"ellipsoid", "a mirror ellipsoid (radii 1.9, 1.1, 1.2) in the textured box room", 20000, "",
      ellipsoid_in_room},
 };
 
+// Key cameras of one path: eyes and targets in pairs.
+CameraPath path(const char* name, int frames, float vfov, std::initializer_list<std::pair<glm::vec3, glm::vec3>> keys) {
+  CameraPath p;
+  p.name = name;
+  p.frames = frames;
+  for (const auto& [eye, target] : keys) p.keys.push_back(camera(name, eye, target, vfov, 30.0f));
+  return p;
+}
+
 }  // namespace
+
+Camera CameraPath::at(int frame) const {
+  if (keys.size() < 2 || frames < 2) return keys.front();
+  const float s = float(std::clamp(frame, 0, frames - 1)) / float(frames - 1) * float(keys.size() - 1);
+  const std::size_t k = std::min(keys.size() - 2, static_cast<std::size_t>(s));
+  const float t = s - float(k);
+  Camera c = keys.front();
+  // (1 − t) a + t b: exactly the keys at t = 0 and t = 1.
+  c.eye = keys[k].eye * (1.0f - t) + keys[k + 1].eye * t;
+  c.target = keys[k].target * (1.0f - t) + keys[k + 1].target * t;
+  return c;
+}
+
+std::vector<CameraPath> builtin_camera_paths(std::string_view name) {
+  if (name == "bathroom")
+    return {path("walk", 60, 60.0f,
+                 {{{1.2f, 1.6f, 1.55f}, {-0.6f, 1.0f, -1.2f}},
+                  {{0.7f, 1.55f, 0.9f}, {-0.7f, 1.1f, -1.5f}},
+                  {{0.2f, 1.5f, 0.3f}, {-0.8f, 1.2f, -1.7f}}}),
+            path("pan", 60, 60.0f,
+                 {{{0.9f, 1.5f, 1.4f}, {-1.1f, 0.8f, 1.0f}},
+                  {{0.9f, 1.5f, 1.4f}, {-0.8f, 1.3f, -1.6f}},
+                  {{0.9f, 1.5f, 1.4f}, {1.2f, 0.9f, -1.5f}}})};
+  if (name == "living-room")
+    return {path("walk", 60, 60.0f,
+                 {{{3.3f, 1.8f, 2.7f}, {-0.6f, 0.9f, -1.0f}},
+                  {{2.0f, 1.6f, 2.2f}, {-0.5f, 1.0f, -1.8f}},
+                  {{0.8f, 1.5f, 1.8f}, {-0.5f, 1.1f, -2.8f}}}),
+            path("orbit", 60, 60.0f,
+                 {{{3.0f, 1.7f, 1.2f}, {0.0f, 0.9f, 0.0f}},
+                  {{2.2f, 1.7f, 2.2f}, {0.0f, 0.9f, 0.0f}},
+                  {{0.6f, 1.7f, 2.7f}, {0.0f, 0.9f, 0.0f}},
+                  {{-1.6f, 1.7f, 2.4f}, {0.0f, 0.9f, 0.0f}}})};
+  return {};
+}
 
 std::span<const BuiltinScene> builtin_scenes() { return kScenes; }
 

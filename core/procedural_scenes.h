@@ -7,6 +7,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/scene.h"
 
@@ -33,6 +34,20 @@ struct BuiltinScene {
 };
 
 std::span<const BuiltinScene> builtin_scenes();
+
+// A named camera path through a built-in scene (SOFF §4 measures two per scene): key
+// cameras spaced evenly over `frames` frames, eye and target interpolated linearly between
+// neighbouring keys (field of view and clip planes are the first key's). Every frame is a
+// pure function of its index, so frames render independently.
+struct CameraPath {
+  std::string name;
+  int frames = 60;
+  std::vector<Camera> keys;
+  Camera at(int frame) const;  // frame in [0, frames)
+};
+
+// The paths of built-in scene `name` (a bare name, no ":size=" suffix); empty: none.
+std::vector<CameraPath> builtin_camera_paths(std::string_view name);
 const BuiltinScene* find_builtin_scene(std::string_view name);
 
 }  // namespace speculum

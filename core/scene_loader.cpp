@@ -87,6 +87,8 @@ Scene build_builtin(const std::string& spec, const SceneOptions& options) {
     throw InputError(spec, "n must be in [0, 1000]");
   if (const double a = params.get("amplitude", 0.06); !(a >= 0.0 && a <= 0.5))
     throw InputError(spec, "amplitude must be in [0, 0.5]");
+  if (const double r = params.get("reflectors", 8.0); !(r >= 8.0 && r <= 40.0 && r == std::floor(r)))
+    throw InputError(spec, "reflectors must be a whole number in [8, 40]");
   Scene scene = def->build(params);
   scene.name = spec;
   return scene;

@@ -42,5 +42,6 @@ void add_experiment_yu_fig9_subcommand(CLI::App& experiment, GlobalOptions& glob
 void add_experiment_survey_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_ray_hierarchy_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_vertex_projection_subcommand(CLI::App& experiment, GlobalOptions& global);
+void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global);
 
 }  // namespace speculum::cli

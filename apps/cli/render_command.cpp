@@ -12,6 +12,7 @@
 #include "apps/techniques/technique_table.h"
 #include "apps/cli/progress.h"
 #include "core/error.h"
+#include "core/procedural_scenes.h"
 #include "core/scene_loader.h"
 #include "raster/visibility.h"
 
@@ -24,13 +25,89 @@ struct RenderOptions {
   std::string aov;  // "albedo,normal,depth": G-buffer layers of the EXR
   bool aov_given = false;
   bool timings = false;
+  std::string path;    // --path NAME: a built-in scene's camera path
+  std::string frames;  // --frames A..B of that path
 };
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// "A..B" (or "A"): the inclusive frame range of --frames.
+std::pair<int, int> parse_frame_range(const std::string& text) {
+  const auto dots = text.find("..");
+  const std::string a = text.substr(0, dots), b = dots == std::string::npos ? a : text.substr(dots + 2);
+  const auto whole = [&](const std::string& s) {
+    if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos)
+      throw InputError("--frames", "expected A..B with whole numbers A <= B, got '" + text + "'");
+    return std::stoi(s);
+  };
+  const int first = whole(a), last = whole(b);
+  if (first > last) throw InputError("--frames", "empty range '" + text + "' (the first frame is after the last)");
+  return {first, last};
+}
+
+// The output name of `frame`: the run of '#' in `pattern` replaced by the zero-padded number.
+std::string frame_file(const std::string& pattern, int frame) {
+  const auto first = pattern.find('#');
+  const auto last = pattern.find_first_not_of('#', first);
+  const std::size_t width = (last == std::string::npos ? pattern.size() : last) - first;
+  std::string number = std::to_string(frame);
+  if (number.size() < width) number.insert(0, width - number.size(), '0');
+  return pattern.substr(0, first) + number + (last == std::string::npos ? "" : pattern.substr(last));
+}
+
+// --path NAME --frames A..B: each frame of the path rendered independently (the same bytes
+// as rendering that camera alone) and written to the output pattern, a progress bar over
+// the frames.
+void run_render_path(const RenderOptions& opts, const GlobalOptions& global) {
+  const pipeline::FrameOptions& o = opts.frame;
+  const pipeline::Technique& technique = pipeline::find_technique(o.technique);
+  if (opts.output.find('#') == std::string::npos)
+    throw InputError("-o", "a --path render needs a file pattern with '#' for the frame number, e.g. f_####.png; got '" +
+                               opts.output + "'");
+  if (opts.aov_given) throw InputError("--aov", "not available with --path");
+  if (opts.frames.empty()) throw InputError("--frames", "--path needs --frames A..B");
+  const auto [first, last] = parse_frame_range(opts.frames);
+  const std::string base = o.scene.substr(0, o.scene.find(':'));
+  const std::vector<CameraPath> paths = builtin_camera_paths(base);
+  const CameraPath* path = nullptr;
+  std::string known;
+  for (const CameraPath& p : paths) {
+    if (p.name == opts.path) path = &p;
+    known += (known.empty() ? "" : ", ") + p.name;
+  }
+  if (!path)
+    throw InputError("--path", "unknown path '" + opts.path + "' for scene '" + base + "' (" +
+                                   (known.empty() ? std::string("it has no camera paths") : "known: " + known) + ")");
+  if (last >= path->frames)
+    throw InputError("--frames", "frame " + std::to_string(last) + " is past the end of path '" + path->name +
+                                     "' (frames 0.." + std::to_string(path->frames - 1) + ")");
+  pipeline::check_frame_options(o);
+  Scene scene = pipeline::load_frame_scene(o, global.quiet);
+  const pipeline::FrameSettings base_settings = pipeline::make_frame_settings(o, scene);
+  par::Executor executor(global.threads, global.lanes);
+  const bool exr = ends_with(opts.output, ".exr");
+  Progress progress("render " + path->name, std::size_t(last - first + 1), global.quiet);
+  for (int frame = first; frame <= last; ++frame) {
+    pipeline::FrameSettings f = base_settings;
+    f.camera = path->at(frame);
+    par::Graph graph;
+    const pipeline::FrameOutputs outputs = technique.add_passes(graph, &scene, f);
+    const par::Resource<ImageRGBA>& image = exr ? outputs.radiance : outputs.display;
+    graph.request(image);
+    graph.run(executor);
+    const std::string file = frame_file(opts.output, frame);
+    write_image(file, graph.get(image));
+    progress.step(file);
+    std::printf("%s\n", std::filesystem::absolute(file).string().c_str());
+  }
+  progress.finish();
+}
+
 void run_render(const RenderOptions& opts, const GlobalOptions& global) {
+  if (!opts.path.empty()) return run_render_path(opts, global);
+  if (!opts.frames.empty()) throw InputError("--frames", "needs --path NAME (a built-in scene's camera path)");
   const pipeline::FrameOptions& o = opts.frame;
   const pipeline::Technique& technique = pipeline::find_technique(o.technique);
   const int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
@@ -122,7 +199,8 @@ void add_render_command(CLI::App& app, GlobalOptions& global) {
   cmd->footer(
       "Example: speculum render glossy-plane --technique envmap --width 800 --height 600 --spp 4 -o out.png\n"
       "         speculum render sphere-in-room --technique reference --spp 64 -o ref.exr\n"
-      "         speculum render model.glb --env sky --view three-quarter -o model.png");
+      "         speculum render model.glb --env sky --view three-quarter -o model.png\n"
+      "         speculum render bathroom --technique soff --path walk --frames 0..59 -o f_####.png");
   opts->frame.width = 640;  // render's defaults; inspect and profile use smaller frames
   opts->frame.height = 480;
   opts->frame.exposure = "auto";  // a user's own scene in any units; comparisons pass 1
@@ -135,6 +213,10 @@ void add_render_command(CLI::App& app, GlobalOptions& global) {
                   "(world), roughness; named albedo.R, normal.X, depth.Z, ... For a denoiser or a "
                   "compositor. The reference tracer's are its first hits at the pixel centres");
   cmd->add_flag("--timings", opts->timings, "Print each pass's wall time on stderr");
+  cmd->add_option("--path", opts->path,
+                  "A built-in scene's camera path (bathroom: walk, pan; living-room: walk, orbit): renders "
+                  "--frames A..B of it, each frame to -o with its number in place of the '#'s");
+  cmd->add_option("--frames", opts->frames, "Frames of --path, e.g. 0..59 (inclusive)");
   cmd->callback([opts, cmd, &global] {
     opts->aov_given = cmd->count("--aov") > 0;
     run_render(*opts, global);

@@ -15,6 +15,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
   add_experiment_ray_hierarchy_subcommand(*cmd, global);
   add_experiment_yu_fig9_subcommand(*cmd, global);
   add_experiment_vertex_projection_subcommand(*cmd, global);
+  add_experiment_soff_subcommand(*cmd, global);
   (void)global;
 }
 

@@ -16,6 +16,7 @@
 #include "raster/reflector_maps.h"
 #include "raster/vertex_projection.h"
 #include "raster/shadow_map.h"
+#include "raster/soff.h"
 #include "raster/visibility.h"
 
 namespace speculum::inspect {
@@ -304,6 +305,12 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
       else if (!s.distance.empty())
         d.views.push_back(scalar_view(name, s.distance));
     }
+  } else if (const auto* clusters = o.as<raster::SoffClusters>()) {
+    // SOFF Fig. 4: every cluster in its own false colour, diffuse samples black.
+    d.size = dims(clusters->width, clusters->height) + ", " + std::to_string(clusters->count()) + " clusters";
+    IdBuffer ids(clusters->width, clusters->height);
+    ids.pixels = clusters->cluster;
+    d.views.push_back(id_view("clusters", ids));
   } else if (const auto* maps = o.as<raster::ReflectorMaps>()) {
     d.size = std::to_string(maps->cubes.size()) + " cube maps";
     for (std::size_t m = 0; m < maps->cubes.size() && m < kMaxListed; ++m)

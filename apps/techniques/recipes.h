@@ -34,6 +34,8 @@ FrameOutputs add_planar_mirror_passes(par::Graph& graph, const Scene* scene, con
 // vertex-projection (ROGER ch.2): reflector_cube_maps → envmap_reflect (fallback); tessellate,
 // reflector_param → vertex_project → reflected_triangles → vertex_projection_shade.
 FrameOutputs add_vertex_projection_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
+// soff (SOFF §3): soff_clusters → soff_cameras → soff_depth_images → soff_intersect.
+FrameOutputs add_soff_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // yu-lod (YU §3): bvh_build → radiance_bake → lod_build; glossy_rays → lod_trace → hit_radiance.
 // One sample per pixel: settings.spp is N, the glossy rays per pixel.
 FrameOutputs add_yu_lod_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);

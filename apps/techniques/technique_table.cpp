@@ -92,6 +92,21 @@ const std::vector<Technique>& techniques() {
        // cost up to (m-1)^depth views, so the depth stays small and the pass renders at most
        // 256 mirrored views in all (PlanarMirrorSettings::max_views, counted when reached).
        {{"depth", 3, 0, 8, true, "mirror bounces rendered by reflected cameras (at most 256 views in all)"}}},
+      {"soff",
+       "second-order feed-forward (SOFF §3): non-diffuse samples binned into clusters by normal "
+       "and reflector, a pinhole camera and a rasterized depth image per cluster, reflected rays "
+       "walked through it pixel by pixel; glossy: several lobe rays",
+       add_soff_passes,
+       // Each cluster renders the scene once: the bins bound the clusters (reflectors × θ × φ),
+       // and max_image_side bounds each depth image (4096²: 64M pixels, ~1.5 GB with its
+       // G-buffer); glossy_rays multiplies the intersection work per glossy sample.
+       {{"theta_bins", 13, 1, 64, true, "MAXTHETABINS: normal azimuth bins (clusters grow with it)"},
+        {"phi_bins", 8, 1, 32, true, "MAXPHIBINS: normal polar bins (clusters grow with it)"},
+        {"image_scale", 1, 0.125, 4, false, "depth-image resolution × this (SOFF Table 5)"},
+        {"max_image_side", 1024, 16, 4096, true, "largest depth-image side (clamped images are counted)"},
+        {"glossy_rays", 8, 1, 64, true, "reflected rays per glossy sample (SOFF §3.5: 8 to 49)"},
+        {"glossy_far", 1, 0.05, 1, false, "glossy clusters' far plane at this × the scene diameter (§3.5)"},
+        {"fill", 0, 0, 1, true, "disoccluded rays: 0 the environment (SOFF), 1 the depth image beside the silhouette"}}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",

@@ -1,6 +1,7 @@
 // Built-in scenes: valid at both ends of the size range, triangle counts track the size,
 // deterministic, outward-facing closed shapes, and the parameters are honoured.
 #include <cmath>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -15,11 +16,11 @@
 namespace speculum {
 namespace {
 
-TEST(ProceduralScenes, AllEightAreListedAndDefaultExists) {
-  EXPECT_EQ(builtin_scenes().size(), 8u);
-  for (const char* name : {"sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",
-                           "glass-sphere", "bowl", "bumpy-sphere", "ellipsoid"})
-    EXPECT_NE(find_builtin_scene(name), nullptr) << name;
+TEST(ProceduralScenes, EveryNamedSceneIsListedAndDefaultExists) {
+  const char* names[] = {"sphere-in-room", "glossy-plane", "mirror-corridor", "living-room", "glass-sphere",
+                         "bowl",           "bumpy-sphere", "ellipsoid",       "bathroom"};
+  EXPECT_EQ(builtin_scenes().size(), std::size(names));
+  for (const char* name : names) EXPECT_NE(find_builtin_scene(name), nullptr) << name;
   EXPECT_NE(find_builtin_scene(default_scene_name()), nullptr);
 }
 

@@ -1,0 +1,740 @@
+// Second-order feed-forward reflections: see soff.h.
+#include "raster/soff.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <glm/geometric.hpp>
+
+#include "core/optics.h"
+#include "core/sampling.h"
+#include "raster/direct_light.h"
+#include "raster/specular_radiance.h"
+#include "raster/tile_binning.h"
+#include "raster/triangle_setup.h"
+#include "raster/visibility.h"
+
+namespace speculum::raster {
+
+namespace {
+constexpr float kRadToDeg = 57.29577951308232f;
+// Reflected rays this close to parallel with the image plane (|r·n_c|) cannot be framed by
+// a camera behind the plane: they are left out of the frame and take the environment.
+constexpr float kMinAxisCos = 0.02f;
+// The glossy frame widening stops short of a hemisphere (tan grows without bound).
+constexpr float kMaxCone = 1.3f;
+// Triangles are culled per cluster frustum in groups of this many consecutive triangles of
+// one object (procedural and loaded meshes store neighbours together, so the groups' boxes
+// are tight): a box test per group, then only the kept groups' vertices are transformed.
+constexpr std::uint32_t kCullGroup = 128;
+// Depth-image pixels per cluster sample at image_scale 1 (see soff_camera's step 5).
+constexpr double kMaxPixelsPerSample = 4.0;
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// Clustering
+
+void soff_bin(const glm::vec3& n, float scale, const SoffBinSettings& bins, int& i, int& j) {
+  float theta = std::atan2(n.z, n.x) * kRadToDeg;
+  if (theta < 0.0f) theta += 360.0f;
+  const float phi = std::acos(std::clamp(n.y, -1.0f, 1.0f)) * kRadToDeg;
+  i = std::clamp(static_cast<int>(std::floor(float(bins.theta_bins) * theta / 360.0f * scale)), 0,
+                 bins.theta_bins - 1);
+  j = std::clamp(static_cast<int>(std::floor(float(bins.phi_bins) * phi / 180.0f * scale)), 0,
+                 bins.phi_bins - 1);
+}
+
+float soff_bin_scale(double percent, int visible) {
+  if (visible < 1) return 1.0f;
+  return static_cast<float>(std::min(1.0, percent / double(visible)));
+}
+
+SoffClusters soff_cluster(par::Executor& executor, const GBuffer& g, const SoffBinSettings& bins) {
+  SoffClusters out;
+  out.width = g.width;
+  out.height = g.height;
+  const std::size_t n = g.object.size();
+  // a_R: samples per reflector (the screen share), serially: one pass of integer adds.
+  std::uint32_t max_object = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (g.covered(i)) max_object = std::max(max_object, g.object.pixels[i]);
+  std::vector<std::uint64_t> per_object(n ? std::size_t(max_object) + 1 : 0, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (g.covered(i) && soff_reflects(g.surface.pixels[i])) ++per_object[g.object.pixels[i]];
+  std::vector<std::uint32_t> visible_index(per_object.size(), kNoId);
+  std::vector<std::uint32_t> visible_object;
+  for (std::size_t o = 0; o < per_object.size(); ++o)
+    if (per_object[o] > 0) {
+      visible_index[o] = static_cast<std::uint32_t>(visible_object.size());
+      visible_object.push_back(static_cast<std::uint32_t>(o));
+    }
+  out.visible_reflectors = static_cast<int>(visible_object.size());
+  std::vector<float> scale(visible_object.size());
+  for (std::size_t k = 0; k < visible_object.size(); ++k)
+    scale[k] = soff_bin_scale(100.0 * double(per_object[visible_object[k]]) / double(n),
+                              out.visible_reflectors);
+  const std::uint32_t per_reflector = std::uint32_t(bins.theta_bins) * std::uint32_t(bins.phi_bins);
+  // The fixed bin array: visible reflectors × θ bins × φ bins; each sample's bin is a pure
+  // function of its own normal and reflector (SOFF §4.3: no neighbour information).
+  std::vector<std::uint32_t> bin(n, kNoId);
+  executor.parallel_for("soff_clusters.bin", n, 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!g.covered(i) || !soff_reflects(g.surface.pixels[i])) continue;
+      const std::uint32_t k = visible_index[g.object.pixels[i]];
+      int ti = 0, pj = 0;
+      soff_bin(g.normal.pixels[i], scale[k], bins, ti, pj);
+      bin[i] = k * per_reflector + std::uint32_t(ti) * std::uint32_t(bins.phi_bins) + std::uint32_t(pj);
+    }
+  });
+  // Non-empty bins, in bin order, are the clusters.
+  std::vector<std::uint32_t> histogram(visible_object.size() * per_reflector, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (bin[i] != kNoId) ++histogram[bin[i]];
+  std::vector<std::uint32_t> cluster_of_bin(histogram.size(), kNoId);
+  out.offsets.push_back(0);
+  for (std::size_t b = 0; b < histogram.size(); ++b) {
+    if (histogram[b] == 0) continue;
+    cluster_of_bin[b] = static_cast<std::uint32_t>(out.reflector.size());
+    out.reflector.push_back(visible_object[b / per_reflector]);
+    out.offsets.push_back(out.offsets.back() + histogram[b]);
+  }
+  const std::size_t clusters = out.reflector.size();
+  out.cluster.assign(n, kNoId);
+  out.samples.resize(out.offsets.back());
+  out.sum_position.assign(clusters, glm::dvec3(0.0));
+  out.sum_normal.assign(clusters, glm::dvec3(0.0));
+  std::vector<std::uint32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+  // A stable counting sort and the per-cluster sums in sample order: the same bits for
+  // every thread count.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (bin[i] == kNoId) continue;
+    const std::uint32_t c = cluster_of_bin[bin[i]];
+    out.cluster[i] = c;
+    out.samples[fill[c]++] = static_cast<std::uint32_t>(i);
+    out.sum_position[c] += glm::dvec3(g.position.pixels[i]);
+    out.sum_normal[c] += glm::dvec3(g.normal.pixels[i]);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Cameras
+
+float soff_eq1(float d_n, float d_f, float d_F) {
+  const float den = d_f * (d_F - d_n);
+  if (!(std::abs(den) > 1e-12f) || !(d_n > 0.0f)) return 1.0f;
+  const float f = d_n * (d_F - d_f) / den;
+  return std::isfinite(f) ? f : 1.0f;
+}
+
+glm::mat4 SoffCamera::view_projection() const {
+  glm::mat4 view(1.0f);
+  view[0][0] = u.x, view[1][0] = u.y, view[2][0] = u.z;
+  view[0][1] = v.x, view[1][1] = v.y, view[2][1] = v.z;
+  view[0][2] = -w.x, view[1][2] = -w.y, view[2][2] = -w.z;
+  view[3][0] = -glm::dot(u, eye);
+  view[3][1] = -glm::dot(v, eye);
+  view[3][2] = glm::dot(w, eye);
+  // glm::frustum(l, r, b, t, near, far) written out (OpenGL clip space).
+  glm::mat4 p(0.0f);
+  p[0][0] = 2.0f * near_dist / (r - l);
+  p[1][1] = 2.0f * near_dist / (t - b);
+  p[2][0] = (r + l) / (r - l);
+  p[2][1] = (t + b) / (t - b);
+  p[2][2] = -(far_dist + near_dist) / (far_dist - near_dist);
+  p[2][3] = -1.0f;
+  p[3][2] = -2.0f * far_dist * near_dist / (far_dist - near_dist);
+  return p * view;
+}
+
+glm::vec3 SoffCamera::project(const glm::vec3& p) const {
+  const glm::vec3 q = p - eye;
+  const float z = glm::dot(q, w);
+  const float x = glm::dot(q, u) * near_dist / z, y = glm::dot(q, v) * near_dist / z;
+  return {(x - l) / (r - l) * float(width), (t - y) / (t - b) * float(height), 1.0f / z};
+}
+
+glm::vec3 SoffCamera::pixel_direction(float sx, float sy) const {
+  const float x = l + sx / float(width) * (r - l), y = t - sy / float(height) * (t - b);
+  return glm::normalize(x * u + y * v + near_dist * w);
+}
+
+namespace {
+
+struct Box2 {
+  glm::vec2 lo{3e38f}, hi{-3e38f};
+  void grow(glm::vec2 p) { lo = glm::min(lo, p), hi = glm::max(hi, p); }
+  float diagonal() const { return lo.x <= hi.x ? glm::length(hi - lo) : 0.0f; }
+};
+
+// In-plane coordinates (along u, v, on the plane at distance `near` from `eye` along w) of
+// the central projection of x from eye.
+glm::vec2 project_from(const glm::vec3& eye, float near, const glm::vec3& u, const glm::vec3& v,
+                       const glm::vec3& w, const glm::vec3& x) {
+  const glm::vec3 q = x - eye;
+  const float z = glm::dot(q, w);
+  return {glm::dot(q, u) * near / z, glm::dot(q, v) * near / z};
+}
+
+}  // namespace
+
+SoffCamera soff_camera(const glm::vec3& eye, const std::vector<glm::vec3>& positions,
+                       const std::vector<glm::vec3>& normals, const std::vector<glm::vec3>& reflected,
+                       const std::vector<SoffPair>& adjacent,
+                       float cone, float far_distance, const SoffCameraSettings& settings) {
+  SoffCamera cam;
+  const std::size_t n = positions.size();
+  if (n == 0) return cam;
+  // Step 1: image (and near) plane through the mean point with the mean normal.
+  glm::dvec3 sp(0.0), sn(0.0);
+  for (std::size_t i = 0; i < n; ++i) sp += glm::dvec3(positions[i]), sn += glm::dvec3(normals[i]);
+  const glm::vec3 pc = glm::vec3(sp / double(n));
+  const double sn_len = glm::length(sn);
+  if (!(sn_len > 1e-6 * double(n))) return cam;  // normals cancel: no plane
+  const glm::vec3 nc = glm::vec3(sn / sn_len);
+  cam.centre = pc;
+  cam.normal = nc;
+  const float h = glm::dot(eye - pc, nc);
+  if (!(h > 1e-6f)) return cam;  // the eye behind the mean plane (a grazing cluster)
+  // Step 3a: the eye reflected about the plane.
+  const glm::vec3 e0 = eye - 2.0f * h * nc;
+  cam.mirrored_eye = e0;
+  cam.w = nc;
+  const glm::vec3 helper = std::abs(nc.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+  cam.v = glm::normalize(helper - glm::dot(helper, nc) * nc);
+  cam.u = glm::cross(cam.v, -nc);  // u × v = −w: right-handed view space looking down −z
+  const float D = far_distance;
+  // Near endpoints on or in front of the image plane (a sample behind it, at a convex
+  // cluster's rim, starts where its ray crosses the plane) and far endpoints on the far plane.
+  std::vector<glm::vec3> near_end, far_end;
+  near_end.reserve(n), far_end.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float rn = glm::dot(reflected[i], nc);
+    if (!(rn > kMinAxisCos)) continue;
+    const float d = glm::dot(positions[i] - pc, nc);
+    near_end.push_back(d < 0.0f ? positions[i] + reflected[i] * (-d / rn) : positions[i]);
+    far_end.push_back(positions[i] + reflected[i] * ((D - d) / rn));
+  }
+  if (near_end.empty()) return cam;
+  // Step 3b, eq.1: diagonals of the near and far endpoints' frames seen from e0, and of the
+  // far endpoints on the far plane.
+  Box2 bn, bf, bF;
+  for (std::size_t i = 0; i < near_end.size(); ++i) {
+    bn.grow(project_from(e0, h, cam.u, cam.v, nc, near_end[i]));
+    bf.grow(project_from(e0, h, cam.u, cam.v, nc, far_end[i]));
+    bF.grow({glm::dot(far_end[i] - pc, cam.u), glm::dot(far_end[i] - pc, cam.v)});
+  }
+  cam.d_n = bn.diagonal(), cam.d_f = bf.diagonal(), cam.d_F = bF.diagonal();
+  // Bounded so that the eye stays at a sane distance for clusters whose diagonals are
+  // degenerate (a single ray: d_n = 0) or whose rays converge (concave: d_F < d_n).
+  cam.f = std::clamp(soff_eq1(cam.d_n, cam.d_f, cam.d_F), 0.02f, 50.0f);
+  cam.eye = pc + (e0 - pc) * cam.f;  // corrected eq.1 (see soff_eq1)
+  const float H = h * cam.f;
+  cam.near_dist = H;
+  cam.far_dist = H + D;
+  // SOFF §4.4's concavity test: the cluster's centre sample (the one nearest the mean
+  // point) behind the image plane; a planar cluster (within float noise) is not concave.
+  {
+    std::size_t best = 0;
+    float best_d = 3e38f;
+    float extent = 0.0f;
+    for (std::size_t i = 0; i < n; ++i) {
+      const float d2 = glm::dot(positions[i] - pc, positions[i] - pc);
+      extent = std::max(extent, d2);
+      if (d2 < best_d) best_d = d2, best = i;
+    }
+    cam.concave = glm::dot(positions[best] - pc, nc) < -1e-4f * std::sqrt(extent);
+  }
+  // Step 4: the frame, the box of both endpoints seen from e_c (widened for glossy cones).
+  Box2 frame;
+  for (std::size_t i = 0; i < near_end.size(); ++i) {
+    frame.grow(project_from(cam.eye, H, cam.u, cam.v, nc, near_end[i]));
+    frame.grow(project_from(cam.eye, H, cam.u, cam.v, nc, far_end[i]));
+  }
+  if (cone > 0.0f) {
+    cam.glossy = true;
+    cam.cone = std::min(cone, kMaxCone);
+    const float widen = std::tan(cam.cone) * D * H / (H + D);
+    frame.lo -= glm::vec2(widen), frame.hi += glm::vec2(widen);
+  }
+  // Step 5: the pixel size from the projected spacing of neighbouring cluster samples.
+  // Pairs with a point nearer the eye than half the near distance (a convex cluster's rim
+  // when the eye is close) would project with a blown-up spacing and are left out.
+  double spacing[2] = {0.0, 0.0};
+  std::size_t pairs[2] = {0, 0};
+  for (const SoffPair& q : adjacent) {
+    const glm::vec3 &pa = positions[q.a], &pb = positions[q.b];
+    if (glm::dot(pa - cam.eye, nc) < 0.5f * H || glm::dot(pb - cam.eye, nc) < 0.5f * H) continue;
+    spacing[q.vertical] += glm::length(project_from(cam.eye, H, cam.u, cam.v, nc, pa) -
+                                       project_from(cam.eye, H, cam.u, cam.v, nc, pb));
+    ++pairs[q.vertical];
+  }
+  glm::vec2 size = frame.hi - frame.lo;
+  float p = 0.0f;
+  for (int axis = 0; axis < 2; ++axis)
+    if (pairs[axis] > 0) {
+      const float mean = float(spacing[axis] / double(pairs[axis]));
+      if (mean > 0.0f) p = p > 0.0f ? std::min(p, mean) : mean;
+    }
+  if (!(p > 0.0f)) p = std::max({size.x, size.y, 1e-4f * H}) / 2.0f;
+  p /= settings.image_scale;
+  // Bounded work: a depth image holds at most kMaxPixelsPerSample × image_scale² pixels per
+  // cluster sample (a curved cluster's frame spans the whole solid angle its rays reach, and
+  // its finest spacing would otherwise ask for far more pixels than it has rays).
+  {
+    const double cap = double(kMaxPixelsPerSample) * double(settings.image_scale) * double(settings.image_scale) *
+                       double(std::max<std::size_t>(n, 4));
+    const double pixels = double(size.x + 2.0f * p) * double(size.y + 2.0f * p) / (double(p) * double(p));
+    if (pixels > cap) p *= float(std::sqrt(pixels / cap));
+  }
+  // One pixel of overlap on every side so that neighbouring clusters' images meet (SOFF
+  // §4.1.1: clusters overlap slightly, so the reflection has no gaps).
+  frame.lo -= glm::vec2(p), frame.hi += glm::vec2(p);
+  size = frame.hi - frame.lo;
+  const double wd = std::ceil(double(size.x) / p), hd = std::ceil(double(size.y) / p);
+  const double side = double(settings.max_image_side);
+  cam.clamped = wd > side || hd > side;
+  cam.width = int(std::clamp(wd, 1.0, side));
+  cam.height = int(std::clamp(hd, 1.0, side));
+  cam.l = frame.lo.x, cam.r = frame.hi.x, cam.b = frame.lo.y, cam.t = frame.hi.y;
+  cam.valid = std::isfinite(cam.l) && std::isfinite(cam.r) && std::isfinite(cam.b) && std::isfinite(cam.t) &&
+              cam.r > cam.l && cam.t > cam.b && H > 0.0f;
+  return cam;
+}
+
+SoffCameras soff_cameras(par::Executor& executor, const GBuffer& g, const SoffClusters& clusters,
+                         const SoffCameraSettings& settings) {
+  SoffCameras cameras(clusters.count());
+  executor.parallel_for("soff_cameras.build", clusters.count(), 1, [&](std::size_t begin, std::size_t end) {
+    std::vector<glm::vec3> positions, normals, reflected;
+    std::vector<SoffPair> adjacent;
+    for (std::size_t c = begin; c < end; ++c) {
+      const std::uint32_t first = clusters.offsets[c], count = clusters.size_of(c);
+      positions.resize(count), normals.resize(count), reflected.resize(count);
+      adjacent.clear();
+      float cone = 0.0f;
+      for (std::uint32_t k = 0; k < count; ++k) {
+        const std::uint32_t i = clusters.samples[first + k];
+        const glm::vec3 nrm = g.normal.pixels[i];
+        positions[k] = g.position.pixels[i];
+        normals[k] = nrm;
+        reflected[k] = reflect(-g.view_direction(i), nrm);
+        const SurfaceParams& s = g.surface.pixels[i];
+        if (s.is_glossy_lobe()) {
+          // The GGX lobe's reflected directions: 90% of the half-vector distribution lies
+          // within tan θ_h = 3α, and the reflected direction turns by 2θ_h.
+          const float alpha = s.roughness * s.roughness;
+          cone = std::max(cone, 2.0f * std::atan(3.0f * alpha));
+        }
+        // Step 5's pairs: the right and lower neighbours that belong to the same cluster.
+        const std::uint32_t x = i % std::uint32_t(g.width), y = i / std::uint32_t(g.width);
+        if (x + 1 < std::uint32_t(g.width) && clusters.cluster[i + 1] == c)
+          adjacent.push_back({k, k + 1, false});  // samples are in increasing order: i + 1 is next
+        if (y + 1 < std::uint32_t(g.height) && clusters.cluster[i + g.width] == c) {
+          const auto below = std::lower_bound(clusters.samples.begin() + first,
+                                              clusters.samples.begin() + first + count,
+                                              i + std::uint32_t(g.width));
+          adjacent.push_back({k, std::uint32_t(below - (clusters.samples.begin() + first)), true});
+        }
+      }
+      const float far = cone > 0.0f ? settings.scene_diameter * settings.glossy_far : settings.scene_diameter;
+      cameras[c] = soff_camera(g.eye, positions, normals, reflected, adjacent, cone, far, settings);
+    }
+  });
+  return cameras;
+}
+
+// ---------------------------------------------------------------------------------------
+// Depth images
+
+namespace {
+
+struct FrustumPlanes {
+  glm::vec3 n[6];
+  float d[6];  // inside: dot(n, x) + d >= 0
+};
+
+FrustumPlanes frustum_planes(const SoffCamera& c) {
+  FrustumPlanes f;
+  const glm::vec3 normals[6] = {c.near_dist * c.u - c.l * c.w, c.r * c.w - c.near_dist * c.u,
+                                c.near_dist * c.v - c.b * c.w, c.t * c.w - c.near_dist * c.v,
+                                c.w, -c.w};
+  for (int k = 0; k < 4; ++k) {
+    f.n[k] = normals[k];
+    f.d[k] = -glm::dot(normals[k], c.eye);
+  }
+  f.n[4] = c.w, f.d[4] = -glm::dot(c.w, c.eye) - c.near_dist;
+  f.n[5] = -c.w, f.d[5] = glm::dot(c.w, c.eye) + c.far_dist;
+  return f;
+}
+
+bool box_outside(const FrustumPlanes& f, const Bounds& b) {
+  for (int k = 0; k < 6; ++k) {
+    const glm::vec3 corner(f.n[k].x >= 0.0f ? b.hi.x : b.lo.x, f.n[k].y >= 0.0f ? b.hi.y : b.lo.y,
+                           f.n[k].z >= 0.0f ? b.hi.z : b.lo.z);
+    if (glm::dot(f.n[k], corner) + f.d[k] < 0.0f) return true;
+  }
+  return false;
+}
+
+struct CullGroup {
+  std::uint32_t first = 0, count = 0, object = 0;
+  Bounds box;
+};
+
+}  // namespace
+
+SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, const SoffClusters& clusters,
+                                  const SoffCameras& cameras, const std::vector<ShadowMap>& shadows,
+                                  const EnvironmentMap& env, SoffDepthStats* stats) {
+  SoffDepthImages out;
+  const TriangleMesh& m = scene.mesh;
+  // Groups of consecutive triangles of one object and their boxes (the scene may move every
+  // frame, so they are rebuilt here: one pass over the triangles).
+  std::vector<CullGroup> groups;
+  for (std::uint32_t o = 0; o < scene.objects.size(); ++o) {
+    const Object& obj = scene.objects[o];
+    for (std::uint32_t t = 0; t < obj.triangle_count; t += kCullGroup)
+      groups.push_back({obj.first_triangle + t, std::min(kCullGroup, obj.triangle_count - t), o, {}});
+  }
+  executor.parallel_for("soff_depth_images.group_bounds", groups.size(), 64,
+                        [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k)
+      for (std::uint32_t t = groups[k].first; t < groups[k].first + groups[k].count; ++t)
+        for (int v = 0; v < 3; ++v) groups[k].box.grow(m.positions[m.indices[3 * t + v]]);
+  });
+  out.offsets.assign(cameras.size() + 1, 0);
+  for (std::size_t c = 0; c < cameras.size(); ++c)
+    out.offsets[c + 1] =
+        out.offsets[c] + (cameras[c].valid ? std::size_t(cameras[c].width) * std::size_t(cameras[c].height) : 0);
+  out.pixels = out.offsets.back();
+  out.inv_z.assign(out.pixels, 0.0f);
+  out.colour.assign(out.pixels, glm::vec3(0.0f));
+
+  SoffDepthStats st;
+  std::vector<std::uint32_t> kept, indices, objects;
+  std::vector<glm::vec3> positions;
+  std::vector<ScreenVertex> vertices;
+  TileBins bins;
+  VisibilityBuffer vis;
+  GBuffer gb;
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    const SoffCamera& cam = cameras[c];
+    if (!cam.valid) continue;
+    ++st.images;
+    // Cull per cluster frustum before setup: whole groups outside one plane are dropped,
+    // and the cluster's own reflector is left out (first-order: SOFF §4.4).
+    const FrustumPlanes planes = frustum_planes(cam);
+    kept.clear();
+    for (const CullGroup& grp : groups) {
+      if (grp.object == clusters.reflector[c]) continue;
+      if (box_outside(planes, grp.box)) {
+        st.triangles_culled += grp.count;
+        continue;
+      }
+      for (std::uint32_t t = grp.first; t < grp.first + grp.count; ++t) kept.push_back(t);
+    }
+    st.triangles_set_up += kept.size();
+    // Three vertices per kept triangle (shared vertices snap identically: make_screen_vertex
+    // is a pure function, so the mesh stays watertight).
+    positions.resize(3 * kept.size());
+    vertices.resize(3 * kept.size());
+    objects.resize(kept.size());
+    if (indices.size() < 3 * kept.size()) {
+      const std::size_t old = indices.size();
+      indices.resize(3 * kept.size());
+      std::iota(indices.begin() + std::ptrdiff_t(old), indices.end(), std::uint32_t(old));
+    }
+    const Viewport vp{cam.width, cam.height};
+    const glm::mat4 vp_matrix = cam.view_projection();
+    executor.parallel_for("soff_depth_images.vertices", kept.size(), 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::uint32_t t = kept[k];
+        for (int v = 0; v < 3; ++v) positions[3 * k + v] = m.positions[m.indices[3 * t + v]];
+        objects[k] = m.triangle_object[t];
+      }
+      make_screen_vertices(vp_matrix, &positions[3 * begin], 3 * (end - begin), vp, &vertices[3 * begin]);
+    });
+    const std::vector<std::uint32_t> used(indices.begin(), indices.begin() + std::ptrdiff_t(3 * kept.size()));
+    rasterize_screen_vertices(executor, vertices, used, objects, cam.width, cam.height, {}, bins, vis);
+    for (auto& t : vis.triangle.pixels)
+      if (t != kNoId) t = kept[t];
+    resolve_gbuffer(executor, scene, vis, cam.eye, gb);
+    const std::size_t base = out.offsets[c];
+    executor.parallel_for("soff_depth_images.shade", gb.object.size(), 2048, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        if (gb.covered(i)) {
+          out.inv_z[base + i] = 1.0f / vis.depth.pixels[i];
+          out.colour[base + i] = shade_surface(scene, gb.surface.pixels[i], gb.position.pixels[i],
+                                               gb.normal.pixels[i], gb.view_direction(i), shadows, env);
+        } else {
+          const float sx = float(i % std::size_t(cam.width)) + 0.5f, sy = float(i / std::size_t(cam.width)) + 0.5f;
+          out.colour[base + i] = env.radiance(cam.pixel_direction(sx, sy), 1e6f);
+        }
+      }
+    });
+  }
+  out.triangles_set_up = st.triangles_set_up;
+  st.objects_culled = 0;
+  if (stats) *stats = st;
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Intersection
+
+SoffWalkResult soff_walk(const SoffCamera& cam, const float* inv_z, const glm::vec3& p, const glm::vec3& d) {
+  SoffWalkResult res;
+  const float dz = glm::dot(d, cam.w);
+  if (!(dz > 1e-4f)) {
+    res.kind = SoffWalkResult::Unrepresentable;
+    return res;
+  }
+  const float zp = glm::dot(p - cam.eye, cam.w);
+  const glm::vec3 start = zp < cam.near_dist ? p + d * ((cam.near_dist - zp) / dz) : p;
+  const glm::vec3 end = p + d * ((cam.far_dist - zp) / dz);
+  const glm::vec3 a = cam.project(start), b = cam.project(end);
+  const float dx = b.x - a.x, dy = b.y - a.y;
+  const int w = cam.width, h = cam.height;
+  const int steps = std::max(1, int(std::ceil(std::max(std::abs(dx), std::abs(dy)))));
+  auto stored = [&](float sx, float sy, bool& inside) {
+    const int ix = int(std::floor(sx)), iy = int(std::floor(sy));
+    inside = ix >= 0 && iy >= 0 && ix < w && iy < h;
+    return inside ? inv_z[std::size_t(iy) * std::size_t(w) + std::size_t(ix)] : 0.0f;
+  };
+  bool inside = true;
+  float ray_a = a.z, di_a = stored(a.x, a.y, inside);
+  if (!inside) return res;  // Miss: the ray starts outside the frame
+  float prev_jump = 0.0f;
+  bool hidden = false;
+  for (int k = 1; k <= steps; ++k) {
+    const float s = float(k) / float(steps);
+    const float sx = a.x + dx * s, sy = a.y + dy * s;
+    const float ray_b = a.z + (b.z - a.z) * s;  // 1/z is linear in screen space
+    const float di_b = stored(sx, sy, inside);
+    ++res.steps;
+    if (!inside) break;
+    // In front: the ray is nearer than the stored surface (larger 1/z); empty pixels (0)
+    // never stop it.
+    const float da = ray_a - di_a, db = ray_b - di_b;
+    const float jump = di_b - di_a;
+    if (da > 0.0f && db <= 0.0f) {
+      // A crossing. The stored segment continues a surface unless it jumps in front of where
+      // the ray was, by more than the surface's own slope: then the ray passed behind a
+      // silhouette into what the depth image does not hold.
+      const bool silhouette = di_b > ray_a && jump > 2.0f * std::max(std::abs(prev_jump), ray_a - ray_b);
+      if (!silhouette) {
+        const float frac = da / (da - db);
+        const float s_hit = (float(k - 1) + frac) / float(steps);
+        res.kind = SoffWalkResult::Hit;
+        res.sx = a.x + dx * s_hit;
+        res.sy = a.y + dy * s_hit;
+        res.inv_z = a.z + (b.z - a.z) * s_hit;
+        return res;
+      }
+      if (!hidden) res.sx = a.x + dx * (float(k - 1) / float(steps)), res.sy = a.y + dy * (float(k - 1) / float(steps));
+      hidden = true;
+    }
+    prev_jump = jump;
+    ray_a = ray_b;
+    di_a = di_b;
+  }
+  res.kind = hidden ? SoffWalkResult::Disoccluded : SoffWalkResult::Miss;
+  return res;
+}
+
+namespace {
+
+glm::vec3 bilinear(const glm::vec3* colour, int w, int h, float sx, float sy) {
+  const float x = sx - 0.5f, y = sy - 0.5f;
+  const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+  const float fx = x - float(x0), fy = y - float(y0);
+  auto at = [&](int xx, int yy) {
+    xx = std::clamp(xx, 0, w - 1), yy = std::clamp(yy, 0, h - 1);
+    return colour[std::size_t(yy) * std::size_t(w) + std::size_t(xx)];
+  };
+  return (at(x0, y0) * (1.0f - fx) + at(x0 + 1, y0) * fx) * (1.0f - fy) +
+         (at(x0, y0 + 1) * (1.0f - fx) + at(x0 + 1, y0 + 1) * fx) * fy;
+}
+
+}  // namespace
+
+ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffClusters& clusters,
+                         const SoffCameras& cameras, const SoffDepthImages& images,
+                         const EnvironmentMap& env, const SoffIntersectSettings& settings,
+                         SoffIntersectStats* stats) {
+  constexpr std::size_t kChunk = 1024;
+  ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  std::vector<SoffIntersectStats> per_chunk(par::Executor::chunk_count(out.size(), kChunk));
+  executor.parallel_for("soff_intersect.walk", out.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    SoffIntersectStats& st = per_chunk[begin / kChunk];
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!g.covered(i)) continue;
+      const SurfaceParams& s = g.surface.pixels[i];
+      if (!is_specular(s)) continue;
+      const glm::vec3 n = g.normal.pixels[i], v = g.view_direction(i);
+      const auto env_lookup = [&](const glm::vec3& d, float exponent) { return env.radiance(d, exponent); };
+      const std::uint32_t c = clusters.cluster[i];
+      if (!soff_reflects(s) || c == kNoId || !cameras[c].valid) {
+        if (soff_reflects(s)) ++st.unclustered_samples;
+        out.pixels[i] = glm::vec4(specular_radiance(s, n, v, env_lookup), 1.0f);
+        continue;
+      }
+      const SoffCamera& cam = cameras[c];
+      const float* inv_z = images.inv_z.data() + images.offsets[c];
+      const glm::vec3* colour = images.colour.data() + images.offsets[c];
+      int disoccluded = 0, rays = 0;
+      const bool fade = cam.glossy && settings.glossy_fade;
+      // The radiance a reflected ray from this sample finds in the depth image, or the
+      // environment (a miss, a disocclusion, a direction the camera cannot frame).
+      const auto trace = [&](const glm::vec3& d) {
+        ++st.rays, ++rays;
+        const SoffWalkResult r = soff_walk(cam, inv_z, g.position.pixels[i], d);
+        st.steps += r.steps;
+        if (r.steps <= 1) ++st.planar_lookups;
+        if (r.kind == SoffWalkResult::Hit) {
+          ++st.hits;
+          const glm::vec3 hit = bilinear(colour, cam.width, cam.height, r.sx, r.sy);
+          if (!fade) return hit;
+          // SOFF §3.5: a glossy reflection fades as the reflected surface nears the pulled-in
+          // far plane, here over the last quarter of the depth range, towards what a ray
+          // beyond the far plane gets (the environment), so nothing pops at the plane.
+          const float z = 1.0f / r.inv_z;
+          const float weight = std::clamp((cam.far_dist - z) / (0.25f * (cam.far_dist - cam.near_dist)), 0.0f, 1.0f);
+          return weight * hit + (1.0f - weight) * env.radiance(d, 1e6f);
+        }
+        ++st.env_fallback;
+        if (r.kind == SoffWalkResult::Disoccluded) {
+          ++st.disoccluded_rays, ++disoccluded;
+          // The depth image's sample just before the silhouette the ray passed behind.
+          if (settings.fill_disocclusions) return bilinear(colour, cam.width, cam.height, r.sx, r.sy);
+        }
+        return env.radiance(d, 1e6f);
+      };
+      glm::vec3 radiance(0.0f);
+      if (s.is_glossy_lobe()) {
+        // SOFF §3.5: several reflected rays per glossy sample, here drawn from the shared
+        // GGX lobe (the application's BRDF of §3.1's G(d_i, g)) with its estimator weight
+        // F G2/G1, from a per-pixel rotated Hammersley set; rays below the surface count 0.
+        const int k_rays = settings.glossy_rays;
+        const glm::vec2 offset = random_float2(std::uint32_t(i), 0, 0, settings.seed);
+        for (int k = 0; k < k_rays; ++k) {
+          const glm::vec2 u = rotate_unit_square(hamersley(std::uint32_t(k), std::uint32_t(k_rays)), offset);
+          const LobeSample lobe = sample_specular_lobe(s, n, v, u);
+          if (lobe.weight == glm::vec3(0.0f)) continue;
+          radiance += lobe.weight * trace(lobe.direction);
+        }
+        radiance /= float(k_rays);
+      } else {
+        radiance = specular_radiance(s, n, v, [&](const glm::vec3& d, float) { return trace(d); });
+      }
+      // A sample is disoccluded when most of its rays are (a mirror's one ray; a glossy
+      // lobe's majority), so the count compares with SOFF's per-pixel figure.
+      if (2 * disoccluded > rays) ++st.disoccluded_samples;
+      out.pixels[i] = glm::vec4(radiance, 1.0f);
+    }
+  });
+  if (stats)
+    for (const SoffIntersectStats& c : per_chunk) {
+      stats->rays += c.rays;
+      stats->steps += c.steps;
+      stats->hits += c.hits;
+      stats->env_fallback += c.env_fallback;
+      stats->disoccluded_rays += c.disoccluded_rays;
+      stats->disoccluded_samples += c.disoccluded_samples;
+      stats->unclustered_samples += c.unclustered_samples;
+      stats->planar_lookups += c.planar_lookups;
+    }
+  return out;
+}
+
+ImageRGBA soff_cluster_image(const SoffClusters& clusters) {
+  ImageRGBA out(clusters.width, clusters.height, glm::vec4(0.5f, 0.5f, 0.5f, 1.0f));
+  for (std::size_t i = 0; i < clusters.cluster.size(); ++i) {
+    const std::uint32_t c = clusters.cluster[i];
+    if (c == kNoId) continue;
+    // A hash of the id to a saturated hue, so neighbouring clusters differ.
+    const float hue = random_float(c, 0, 0, 0x50ffu) * 6.0f;
+    const float x = 1.0f - std::abs(std::fmod(hue, 2.0f) - 1.0f);
+    const int sector = int(hue);
+    glm::vec3 rgb = sector == 0 ? glm::vec3(1, x, 0) : sector == 1 ? glm::vec3(x, 1, 0)
+                  : sector == 2 ? glm::vec3(0, 1, x) : sector == 3 ? glm::vec3(0, x, 1)
+                  : sector == 4 ? glm::vec3(x, 0, 1) : glm::vec3(1, 0, x);
+    out.pixels[i] = glm::vec4(rgb * (0.35f + 0.65f * random_float(c, 1, 0, 0x50ffu)), 1.0f);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Passes
+
+SoffClusters SoffClustersPass::operator()(par::NodeContext& c, const GBuffer& gbuffer) const {
+  SoffClusters clusters = soff_cluster(c.executor(), gbuffer, bins);
+  c.count("clusters", double(clusters.count()));
+  c.count("visible_reflectors", clusters.visible_reflectors);
+  c.count("clustered_samples", double(clusters.samples.size()));
+  if (clusters.count() > 0) {
+    std::vector<std::uint32_t> sizes(clusters.count());
+    for (std::size_t k = 0; k < sizes.size(); ++k) sizes[k] = clusters.size_of(k);
+    std::sort(sizes.begin(), sizes.end());
+    c.count("samples_per_cluster_min", sizes.front());
+    c.count("samples_per_cluster_median", sizes[sizes.size() / 2]);
+    c.count("samples_per_cluster_max", sizes.back());
+  }
+  return clusters;
+}
+
+SoffCameras SoffCamerasPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                        const SoffClusters& clusters) const {
+  SoffCameraSettings s = settings;
+  const Bounds b = scene->bounds();
+  s.scene_diameter = b.valid() ? std::max(glm::length(b.extent()), 1e-3f) : 1.0f;
+  SoffCameras cameras = soff_cameras(c.executor(), gbuffer, clusters, s);
+  std::uint64_t valid = 0, concave = 0, clamped = 0, planar = 0, pixels = 0;
+  for (const SoffCamera& cam : cameras) {
+    if (!cam.valid) continue;
+    ++valid;
+    concave += cam.concave;
+    clamped += cam.clamped;
+    planar += std::abs(cam.f - 1.0f) < 1e-3f;
+    pixels += std::uint64_t(cam.width) * std::uint64_t(cam.height);
+  }
+  c.count("cameras", double(valid));
+  c.count("invalid_cameras", double(cameras.size() - valid));
+  c.count("concave_clusters", double(concave));
+  c.count("clamped_images", double(clamped));
+  c.count("planar_clusters", double(planar));
+  c.count("depth_image_pixels", double(pixels));
+  return cameras;
+}
+
+SoffDepthImages SoffDepthImagesPass::operator()(par::NodeContext& c, const SoffClusters& clusters,
+                                                const SoffCameras& cameras, const ShadowMaps& shadows,
+                                                const EnvironmentMap& environment) const {
+  SoffDepthStats st;
+  SoffDepthImages images = soff_depth_images(c.executor(), *scene, clusters, cameras, shadows, environment, &st);
+  c.count("images", double(st.images));
+  c.count("triangles_set_up", double(st.triangles_set_up));
+  c.count("triangles_culled", double(st.triangles_culled));
+  c.count("pixels", double(images.pixels));
+  return images;
+}
+
+ImageRGBA SoffIntersectPass::operator()(par::NodeContext& c, const GBuffer& gbuffer, const SoffClusters& clusters,
+                                        const SoffCameras& cameras, const SoffDepthImages& images,
+                                        const EnvironmentMap& environment) const {
+  SoffIntersectStats st;
+  ImageRGBA specular = soff_intersect(c.executor(), gbuffer, clusters, cameras, images, environment, settings, &st);
+  c.count("rays", double(st.rays));
+  c.count("steps", double(st.steps));
+  c.count("hits", double(st.hits));
+  c.count("env_fallback", double(st.env_fallback));
+  c.count("disoccluded_rays", double(st.disoccluded_rays));
+  c.count("disoccluded_samples", double(st.disoccluded_samples));
+  c.count("unclustered_samples", double(st.unclustered_samples));
+  c.count("planar_lookups", double(st.planar_lookups));
+  return specular;
+}
+
+}  // namespace speculum::raster
