@@ -15,6 +15,7 @@
 #include "core/sampling.h"
 #include "core/shading.h"
 #include "trace/hit_surface.h"
+#include "trace/light_tracer.h"
 #include "trace/traversal.h"
 
 namespace speculum::trace {
@@ -159,6 +160,20 @@ ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& cam
     tr.stats.stack_overflows = tr.counters.stack_overflows;
     per_chunk[b / kChunk] = tr.stats;
   });
+  if (opt.caustic_photons > 0) {
+    PhotonOptions po;
+    po.photons = opt.caustic_photons;
+    po.max_depth = opt.max_depth;
+    po.seed = opt.seed;
+    PhotonStats ps;
+    const ImageRGBA caustics = render_caustics(scene, bvh, camera, opt.width, opt.height, po, ex, &ps);
+    for (std::size_t i = 0; i < pixels; ++i)
+      image.pixels[i] += glm::vec4(glm::vec3(caustics.pixels[i]), 0.0f);
+    if (stats) {
+      stats->caustic_photons += ps.photons;
+      stats->caustic_splats += ps.splats;
+    }
+  }
   if (stats) {
     for (const ReferenceStats& s : per_chunk) {
       stats->camera_rays += s.camera_rays;
@@ -178,6 +193,10 @@ ImageRGBA ReferencePass::operator()(par::NodeContext& c) const {
   c.count("camera_rays", stats.camera_rays);
   c.count("shadow_rays", stats.shadow_rays);
   c.count("specular_rays", stats.specular_rays);
+  if (options.caustic_photons > 0) {
+    c.count("caustic_photons", static_cast<double>(stats.caustic_photons));
+    c.count("caustic_splats", static_cast<double>(stats.caustic_splats));
+  }
   return radiance;
 }
 
