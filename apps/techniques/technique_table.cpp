@@ -103,6 +103,21 @@ const std::vector<Technique>& techniques() {
         {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
         // ≈ 150 MB per refractor at 1024² faces, ≈ 3.6 GB at 4096².
         {"impostor_size", 128, 4, 1024, true, "cube face side of the distance impostors (method 2; ~150 MB each at 1024)"}}},
+      {"caustics",
+       "caustics (SURVEY §6): photons shot from each light through each mirror/refractor, "
+       "receivers found in its distance map, stored in a cube map at the generator, splats or "
+       "caustic triangles, gathered with a distance check; distance-map reflection/refraction",
+       add_caustics_passes,
+       // Photon images cost photon_res² texels per light and generator (512: 262k each), the
+       // caustic map 6·caustic_size² texels (1024: ~200 MB per generator).
+       {{"photon_res", 128, 16, 512, true, "photon image side per light and generator (512: 262k photons)"},
+        {"filter", 0, 0, 1, true, "0 splat (normalized tent kernel), 1 caustic triangles (then blurred)"},
+        {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (filter 0)"},
+        {"caustic_size", 128, 16, 1024, true, "cube face side of the caustic map (1024: ~200 MB per generator)"},
+        {"tolerance", 0.05, 0.001, 1, false, "relative distance mismatch still taken as the photons' receiver"},
+        {"linear_steps", 16, 0, 256, true, "linear search steps (receiver and exit searches; < 2: off)"},
+        {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
+        {"impostor_size", 128, 4, 1024, true, "cube face side of the refractors' distance impostors (~150 MB each at 1024)"}}},
       {"yu-lod",
        "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
        "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",

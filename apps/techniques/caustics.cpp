@@ -1,0 +1,52 @@
+// The caustics technique's recipe (SURVEY §6): the distance-map frame (mirrors searched in
+// their colour + distance cubes, refractors by distance impostors, §4), with the direct
+// light completed by the caustics of the light pass: caustic_photons → caustic_map →
+// caustic_gather.
+#include "apps/techniques/frame_passes.h"
+#include "apps/techniques/recipes.h"
+#include "raster/caustics.h"
+#include "raster/distance_map_reflect.h"
+#include "raster/reflector_maps.h"
+#include "raster/refraction.h"
+#include "raster/refraction_impostor.h"
+
+namespace speculum::pipeline {
+
+using namespace speculum::raster;
+
+FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
+  DistanceSearchOptions search;
+  search.linear_steps = static_cast<int>(f.param("linear_steps"));
+  search.linear = search.linear_steps >= 2;
+  search.secant_steps = static_cast<int>(f.param("secant_steps"));
+  const SurfaceResources s = add_surface_passes(g, scene, f);
+  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size}, s.shadow_maps,
+                    s.environment, s.gbuffer)
+                  .describe("Colour + distance cube map around each specular object, itself left out: "
+                            "what reflected rays and the photons leaving a generator search (SURVEY §4.1, §6.1).");
+  auto impostors = g.add("refractor_impostors",
+                         RefractorImpostorsPass{scene, static_cast<int>(f.param("impostor_size"))});
+  CausticPhotonOptions po;
+  po.photon_res = static_cast<int>(f.param("photon_res"));
+  po.receiver_search = search;
+  po.exit_search = search;
+  auto photons = g.add("caustic_photons", CausticPhotonsPass{scene, po}, maps, impostors);
+  CausticMapOptions mo;
+  mo.size = static_cast<int>(f.param("caustic_size"));
+  mo.filter = static_cast<CausticFilter>(static_cast<int>(f.param("filter")));
+  mo.splat_radius = static_cast<int>(f.param("splat_radius"));
+  auto caustic_maps = g.add("caustic_map", CausticMapPass{scene, mo}, photons);
+  auto lit = g.add("caustic_gather", CausticGatherPass{static_cast<float>(f.param("tolerance"))}, s.gbuffer,
+                   caustic_maps, s.direct);
+  auto reflected = g.add("distance_map_reflect", DistanceMapReflectPass{search}, s.gbuffer, s.environment, maps);
+  RefractionOptions ro;
+  ro.method = RefractionMethod::DistanceImpostor;
+  ro.environment_search = search;
+  ro.exit_search = search;
+  auto specular = g.add("refraction", RefractionPass{scene, f.camera, ro}, s.gbuffer, s.visibility, maps,
+                        s.environment, reflected, par::Resource<GBuffer>{}, par::Resource<VertexThickness>{},
+                        impostors);
+  return add_output_passes(g, f, lit, specular);
+}
+
+}  // namespace speculum::pipeline
