@@ -19,6 +19,7 @@ namespace speculum::raster {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kMaxSplatRadius = 8;  // texels: bounds a splat's work ((2r+1)² texels)
 
 bool generator_material(const SurfaceParams& s) { return s.is_refractor() || s.is_mirror_lobe(); }
 
@@ -41,9 +42,19 @@ Sphere bounding_sphere(const Scene& scene, const Object& obj) {
   return {b.center(), std::sqrt(r2) * 1.01f + 1e-6f};
 }
 
-// Face-local continuous pixel coordinates of d on `face` (unclamped) — for triangles whose
-// corners share a face.
-glm::vec2 face_pixel(const glm::vec3& d, int size) { return cube_coord(d, size).pixel; }
+// Continuous pixel coordinates of direction d projected on the plane of `face`, unclamped
+// (beyond [0, size] off the face): so caustic triangles and photon spacings that straddle a
+// face edge are measured in one face's texels. False when d points away from the face.
+bool face_pixel(const glm::vec3& d, int face, int size, glm::vec2& out) {
+  const float s = static_cast<float>(size);
+  const glm::vec3 f = cube_direction(face, {0.5f * s, 0.5f * s}, size);
+  const glm::vec3 r = cube_direction(face, {s, 0.5f * s}, size) * std::sqrt(2.0f) - f;
+  const glm::vec3 u = cube_direction(face, {0.5f * s, 0.0f}, size) * std::sqrt(2.0f) - f;
+  const float depth = glm::dot(d, f);
+  if (depth <= 0.0f) return false;
+  out = {(glm::dot(d, r) / depth + 1.0f) * 0.5f * s, (1.0f - glm::dot(d, u) / depth) * 0.5f * s};
+  return true;
+}
 
 // A caustic map being built: flux, weight and Σ weight·distance in the cube, Σ weight·wi
 // beside it.
@@ -348,27 +359,45 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
     const int res = img.res;
     auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
     if (opt.filter == CausticFilter::Splat) {
-      for (std::size_t i = 0; i < img.valid.size(); ++i) {
-        if (!img.valid[i]) continue;
-        const glm::vec3 d = img.hit[i] - m.centre;
-        splat(target, d, img.flux[i], glm::length(d), img.wi[i], opt.splat_radius);
-      }
+      for (int y = 0; y < res; ++y)
+        for (int x = 0; x < res; ++x) {
+          const std::size_t i = idx(x, y);
+          if (!img.valid[i]) continue;
+          const glm::vec3 d = img.hit[i] - m.centre;
+          const float dist = glm::length(d);
+          int radius = opt.splat_radius;
+          if (opt.adaptive) {
+            // The photon's reach: the farthest of its photon-image neighbours on the same
+            // receiver (distances within 20 %), in caustic-map texels, so sparse photons
+            // leave no holes and dense ones stay sharp.
+            const CubeCoord c = cube_coord(d, m.size);
+            float spacing = 0.0f;
+            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+            for (int k = 0; k < 4; ++k) {
+              if (nx[k] < 0 || ny[k] < 0 || nx[k] >= res || ny[k] >= res) continue;
+              const std::size_t j = idx(nx[k], ny[k]);
+              if (!img.valid[j]) continue;
+              const glm::vec3 dj = img.hit[j] - m.centre;
+              const float lj = glm::length(dj);
+              if (std::max(lj, dist) > 1.2f * std::min(lj, dist)) continue;
+              glm::vec2 pj;
+              if (face_pixel(dj, c.face, m.size, pj)) spacing = std::max(spacing, glm::length(pj - c.pixel));
+            }
+            radius = std::max(radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
+          }
+          splat(target, d, img.flux[i], dist, img.wi[i], radius);
+        }
       continue;
     }
-    // Caustic triangles (§6.3.2): a cell of four neighbouring photons on one face whose
-    // receiver distances agree within 20 % (one receiver surface) makes two triangles. Each
-    // photon's flux is shared equally by the cells it is a corner of; a photon in none is
-    // splatted into its texel.
+    // Caustic triangles (§6.3.2): a cell of four neighbouring photons whose receiver
+    // distances agree within 20 % (one receiver surface) makes two triangles, drawn on the
+    // face of the cell's mean direction. Each photon's flux is shared equally by the cells it
+    // is a corner of; a photon in none is splatted into its texel.
     const int cells = res - 1;
     std::vector<std::uint8_t> cell_ok(static_cast<std::size_t>(std::max(cells, 0)) * std::max(cells, 0), 0);
-    std::vector<int> faces(img.valid.size(), -1);
     std::vector<float> dists(img.valid.size(), 0.0f);
     for (std::size_t i = 0; i < img.valid.size(); ++i)
-      if (img.valid[i]) {
-        const glm::vec3 d = img.hit[i] - m.centre;
-        faces[i] = cube_coord(d, m.size).face;
-        dists[i] = glm::length(d);
-      }
+      if (img.valid[i]) dists[i] = glm::length(img.hit[i] - m.centre);
     std::vector<int> corner_of(img.valid.size(), 0);
     for (int y = 0; y < cells; ++y)
       for (int x = 0; x < cells; ++x) {
@@ -376,7 +405,7 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
         bool ok = true;
         float lo = kInf, hi = 0.0f;
         for (std::size_t k : c) {
-          ok = ok && img.valid[k] && faces[k] == faces[c[0]];
+          ok = ok && img.valid[k];
           lo = std::min(lo, dists[k]);
           hi = std::max(hi, dists[k]);
         }
@@ -393,13 +422,22 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
         glm::vec3 flux(0.0f), wi(0.0f);
         float dist = 0.0f;
         glm::vec2 p[4];
+        glm::vec3 mean_dir(0.0f);
         for (int k = 0; k < 4; ++k) {
           flux += img.flux[c[k]] / static_cast<float>(corner_of[c[k]]);
           dist += 0.25f * dists[c[k]];
           wi += 0.25f * img.wi[c[k]];
-          p[k] = face_pixel(img.hit[c[k]] - m.centre, m.size);
+          mean_dir += (img.hit[c[k]] - m.centre) / dists[c[k]];
         }
-        const int face = faces[c[0]];
+        const int face = cube_coord(mean_dir, m.size).face;
+        bool projected = true;
+        for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, face, m.size, p[k]);
+        if (!projected) {  // a cell wider than a face's half space: its corners as points
+          for (int k = 0; k < 4; ++k)
+            splat(target, img.hit[c[k]] - m.centre, img.flux[c[k]] / static_cast<float>(corner_of[c[k]]), dists[c[k]],
+                  img.wi[c[k]], 0);
+          continue;
+        }
         const glm::vec2 t0[3] = {p[0], p[1], p[2]}, t1[3] = {p[0], p[2], p[3]};
         raster_triangle(target, face, t0, flux * 0.5f, dist, wi, scratch);
         raster_triangle(target, face, t1, flux * 0.5f, dist, wi, scratch);
@@ -443,8 +481,14 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
         const float dist = glm::length(d);
         if (!(dist > 0.0f)) continue;
         const float stored = m.distance_towards(d);
-        // The shadow-map-like test: only the receiver the photons found is lit.
-        if (!std::isfinite(stored) || std::fabs(dist - stored) > tolerance * stored) continue;
+        // The shadow-map-like test: only the receiver the photons found is lit. Across one
+        // texel (angle ≈ 2/size) a receiver at angle α to the line of sight from the centre
+        // changes its distance by about d (2/size) tanα, so grazing receivers are allowed
+        // that much more (tanα capped at 16, beyond which no texel resolves the surface).
+        const float cos_view = std::fabs(glm::dot(nrm, d)) / dist;
+        const float tan_view = std::min(16.0f, std::sqrt(std::max(0.0f, 1.0f - cos_view * cos_view)) / std::max(cos_view, 1e-3f));
+        const float slack = tolerance * stored + 2.0f * dist * tan_view * (2.0f / static_cast<float>(m.size));
+        if (!std::isfinite(stored) || std::fabs(dist - stored) > slack) continue;
         const CubeCoord c = cube_coord(d, m.size);
         const int x = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
         const int y = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);

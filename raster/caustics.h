@@ -16,8 +16,9 @@
 //   Fresnel factors and transmittance.
 // - caustic_map (§6.2–6.3): the photon hits in cube-map space about the generator's centre:
 //   flux per texel and the flux-weighted receiver distance. filter splat: each photon's flux
-//   spread by a normalized tent kernel of splat_radius texels (the weights sum to one, so the
-//   map's total flux does not depend on the radius); filter triangles: neighbouring photon
+//   spread by a normalized tent kernel of splat_radius texels, or (adaptive) of the distance
+//   to its neighbours in the photon image, at most 8 (the weights sum to one, so the map's
+//   total flux does not depend on the radius); filter triangles: neighbouring photon
 //   texels joined into caustic triangles whose flux is spread over the texels they cover,
 //   then a normalized 3×3 blur.
 // - caustic_gather (§6.3.3): per G-buffer sample and generator, the flux of the texel the
@@ -90,6 +91,7 @@ struct CausticMapOptions {
   int size = 128;                // cube face side
   CausticFilter filter = CausticFilter::Splat;
   int splat_radius = 1;          // texels (0: the nearest texel only)
+  bool adaptive = true;          // splat: radius raised to the spacing of neighbouring photons
 };
 
 // One cube per generator: colour rgb = flux (W) per texel, distance = flux-weighted mean
@@ -138,7 +140,8 @@ struct CausticMapPass {
   void parameters(par::Params& p) const {
     p.set("size", options.size)
         .set("filter", options.filter == CausticFilter::Splat ? "splat" : "triangles")
-        .set("splat_radius", options.splat_radius);
+        .set("splat_radius", options.splat_radius)
+        .set("adaptive", options.adaptive ? 1 : 0);
   }
   CausticMaps operator()(par::NodeContext& c, const CausticPhotons& photons) const;
 };

@@ -35,6 +35,7 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   mo.size = static_cast<int>(f.param("caustic_size"));
   mo.filter = static_cast<CausticFilter>(static_cast<int>(f.param("filter")));
   mo.splat_radius = static_cast<int>(f.param("splat_radius"));
+  mo.adaptive = f.param("adaptive") != 0.0;
   auto caustic_maps = g.add("caustic_map", CausticMapPass{scene, mo}, photons);
   auto lit = g.add("caustic_gather", CausticGatherPass{static_cast<float>(f.param("tolerance"))}, s.gbuffer,
                    caustic_maps, s.direct);

@@ -112,7 +112,8 @@ const std::vector<Technique>& techniques() {
        // caustic map 6·caustic_size² texels (1024: ~200 MB per generator).
        {{"photon_res", 128, 16, 512, true, "photon image side per light and generator (512: 262k photons)"},
         {"filter", 0, 0, 1, true, "0 splat (normalized tent kernel), 1 caustic triangles (then blurred)"},
-        {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (filter 0)"},
+        {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (filter 0; the least with adaptive)"},
+        {"adaptive", 1, 0, 1, true, "1: splat radius grows to the neighbouring photons' spacing (at most 8 texels)"},
         {"caustic_size", 128, 16, 1024, true, "cube face side of the caustic map (1024: ~200 MB per generator)"},
         {"tolerance", 0.05, 0.001, 1, false, "relative distance mismatch still taken as the photons' receiver"},
         {"linear_steps", 16, 0, 256, true, "linear search steps (receiver and exit searches; < 2: off)"},

@@ -71,7 +71,7 @@ TEST_P(NoBlackRegions, EveryTechniqueAgainstTheReference) {
 
 INSTANTIATE_TEST_SUITE_P(BuiltinScenes, NoBlackRegions,
                          ::testing::Values("sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",
-                                           "glass-sphere", "bowl", "bumpy-sphere"),
+                                           "glass-sphere", "bowl", "bumpy-sphere", "caustic-ring", "water-slab"),
                          [](const auto& info) {
                            std::string n = info.param;
                            for (char& c : n) if (c == '-') c = '_';

@@ -15,10 +15,10 @@
 namespace speculum {
 namespace {
 
-TEST(ProceduralScenes, AllSevenAreListedAndDefaultExists) {
-  EXPECT_EQ(builtin_scenes().size(), 7u);
+TEST(ProceduralScenes, AllNineAreListedAndDefaultExists) {
+  EXPECT_EQ(builtin_scenes().size(), 9u);
   for (const char* name : {"sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",
-                           "glass-sphere", "bowl", "bumpy-sphere"})
+                           "glass-sphere", "bowl", "bumpy-sphere", "caustic-ring", "water-slab"})
     EXPECT_NE(find_builtin_scene(name), nullptr) << name;
   EXPECT_NE(find_builtin_scene(default_scene_name()), nullptr);
 }
