@@ -30,7 +30,8 @@ struct ReferenceOptions {
   bool environment_lighting = true; // diffuse surfaces lit by the (occluded) environment
   // Caustics by forward light tracing (trace/light_tracer.h): photons per light and caustic
   // generator; 0 leaves them out (camera paths alone cannot reach a point light through a
-  // mirror or a refractor).
+  // mirror or a refractor). Seen after a specular bounce they come from a photon map of up
+  // to 2^20 photons per light and generator (trace/photon_map.h).
   std::uint64_t caustic_photons = 0;
 };
 
