@@ -1,5 +1,5 @@
 // `speculum experiment NAME`: the paper-reproduction sweeps (YU Fig.9, the SURVEY
-// techniques, ROGER's ray hierarchy). Each experiment is a child subcommand in its own file
+// techniques, SURVEY §6 caustics, ROGER's ray hierarchy). Each experiment is a child subcommand in its own file
 // of apps/experiments/, registered here.
 #include "apps/cli/commands.h"
 
@@ -14,6 +14,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
   add_experiment_survey_subcommand(*cmd, global);
   add_experiment_ray_hierarchy_subcommand(*cmd, global);
   add_experiment_yu_fig9_subcommand(*cmd, global);
+  add_experiment_caustics_subcommand(*cmd, global);
   (void)global;
 }
 
