@@ -527,6 +527,18 @@ CausticMaps CausticMapPass::operator()(par::NodeContext& c, const CausticPhotons
   return m;
 }
 
+ReflectorMaps CausticReflectorMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                                   const EnvironmentMap& environment, const GBuffer& gbuffer,
+                                                   const CausticMaps& caustics) const {
+  ReflectorMaps maps = render_reflector_maps(
+      c.executor(), *scene, shadows, environment, size, &gbuffer,
+      [&](const GBuffer& face, const ImageRGBA& direct) {
+        return gather_caustics(c.executor(), face, caustics, direct, tolerance);
+      });
+  c.count("cube_maps", static_cast<double>(maps.cubes.size()));
+  return maps;
+}
+
 ImageRGBA CausticGatherPass::operator()(par::NodeContext& c, const GBuffer& gbuffer, const CausticMaps& maps,
                                         const ImageRGBA& direct) const {
   return gather_caustics(c.executor(), gbuffer, maps, direct, tolerance);

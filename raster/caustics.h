@@ -29,8 +29,9 @@
 // A refractor's photons take two paths, refracted in and out and reflected off its surface
 // (one photon image each). Limits: one generator per path (a photon leaving one generator
 // does not enter another); internal reflections are not followed (TIR photons are dropped
-// and counted); the specular layer's cube maps are rendered without
-// caustics, so caustics are not seen in reflections.
+// and counted). Reflections and refractions see the caustics through
+// caustic_reflector_maps, the reflector cube maps rendered again with the caustics gathered
+// on their faces.
 #pragma once
 
 #include <array>
@@ -47,6 +48,7 @@
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
 #include "raster/refraction_impostor.h"
+#include "raster/shadow_map.h"
 
 namespace speculum::raster {
 
@@ -144,6 +146,20 @@ struct CausticMapPass {
         .set("adaptive", options.adaptive ? 1 : 0);
   }
   CausticMaps operator()(par::NodeContext& c, const CausticPhotons& photons) const;
+};
+
+// Pass "caustic_reflector_maps": the reflector cube maps rendered again with the caustics
+// gathered on their faces, so reflections and refractions show them.
+struct CausticReflectorMapsPass {
+  static constexpr const char* description =
+      "Per specular object the colour + distance cube map again, its faces' direct light "
+      "completed by the caustic maps: caustics seen in reflections and through refractors (SURVEY §6.3.3).";
+  const Scene* scene = nullptr;
+  int size = 256;
+  float tolerance = 0.05f;
+  void parameters(par::Params& p) const { p.set("size", size); }
+  ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
+                           const GBuffer& gbuffer, const CausticMaps& caustics) const;
 };
 
 // Pass "caustic_gather".

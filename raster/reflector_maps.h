@@ -7,6 +7,7 @@
 // 1% of the box diagonal along their mean normal.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "core/scene.h"
@@ -33,10 +34,13 @@ struct ReflectorMaps {
 // Specular objects: at least one triangle's material reflects or refracts
 // (is_specular(surface_params(material))).
 // `camera_view` (may be null) is the camera's G-buffer, used for flat reflectors.
+// `add_light` (may be empty) adds light to each face's direct light before the composite,
+// from the face's G-buffer (the caustics technique gathers its caustics there).
+using FaceLight = std::function<ImageRGBA(const GBuffer& face, const ImageRGBA& direct)>;
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
-                                    const GBuffer* camera_view = nullptr);
+                                    const GBuffer* camera_view = nullptr, const FaceLight& add_light = {});
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {

@@ -1,7 +1,8 @@
 // The caustics technique's recipe (SURVEY §6): the distance-map frame (mirrors searched in
 // their colour + distance cubes, refractors by distance impostors, §4), with the direct
 // light completed by the caustics of the light pass: caustic_photons → caustic_map →
-// caustic_gather.
+// caustic_gather, and caustic_reflector_maps (the cubes again, caustics on their faces) for
+// the reflections and refractions.
 #include "apps/techniques/frame_passes.h"
 #include "apps/techniques/recipes.h"
 #include "raster/caustics.h"
@@ -37,14 +38,17 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   mo.splat_radius = static_cast<int>(f.param("splat_radius"));
   mo.adaptive = f.param("adaptive") != 0.0;
   auto caustic_maps = g.add("caustic_map", CausticMapPass{scene, mo}, photons);
-  auto lit = g.add("caustic_gather", CausticGatherPass{static_cast<float>(f.param("tolerance"))}, s.gbuffer,
-                   caustic_maps, s.direct);
-  auto reflected = g.add("distance_map_reflect", DistanceMapReflectPass{search}, s.gbuffer, s.environment, maps);
+  const float tolerance = static_cast<float>(f.param("tolerance"));
+  auto lit = g.add("caustic_gather", CausticGatherPass{tolerance}, s.gbuffer, caustic_maps, s.direct);
+  // What reflections and refractions look up: the maps again, with the caustics on them.
+  auto lit_maps = g.add("caustic_reflector_maps", CausticReflectorMapsPass{scene, f.cube_map_size, tolerance},
+                        s.shadow_maps, s.environment, s.gbuffer, caustic_maps);
+  auto reflected = g.add("distance_map_reflect", DistanceMapReflectPass{search}, s.gbuffer, s.environment, lit_maps);
   RefractionOptions ro;
   ro.method = RefractionMethod::DistanceImpostor;
   ro.environment_search = search;
   ro.exit_search = search;
-  auto specular = g.add("refraction", RefractionPass{scene, f.camera, ro}, s.gbuffer, s.visibility, maps,
+  auto specular = g.add("refraction", RefractionPass{scene, f.camera, ro}, s.gbuffer, s.visibility, lit_maps,
                         s.environment, reflected, par::Resource<GBuffer>{}, par::Resource<VertexThickness>{},
                         impostors);
   return add_output_passes(g, f, lit, specular);

@@ -254,3 +254,79 @@ TEST(Caustics, FrameIsTheSameForAnyThreadCountAndLaneWidth) {
 
 }  // namespace
 }  // namespace speculum::raster
+
+namespace speculum::raster {
+namespace {
+
+// Caustics in reflections: a mirror beside the glass ball sees the ball's caustic on the
+// floor in its cube map once the caustics are gathered on the map's faces, and its bright
+// part (over 1 % of the brightest gain: the refracted caustic, not the faint halo of the
+// ball's surface reflection) lies on the floor under the ball.
+TEST(Caustics, ReflectorMapsShowTheCausticWhereItLies) {
+  Scene s = ball_over_floor(false);
+  {
+    Scene with = s;
+    Material m = mirror("mirror");
+    with.materials.push_back(m);
+    const auto mat = static_cast<std::uint32_t>(with.materials.size() - 1);
+    const MeshData q = quad({2.5f, 0.0f, 2.0f}, {0, 0, -4}, {0, 2, 0}, 2, 2);  // facing −x
+    Object o;
+    o.name = "mirror";
+    o.first_triangle = static_cast<std::uint32_t>(with.mesh.triangle_count());
+    o.triangle_count = static_cast<std::uint32_t>(q.triangle_count());
+    o.material = mat;
+    const auto base = static_cast<std::uint32_t>(with.mesh.positions.size());
+    for (std::size_t i = 0; i < q.positions.size(); ++i) {
+      with.mesh.positions.push_back(q.positions[i]);
+      with.mesh.normals.push_back({-1, 0, 0});
+      with.mesh.uvs.push_back(q.uvs[i]);
+    }
+    for (std::uint32_t i : q.indices) with.mesh.indices.push_back(base + i);
+    for (std::size_t t = 0; t < q.triangle_count(); ++t) {
+      with.mesh.triangle_material.push_back(mat);
+      with.mesh.triangle_object.push_back(static_cast<std::uint32_t>(with.objects.size()));
+    }
+    with.objects.push_back(o);
+    s = std::move(with);
+  }
+  s.validate();
+  par::Executor ex(2);
+  const PhotonRun r = shoot(ex, s, 128);
+  const CausticMaps caustics = build_caustic_maps(ex, s, r.photons, CausticMapOptions{});
+  const EnvironmentMap env = build_environment(ex, s.environment, 8);
+  const std::vector<ShadowMap> shadows = render_shadow_maps(ex, s, 256);
+  const ReflectorMaps plain = render_reflector_maps(ex, s, shadows, env, 128, nullptr);
+  const ReflectorMaps lit = render_reflector_maps(ex, s, shadows, env, 128, nullptr,
+                                                  [&](const GBuffer& face, const ImageRGBA& direct) {
+                                                    return gather_caustics(ex, face, caustics, direct, 0.05f);
+                                                  });
+  const std::uint32_t mirror_object = static_cast<std::uint32_t>(s.objects.size() - 1);
+  const int k = plain.map_of_object[mirror_object];
+  ASSERT_GE(k, 0);
+  const CubeMap& a = plain.cubes[static_cast<std::size_t>(k)];
+  const CubeMap& b = lit.cubes[static_cast<std::size_t>(k)];
+  double added = 0.0;
+  float brightest = 0.0f;
+  for (int f = 0; f < kCubeFaces; ++f)
+    for (int y = 0; y < a.size; ++y)
+      for (int x = 0; x < a.size; ++x) brightest = std::max(brightest, b.colour[f].at(x, y).x - a.colour[f].at(x, y).x);
+  int misplaced = 0, bright = 0;
+  for (int f = 0; f < kCubeFaces; ++f)
+    for (int y = 0; y < a.size; ++y)
+      for (int x = 0; x < a.size; ++x) {
+        const float gain = b.colour[f].at(x, y).x - a.colour[f].at(x, y).x;
+        EXPECT_GE(gain, -1e-6f);
+        added += gain;
+        if (gain <= 0.01f * brightest) continue;
+        ++bright;
+        // Where the texel looks: the floor under the ball, within its caustic's reach.
+        const glm::vec3 p = a.centre + cube_direction(f, {x + 0.5f, y + 0.5f}, a.size) * a.distance[f].at(x, y);
+        if (std::fabs(p.y) > 0.05f || glm::length(glm::vec2(p.x, p.z)) > 2.0f) ++misplaced;
+      }
+  EXPECT_GT(added, 1.0);
+  EXPECT_GT(bright, 5) << misplaced;
+  EXPECT_EQ(misplaced, 0);
+}
+
+}  // namespace
+}  // namespace speculum::raster
