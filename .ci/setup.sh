@@ -9,7 +9,7 @@ $SUDO apt-get install -y -q --no-install-recommends \
   g++ cmake ninja-build pkg-config \
   libglm-dev libopenimageio-dev openimageio-tools \
   libtinygltf-dev nlohmann-json3-dev libstb-dev libtinyobjloader-dev \
-  libopenmesh-dev libtbb-dev \
+  libopenmesh-dev libtbb-dev libnanoflann-dev \
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev \
   assimp-testmodels graphviz libembree-dev \
   ccache chromium libexpat1-dev parallel gnuplot-nox

@@ -1,4 +1,4 @@
-// The eight built-in scenes (see procedural_scenes.h). Each divides its triangle budget
+// The eleven built-in scenes (see procedural_scenes.h). Each divides its triangle budget
 // among its objects by fixed fractions, so triangle counts track the size parameter.
 #include "core/procedural_scenes.h"
 
@@ -365,6 +365,84 @@ Scene bumpy_sphere_scene(const BuiltinParams& p) {
   return s;
 }
 
+// An open metal ring (a short cylinder, mirror inside and out) on a plane, lit from the side
+// by a low point light: the light reflected inside the ring gathers on the floor along the
+// cusped caustic of a coffee cup (the cardioid of SURVEY §6's figures).
+Scene caustic_ring(const BuiltinParams& p) {
+  SceneBuilder b("caustic-ring");
+  const auto floor = checker_material(b, diffuse("floor checker", glm::vec3(1.0f)),
+                                      {0.85f, 0.85f, 0.85f}, {0.6f, 0.6f, 0.65f}, 12);
+  Material ring_m = mirror("polished ring", {0.95f, 0.93f, 0.88f});
+  ring_m.double_sided = true;
+  const auto ring = b.add_material(ring_m);
+  b.add_object("plane", floor, ground(8.0f, 0.0f, share(p, 0.3), 8.0f));
+  b.add_object("ring", ring, lathe({0, 0, 0}, [](float t) { return glm::vec2(1.0f, 0.5f * t); },
+                                   rings_for(share(p, 0.7))));
+  Scene s = b.take();
+  s.cameras.push_back(camera("main", {0.6f, 2.6f, 2.4f}, {0, 0.1f, -0.1f}, 50.0f, 40.0f));
+  s.lights.push_back(point_light("side light", {-4.0f, 1.3f, 0.4f}, 60.0f));
+  s.environment.constant = glm::vec3(0.08f);
+  return s;
+}
+
+// The surface of a water-like slab: a few crossing waves about height `level`.
+float wave_height(float x, float z, float level, float amplitude) {
+  return level + amplitude * (std::sin(2.7f * x + 0.4f) * std::cos(2.1f * z) + 0.6f * std::sin(3.9f * z - 1.7f * x));
+}
+
+// A closed slab of water, |x|, |z| ≤ half, from `bottom` to the wavy top: the top grid, a
+// flat bottom and four side walls that follow the waves' edge.
+MeshData wavy_slab(float half, float bottom, float level, float amplitude, int n) {
+  MeshData out;
+  const auto append = [&](MeshData m) {
+    const auto base = static_cast<std::uint32_t>(out.positions.size());
+    out.positions.insert(out.positions.end(), m.positions.begin(), m.positions.end());
+    out.uvs.insert(out.uvs.end(), m.uvs.begin(), m.uvs.end());
+    for (std::uint32_t i : m.indices) out.indices.push_back(base + i);
+  };
+  const float w = 2.0f * half;
+  // Each grid's du × dv points out of the slab.
+  append(parametric_grid(n, n, [&](float u, float v) {
+    const float x = -half + w * v, z = -half + w * u;
+    return glm::vec3(x, wave_height(x, z, level, amplitude), z);
+  }));
+  append(parametric_grid(n, n, [&](float u, float v) { return glm::vec3(-half + w * u, bottom, -half + w * v); }));
+  const int sides = std::max(1, n / 8);
+  for (int side = 0; side < 4; ++side)
+    append(parametric_grid(n, sides, [&](float u, float v) {
+      // Walls at z = +half, x = +half, z = −half, x = −half, walked so du × dv faces out.
+      float x = 0.0f, z = 0.0f;
+      const float t = -half + w * u;
+      if (side == 0) x = t, z = half;
+      else if (side == 1) x = half, z = -t;
+      else if (side == 2) x = -t, z = -half;
+      else x = -half, z = t;
+      return glm::vec3(x, bottom + (wave_height(x, z, level, amplitude) - bottom) * v, z);
+    }));
+  return out;
+}
+
+// A slab of water (ior 1.33) with a wavy top over a tiled floor, lit by a high sun: the
+// waves focus the light into a net of caustics on the floor.
+Scene water_slab(const BuiltinParams& p) {
+  SceneBuilder b("water-slab");
+  const auto floor = checker_material(b, diffuse("pool tiles", glm::vec3(1.0f)),
+                                      {0.9f, 0.9f, 0.88f}, {0.35f, 0.55f, 0.7f}, 16);
+  Material water_m = glass("water", 1.33f);
+  water_m.base_color = glm::vec4(0.92f, 0.97f, 1.0f, 1.0f);
+  const auto water = b.add_material(water_m);
+  b.add_object("floor", floor, ground(6.0f, 0.0f, share(p, 0.2), 6.0f));
+  const int n = std::max(4, static_cast<int>(std::lround(std::sqrt(static_cast<double>(share(p, 0.8)) / 5.0))));
+  b.add_object("water", water, wavy_slab(1.6f, 0.35f, 1.0f, 0.05f, n));
+  Scene s = b.take();
+  const glm::vec3 sun{0.25f, 1.0f, 0.35f};
+  s.cameras.push_back(camera("main", {0.0f, 3.4f, 3.6f}, {0, 0.3f, 0}, 45.0f, 40.0f));
+  s.lights.push_back(sun_light(sun, 3.0f));
+  set_sky(s, sun);
+  s.environment.intensity = 0.4f;
+  return s;
+}
+
 constexpr BuiltinScene kScenes[] = {
     {"sphere-in-room", "mirror sphere in a textured box room (SURVEY's classic set-up)", 20000, "",
      sphere_in_room},
@@ -383,6 +461,10 @@ constexpr BuiltinScene kScenes[] = {
      "n=8 (bump frequency), amplitude=0.06 (relative to the radius)", bumpy_sphere_scene},
     {"ellipsoid", "a mirror ellipsoid (radii 1.9, 1.1, 1.2) in the textured box room", 20000, "",
      ellipsoid_in_room},
+    {"caustic-ring", "a mirror ring on a plane lit from the side: the cusped caustic inside the ring",
+     20000, "", caustic_ring},
+    {"water-slab", "a slab of water (ior 1.33) with a wavy top over a tiled floor under a high sun",
+     20000, "", water_slab},
 };
 
 // Key cameras of one path: eyes and targets in pairs.

@@ -55,7 +55,8 @@ const char* to_string(ReflectorSelection which) {
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size,
-                                    const GBuffer* camera_view, ReflectorSelection which) {
+                                    const GBuffer* camera_view, ReflectorSelection which,
+                                    const FaceLight& add_light) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
@@ -96,8 +97,9 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
         executor, scene, centre, opt, [&](const GBuffer& g, const Camera& cam) {
           // Other reflectors seen in this map show the environment along their own R (and
           // T): the first-order fallback, so a mirror seen in a mirror is never black.
-          return composite(executor, direct_light(executor, scene, g, cam, shadows, env),
-                           envmap_reflect(executor, g, env));
+          ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env);
+          if (add_light) direct = add_light(g, direct);
+          return composite(executor, direct, envmap_reflect(executor, g, env));
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
     out.maps.push_back(environment_from_faces(executor, cube.colour, false,

@@ -7,6 +7,7 @@
 // 1% of the box diagonal along their mean normal.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "core/scene.h"
@@ -39,11 +40,15 @@ const char* to_string(ReflectorSelection which);
 // `which` selects the reflectors that get a map: every specular object; all but the planar
 // mirrors (planar_mirror_plane), for a technique that renders those exactly by another pass;
 // or the refractors only, for a technique that traces reflections but not refraction.
+// `add_light` (may be empty) adds light to each face's direct light before the composite,
+// from the face's G-buffer (the caustics technique gathers its caustics there).
+using FaceLight = std::function<ImageRGBA(const GBuffer& face, const ImageRGBA& direct)>;
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
                                     const GBuffer* camera_view = nullptr,
-                                    ReflectorSelection which = ReflectorSelection::all);
+                                    ReflectorSelection which = ReflectorSelection::all,
+                                    const FaceLight& add_light = {});
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -15,6 +16,8 @@
 #include "core/sampling.h"
 #include "core/shading.h"
 #include "trace/hit_surface.h"
+#include "trace/light_tracer.h"
+#include "trace/photon_map.h"
 #include "trace/traversal.h"
 
 namespace speculum::trace {
@@ -30,6 +33,7 @@ struct Tracer {
   ReferenceStats stats;
   TraversalCounters counters;
   std::uint32_t pixel = 0, sample = 0;
+  const PhotonMap* photons = nullptr;  // caustics seen after a specular bounce
 
   float rnd(int depth, std::uint32_t k) const {
     return random_float(pixel, sample, static_cast<std::uint32_t>(depth) * kDimsPerBounce + k, opt.seed);
@@ -70,6 +74,11 @@ struct Tracer {
       if (c == glm::vec3(0.0f)) continue;
       if (!occluded(above, ls.direction, ls.distance)) L += c;
     }
+    // Caustics: seen directly they are the light tracer's (render_caustics); seen through a
+    // mirror, a refractor or a glossy lobe, the photon map's.
+    // (Refractors and pure metals reflect no photon light the query could find: skipped.)
+    if (photons && depth > 0 && !s.is_refractor() && !(s.is_mirror_lobe() && s.metallic >= 1.0f))
+      L += photons->radiance(p, n, v, s);
     // Environment light, occluded, on the lobes no specular ray follows: the diffuse lobe
     // (cosine-sampled, weight f_d cos / (cos/π) = π f_d of the coupled BRDF) and, on rough
     // surfaces, the specular lobe (visible normals, as the glossy branch below).
@@ -136,9 +145,20 @@ ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& cam
   ImageRGBA image(opt.width, opt.height, glm::vec4(0.0f));
   const std::size_t pixels = static_cast<std::size_t>(opt.width) * opt.height;
   constexpr std::size_t kChunk = 64;
+  std::unique_ptr<PhotonMap> photon_map;
+  if (opt.caustic_photons > 0) {
+    // The map stores its photons (~56 bytes each): at most 2^20 per light and generator.
+    PhotonOptions po;
+    po.photons = std::min<std::uint64_t>(opt.caustic_photons, std::uint64_t{1} << 20);
+    po.max_depth = opt.max_depth;
+    po.seed = opt.seed ^ 0x5bd1e995u;  // independent of the light tracer's photons
+    const Bounds b = scene.bounds();
+    const float diagonal = b.valid() ? glm::length(b.extent()) : 1.0f;
+    photon_map = std::make_unique<PhotonMap>(trace_caustic_photons(scene, bvh, po, ex), 32, 0.02f * diagonal);
+  }
   std::vector<ReferenceStats> per_chunk((pixels + kChunk - 1) / kChunk);
   ex.parallel_for("reference_render", pixels, kChunk, [&](std::size_t b, std::size_t e) {
-    Tracer tr{scene, bvh, opt, {}, {}, 0, 0};
+    Tracer tr{scene, bvh, opt, {}, {}, 0, 0, photon_map.get()};
     for (std::size_t i = b; i < e; ++i) {
       const int x = static_cast<int>(i % opt.width), y = static_cast<int>(i / opt.width);
       tr.pixel = static_cast<std::uint32_t>(i);
@@ -159,6 +179,20 @@ ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& cam
     tr.stats.stack_overflows = tr.counters.stack_overflows;
     per_chunk[b / kChunk] = tr.stats;
   });
+  if (opt.caustic_photons > 0) {
+    PhotonOptions po;
+    po.photons = opt.caustic_photons;
+    po.max_depth = opt.max_depth;
+    po.seed = opt.seed;
+    PhotonStats ps;
+    const ImageRGBA caustics = render_caustics(scene, bvh, camera, opt.width, opt.height, po, ex, &ps);
+    for (std::size_t i = 0; i < pixels; ++i)
+      image.pixels[i] += glm::vec4(glm::vec3(caustics.pixels[i]), 0.0f);
+    if (stats) {
+      stats->caustic_photons += ps.photons;
+      stats->caustic_splats += ps.splats;
+    }
+  }
   if (stats) {
     for (const ReferenceStats& s : per_chunk) {
       stats->camera_rays += s.camera_rays;
@@ -178,6 +212,10 @@ ImageRGBA ReferencePass::operator()(par::NodeContext& c) const {
   c.count("camera_rays", stats.camera_rays);
   c.count("shadow_rays", stats.shadow_rays);
   c.count("specular_rays", stats.specular_rays);
+  if (options.caustic_photons > 0) {
+    c.count("caustic_photons", static_cast<double>(stats.caustic_photons));
+    c.count("caustic_splats", static_cast<double>(stats.caustic_splats));
+  }
   return radiance;
 }
 

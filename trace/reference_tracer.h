@@ -28,6 +28,11 @@ struct ReferenceOptions {
   bool pixel_jitter = false;        // false: every sample through the pixel centre, as the
                                     // rasterizer samples; true: box-filtered pixel area
   bool environment_lighting = true; // diffuse surfaces lit by the (occluded) environment
+  // Caustics by forward light tracing (trace/light_tracer.h): photons per light and caustic
+  // generator; 0 leaves them out (camera paths alone cannot reach a point light through a
+  // mirror or a refractor). Seen after a specular bounce they come from a photon map of up
+  // to 2^20 photons per light and generator (trace/photon_map.h).
+  std::uint64_t caustic_photons = 0;
 };
 
 // Counters of one render (integers, summed in chunk order).
@@ -36,6 +41,7 @@ struct ReferenceStats {
   std::uint64_t below_horizon = 0;   // glossy lobe samples under the surface: contribute 0
   std::uint64_t depth_limited = 0;   // specular paths cut by max_depth
   std::uint64_t stack_overflows = 0;
+  std::uint64_t caustic_photons = 0, caustic_splats = 0;  // light tracing (caustic_photons > 0)
 };
 
 // Renders with a BVH built from scene.mesh on the executor (kernel "reference_render").
@@ -51,11 +57,14 @@ ImageRGBA render_reference(const Scene& scene, const Bvh& bvh, const Camera& cam
 struct ReferencePass {
   static constexpr const char* description =
       "Ground truth: ray tracing in the original geometry on the BVH, with camera, shadow and "
-      "specular/glossy rays and spp jittered samples per pixel (SURVEY §2).";
+      "specular/glossy rays and spp jittered samples per pixel (SURVEY §2), plus caustics of "
+      "punctual lights by forward light tracing through mirrors and refractors (SURVEY §6).";
   const Scene* scene = nullptr;
   Camera camera;
   ReferenceOptions options;
-  void parameters(par::Params& p) const { p.set("spp", options.spp).set("seed", options.seed); }
+  void parameters(par::Params& p) const {
+    p.set("spp", options.spp).set("seed", options.seed).set("caustic_photons", static_cast<double>(options.caustic_photons));
+  }
   ImageRGBA operator()(par::NodeContext& c) const;
 };
 

@@ -43,5 +43,6 @@ void add_experiment_survey_subcommand(CLI::App& experiment, GlobalOptions& globa
 void add_experiment_ray_hierarchy_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_vertex_projection_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global);
+void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& global);
 
 }  // namespace speculum::cli

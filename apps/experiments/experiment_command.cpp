@@ -1,5 +1,6 @@
 // `speculum experiment NAME`: the paper-reproduction sweeps (YU Fig.9, the SURVEY
 // techniques, ROGER's ray hierarchy and vertex projection). Each experiment is a child subcommand in its own file
+// techniques, SURVEY §6 caustics, ROGER's ray hierarchy). Each experiment is a child subcommand in its own file
 // of apps/experiments/, registered here.
 #include "apps/cli/commands.h"
 
@@ -16,6 +17,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
   add_experiment_yu_fig9_subcommand(*cmd, global);
   add_experiment_vertex_projection_subcommand(*cmd, global);
   add_experiment_soff_subcommand(*cmd, global);
+  add_experiment_caustics_subcommand(*cmd, global);
   (void)global;
 }
 

@@ -18,7 +18,7 @@ namespace speculum::matrix {
 
 // Bumped whenever a reference image would change for the same key (tracer, shading, metrics):
 // cached references with another version are retraced.
-inline constexpr const char* kReferenceVersion = "speculum-reference-2";
+inline constexpr const char* kReferenceVersion = "speculum-reference-3";
 
 struct MatrixOptions {
   std::string techniques = "all";  // comma-separated names or "all"

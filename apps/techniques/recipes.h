@@ -29,6 +29,10 @@ FrameOutputs add_layered_distance_map_passes(par::Graph& graph, const Scene* sce
 // refraction (SURVEY §4.4): reflector_cube_maps → envmap_reflect → [back_faces,
 // refractor_thickness | refractor_impostors] → refraction.
 FrameOutputs add_refraction_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
+// caustics (SURVEY §6): reflector_cube_maps, refractor_impostors → caustic_photons →
+// caustic_map → caustic_gather (direct + caustics), caustic_reflector_maps → distance_map_reflect
+// → refraction.
+FrameOutputs add_caustics_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // planar-mirror (SURVEY §5): planar_mirrors → planar_mirror_reflect.
 FrameOutputs add_planar_mirror_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // vertex-projection (ROGER ch.2): reflector_cube_maps → envmap_reflect (fallback); tessellate,

@@ -51,9 +51,13 @@ const std::vector<Technique>& techniques() {
        {}},
       {"reference",
        "reference tracer: BVH ray tracing, Whitted mirrors/refraction, GGX-lobe glossy "
-       "sampling (--spp path samples, --bounces specular depth, default 8); the ground truth",
+       "sampling (--spp path samples, --bounces specular depth, default 8), caustics by light "
+       "tracing; the ground truth",
        add_reference_passes,
-       {},
+       // Photons cost time only (each splats into the frame it is traced for): 256 per pixel
+       // of a 640×480 frame is ~79M per light and generator.
+       {{"caustic_photons", 16, 0, 256, true,
+         "light-traced caustic photons per pixel, per light and mirror/refractor (0: no caustics)"}},
        double(1 << 26)},  // paths cost time only (memory is per pixel): about two minutes on two cores
       {"specular-reference",
        "reference for the specular term alone: the feed-forward G-buffer and direct light, "
@@ -116,6 +120,22 @@ const std::vector<Technique>& techniques() {
         {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
         // ≈ 150 MB per refractor at 1024² faces, ≈ 3.6 GB at 4096².
         {"impostor_size", 128, 4, 1024, true, "cube face side of the distance impostors (method 2; ~150 MB each at 1024)"}}},
+      {"caustics",
+       "caustics (SURVEY §6): photons shot from each light through each mirror/refractor, "
+       "receivers found in its distance map, stored in a cube map at the generator, splats or "
+       "caustic triangles, gathered with a distance check; distance-map reflection/refraction",
+       add_caustics_passes,
+       // Photon images cost photon_res² texels per light and generator (512: 262k each), the
+       // caustic map 6·caustic_size² texels (1024: ~200 MB per generator).
+       {{"photon_res", 128, 16, 512, true, "photon image side per light and generator (512: 262k photons)"},
+        {"filter", 0, 0, 1, true, "0 splat (normalized tent kernel), 1 caustic triangles (then blurred)"},
+        {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (filter 0; the least with adaptive)"},
+        {"adaptive", 1, 0, 1, true, "1: splat radius grows to the neighbouring photons' spacing (at most 8 texels)"},
+        {"caustic_size", 128, 16, 1024, true, "cube face side of the caustic map (1024: ~200 MB per generator)"},
+        {"tolerance", 0.05, 0.001, 1, false, "relative distance mismatch still taken as the photons' receiver"},
+        {"linear_steps", 16, 0, 256, true, "linear search steps (receiver and exit searches; < 2: off)"},
+        {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
+        {"impostor_size", 128, 4, 1024, true, "cube face side of the refractors' distance impostors (~150 MB each at 1024)"}}},
       {"yu-lod",
        "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
        "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",

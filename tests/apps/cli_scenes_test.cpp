@@ -81,7 +81,7 @@ TEST(CliScenes, ListExportAndInfoAgree) {
   const CommandResult list = run("scenes list", dir);
   EXPECT_EQ(list.status, 0);
   for (const char* name : {"sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",
-                           "glass-sphere", "bowl", "bumpy-sphere", "ellipsoid"})
+                           "glass-sphere", "bowl", "bumpy-sphere", "ellipsoid", "caustic-ring", "water-slab"})
     EXPECT_NE(list.out.find(name), std::string::npos) << name;
   const auto glb = dir / "room.glb";
   const CommandResult exp = run("scenes export living-room '" + glb.string() + "' --size 3000", dir);

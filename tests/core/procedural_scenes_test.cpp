@@ -17,8 +17,8 @@ namespace speculum {
 namespace {
 
 TEST(ProceduralScenes, EveryNamedSceneIsListedAndDefaultExists) {
-  const char* names[] = {"sphere-in-room", "glossy-plane", "mirror-corridor", "living-room", "glass-sphere",
-                         "bowl",           "bumpy-sphere", "ellipsoid",       "bathroom"};
+  const char* names[] = {"sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",  "glass-sphere", "bowl",
+                         "bumpy-sphere",   "ellipsoid",    "bathroom",        "caustic-ring", "water-slab"};
   EXPECT_EQ(builtin_scenes().size(), std::size(names));
   for (const char* name : names) EXPECT_NE(find_builtin_scene(name), nullptr) << name;
   EXPECT_NE(find_builtin_scene(default_scene_name()), nullptr);

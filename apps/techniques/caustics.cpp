@@ -1,0 +1,57 @@
+// The caustics technique's recipe (SURVEY §6): the distance-map frame (mirrors searched in
+// their colour + distance cubes, refractors by distance impostors, §4), with the direct
+// light completed by the caustics of the light pass: caustic_photons → caustic_map →
+// caustic_gather, and caustic_reflector_maps (the cubes again, caustics on their faces) for
+// the reflections and refractions.
+#include "apps/techniques/frame_passes.h"
+#include "apps/techniques/recipes.h"
+#include "raster/caustics.h"
+#include "raster/distance_map_reflect.h"
+#include "raster/reflector_maps.h"
+#include "raster/refraction.h"
+#include "raster/refraction_impostor.h"
+
+namespace speculum::pipeline {
+
+using namespace speculum::raster;
+
+FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
+  DistanceSearchOptions search;
+  search.linear_steps = static_cast<int>(f.param("linear_steps"));
+  search.linear = search.linear_steps >= 2;
+  search.secant_steps = static_cast<int>(f.param("secant_steps"));
+  const SurfaceResources s = add_surface_passes(g, scene, f);
+  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size}, s.shadow_maps,
+                    s.environment, s.gbuffer)
+                  .describe("Colour + distance cube map around each specular object, itself left out: "
+                            "what reflected rays and the photons leaving a generator search (SURVEY §4.1, §6.1).");
+  auto impostors = g.add("refractor_impostors",
+                         RefractorImpostorsPass{scene, static_cast<int>(f.param("impostor_size"))});
+  CausticPhotonOptions po;
+  po.photon_res = static_cast<int>(f.param("photon_res"));
+  po.receiver_search = search;
+  po.exit_search = search;
+  auto photons = g.add("caustic_photons", CausticPhotonsPass{scene, po}, maps, impostors);
+  CausticMapOptions mo;
+  mo.size = static_cast<int>(f.param("caustic_size"));
+  mo.filter = static_cast<CausticFilter>(static_cast<int>(f.param("filter")));
+  mo.splat_radius = static_cast<int>(f.param("splat_radius"));
+  mo.adaptive = f.param("adaptive") != 0.0;
+  auto caustic_maps = g.add("caustic_map", CausticMapPass{scene, mo}, photons);
+  const float tolerance = static_cast<float>(f.param("tolerance"));
+  auto lit = g.add("caustic_gather", CausticGatherPass{tolerance}, s.gbuffer, caustic_maps, s.direct);
+  // What reflections and refractions look up: the maps again, with the caustics on them.
+  auto lit_maps = g.add("caustic_reflector_maps", CausticReflectorMapsPass{scene, f.cube_map_size, tolerance},
+                        s.shadow_maps, s.environment, s.gbuffer, caustic_maps);
+  auto reflected = g.add("distance_map_reflect", DistanceMapReflectPass{search}, s.gbuffer, s.environment, lit_maps);
+  RefractionOptions ro;
+  ro.method = RefractionMethod::DistanceImpostor;
+  ro.environment_search = search;
+  ro.exit_search = search;
+  auto specular = g.add("refraction", RefractionPass{scene, f.camera, ro}, s.gbuffer, s.visibility, lit_maps,
+                        s.environment, reflected, par::Resource<GBuffer>{}, par::Resource<VertexThickness>{},
+                        impostors);
+  return add_output_passes(g, f, lit, specular);
+}
+
+}  // namespace speculum::pipeline

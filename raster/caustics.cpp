@@ -1,0 +1,547 @@
+// Caustics through distance maps (see caustics.h).
+#include "raster/caustics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "core/error.h"
+#include "core/optics.h"
+#include "core/shading.h"
+#include "raster/refraction_path.h"
+#include "raster/visibility.h"
+
+namespace speculum::raster {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kMaxSplatRadius = 8;  // texels: bounds a splat's work ((2r+1)² texels)
+
+bool generator_material(const SurfaceParams& s) { return s.is_refractor() || s.is_mirror_lobe(); }
+
+struct Sphere {
+  glm::vec3 centre{0.0f};
+  float radius = 0.0f;
+};
+
+// The object's bounding sphere: its box centre and farthest vertex.
+Sphere bounding_sphere(const Scene& scene, const Object& obj) {
+  Bounds b;
+  for (std::uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t)
+    for (int k = 0; k < 3; ++k) b.grow(scene.mesh.positions[scene.mesh.indices[3 * t + k]]);
+  float r2 = 0.0f;
+  for (std::uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 d = scene.mesh.positions[scene.mesh.indices[3 * t + k]] - b.center();
+      r2 = std::max(r2, glm::dot(d, d));
+    }
+  return {b.center(), std::sqrt(r2) * 1.01f + 1e-6f};
+}
+
+// Continuous pixel coordinates of direction d projected on the plane of `face`, unclamped
+// (beyond [0, size] off the face): so caustic triangles and photon spacings that straddle a
+// face edge are measured in one face's texels. False when d points away from the face.
+bool face_pixel(const glm::vec3& d, int face, int size, glm::vec2& out) {
+  const float s = static_cast<float>(size);
+  const glm::vec3 f = cube_direction(face, {0.5f * s, 0.5f * s}, size);
+  const glm::vec3 r = cube_direction(face, {s, 0.5f * s}, size) * std::sqrt(2.0f) - f;
+  const glm::vec3 u = cube_direction(face, {0.5f * s, 0.0f}, size) * std::sqrt(2.0f) - f;
+  const float depth = glm::dot(d, f);
+  if (depth <= 0.0f) return false;
+  out = {(glm::dot(d, r) / depth + 1.0f) * 0.5f * s, (1.0f - glm::dot(d, u) / depth) * 0.5f * s};
+  return true;
+}
+
+// A caustic map being built: flux, weight and Σ weight·distance in the cube, Σ weight·wi
+// beside it.
+struct MapTarget {
+  CubeMap& m;
+  CubeDirections& incident;
+};
+
+// Adds `flux` carried by a photon at distance `dist` from direction `wi` to texel (x, y).
+void deposit(MapTarget& t, int face, int x, int y, const glm::vec3& flux, float weight, float dist,
+             const glm::vec3& wi) {
+  glm::vec4& c = t.m.colour[face].at(x, y);
+  c += glm::vec4(flux, weight);
+  t.m.distance[face].at(x, y) += weight * dist;
+  t.incident[face].at(x, y) += weight * wi;
+}
+
+// A photon's flux spread by a tent kernel of `radius` texels about its continuous pixel
+// position, the weights normalized over the texels of its face (so they sum to one).
+void splat(MapTarget& t, const glm::vec3& dir, const glm::vec3& flux, float dist, const glm::vec3& wi, int radius) {
+  const CubeMap& m = t.m;
+  const CubeCoord c = cube_coord(dir, m.size);
+  const int cx = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
+  const int cy = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
+  if (radius <= 0) {
+    deposit(t, c.face, cx, cy, flux, 1.0f, dist, wi);
+    return;
+  }
+  const float reach = static_cast<float>(radius) + 0.5f;
+  float total = 0.0f;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int y = std::max(0, cy - radius); y <= std::min(m.size - 1, cy + radius); ++y)
+      for (int x = std::max(0, cx - radius); x <= std::min(m.size - 1, cx + radius); ++x) {
+        const float dx = static_cast<float>(x) + 0.5f - c.pixel.x, dy = static_cast<float>(y) + 0.5f - c.pixel.y;
+        const float w = std::max(0.0f, 1.0f - std::sqrt(dx * dx + dy * dy) / reach);
+        if (pass == 0) total += w;
+        else if (w > 0.0f) deposit(t, c.face, x, y, flux * (w / total), w / total, dist, wi);
+      }
+}
+
+float edge(glm::vec2 a, glm::vec2 b, glm::vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
+
+// A caustic triangle's flux spread evenly over the texels whose centres it covers (the
+// texel under its centroid when it covers none), so its total is kept exactly.
+void raster_triangle(MapTarget& t, int face, const glm::vec2 (&p)[3], const glm::vec3& flux, float dist,
+                     const glm::vec3& wi, std::vector<std::pair<int, int>>& scratch) {
+  const CubeMap& m = t.m;
+  scratch.clear();
+  const float area = edge(p[0], p[1], p[2]);
+  const int x0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].x, p[1].x, p[2].x}))));
+  const int x1 = std::min(m.size - 1, static_cast<int>(std::floor(std::max({p[0].x, p[1].x, p[2].x}))));
+  const int y0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].y, p[1].y, p[2].y}))));
+  const int y1 = std::min(m.size - 1, static_cast<int>(std::floor(std::max({p[0].y, p[1].y, p[2].y}))));
+  if (area != 0.0f)
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        const glm::vec2 q(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+        const float w0 = edge(p[1], p[2], q) / area, w1 = edge(p[2], p[0], q) / area, w2 = edge(p[0], p[1], q) / area;
+        if (w0 >= 0.0f && w1 >= 0.0f && w2 >= 0.0f) scratch.emplace_back(x, y);
+      }
+  if (scratch.empty()) {
+    const glm::vec2 g = (p[0] + p[1] + p[2]) / 3.0f;
+    scratch.emplace_back(std::clamp(static_cast<int>(g.x), 0, m.size - 1), std::clamp(static_cast<int>(g.y), 0, m.size - 1));
+  }
+  const float share = 1.0f / static_cast<float>(scratch.size());
+  for (const auto& [x, y] : scratch) deposit(t, face, x, y, flux * share, share, dist, wi);
+}
+
+// A normalized 3×3 tent blur inside each face: every texel's flux goes to its in-face
+// neighbours with weights that sum to one (the total is kept).
+void blur(CubeMap& m, CubeDirections& incident) {
+  static constexpr float k[3] = {0.25f, 0.5f, 0.25f};
+  for (int f = 0; f < kCubeFaces; ++f) {
+    ImageRGBA colour(m.size, m.size, glm::vec4(0.0f));
+    ImageF dist(m.size, m.size, 0.0f);
+    Buffer2D<glm::vec3> inc(m.size, m.size, glm::vec3(0.0f));
+    for (int y = 0; y < m.size; ++y)
+      for (int x = 0; x < m.size; ++x) {
+        const glm::vec4 c = m.colour[f].at(x, y);
+        if (c.w == 0.0f) continue;
+        const float d = m.distance[f].at(x, y);
+        const glm::vec3 wi = incident[f].at(x, y);
+        float total = 0.0f;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            if (x + dx >= 0 && x + dx < m.size && y + dy >= 0 && y + dy < m.size) total += k[dx + 1] * k[dy + 1];
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            if (x + dx >= 0 && x + dx < m.size && y + dy >= 0 && y + dy < m.size) {
+              const float w = k[dx + 1] * k[dy + 1] / total;
+              colour.at(x + dx, y + dy) += c * w;
+              dist.at(x + dx, y + dy) += d * w;
+              inc.at(x + dx, y + dy) += wi * w;
+            }
+      }
+    m.colour[f] = std::move(colour);
+    m.distance[f] = std::move(dist);
+    incident[f] = std::move(inc);
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> caustic_generator_objects(const Scene& scene) {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t o = 0; o < scene.objects.size(); ++o) {
+    const Object& obj = scene.objects[o];
+    if (obj.triangle_count == 0 || obj.material >= scene.materials.size()) continue;
+    if (generator_material(surface_params(scene.materials[obj.material]))) out.push_back(o);
+  }
+  return out;
+}
+
+CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const ReflectorMaps& maps,
+                                   const RefractorImpostors* impostors, const CausticPhotonOptions& opt) {
+  if (opt.photon_res < 1 || opt.photon_res > 4096)
+    throw InputError("caustic_photons", "photon_res out of range (1..4096)");
+  CausticPhotons out;
+  const std::vector<std::uint32_t> gens = caustic_generator_objects(scene);
+  for (std::uint32_t li = 0; li < scene.lights.size(); ++li) {
+    const Light& light = scene.lights[li];
+    for (std::uint32_t object : gens) {
+      if (object >= maps.map_of_object.size() || maps.map_of_object[object] < 0) continue;
+      const int map_index = maps.map_of_object[object];
+      const CubeMap& env = maps.cubes[static_cast<std::size_t>(map_index)];
+      const Sphere sphere = bounding_sphere(scene, scene.objects[object]);
+      // The light's view of the generator: a square frustum holding its bounding sphere. A
+      // directional light looks from 100 radii away along its direction (nearly parallel
+      // rays; the photon's direction is the light's own).
+      const bool directional = light.type == LightType::Directional;
+      Camera cam;
+      float dist_to_centre = 0.0f;
+      if (directional) {
+        dist_to_centre = 100.0f * sphere.radius;
+        cam.eye = sphere.centre - glm::normalize(light.direction) * dist_to_centre;
+      } else {
+        cam.eye = light.position;
+        dist_to_centre = glm::length(sphere.centre - light.position);
+        if (dist_to_centre <= sphere.radius) continue;  // the light inside its generator's sphere
+      }
+      cam.target = sphere.centre;
+      const glm::vec3 forward = glm::normalize(cam.target - cam.eye);
+      cam.up = std::fabs(forward.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+      const float half = std::asin(std::min(1.0f, sphere.radius / dist_to_centre));
+      cam.vfov_degrees = glm::degrees(2.0f * half);
+      cam.znear = std::max(1e-4f * dist_to_centre, (dist_to_centre - sphere.radius) * 1e-3f);
+      cam.zfar = dist_to_centre + 2.0f * sphere.radius;
+      const int res = opt.photon_res;
+      const VisibilityBuffer vis = render_visibility(ex, scene, cam, res, res);
+      const GBuffer gb = resolve_gbuffer(ex, scene, vis, cam.eye);
+      const float tan_half = std::tan(half);
+      const float pixel_area = (2.0f * tan_half / static_cast<float>(res)) * (2.0f * tan_half / static_cast<float>(res));
+      // A refractor makes two photon images from one view: the refracted path and the
+      // surface reflection (each photon image carries one path per texel).
+      const bool refractor = surface_params(scene.materials[scene.objects[object].material]).is_refractor();
+      for (int kind = 0; kind < (refractor ? 2 : 1); ++kind) {
+        const bool surface_reflection = kind == 1;
+        PhotonImage img;
+        img.object = object;
+        img.light = li;
+        img.res = res;
+        img.centre = maps.centres[static_cast<std::size_t>(map_index)];
+        const std::size_t n = static_cast<std::size_t>(res) * res;
+        img.hit.assign(n, glm::vec3(0.0f));
+        img.wi.assign(n, glm::vec3(0.0f));
+        img.flux.assign(n, glm::vec3(0.0f));
+        img.valid.assign(n, 0);
+        std::vector<glm::vec3> arriving(n, glm::vec3(0.0f));
+        std::vector<std::uint8_t> state(n, 0);  // 0 none, 1 stored, 2 TIR, 3 no receiver
+        const CubeMap* impostor = impostors ? impostors->for_object(object) : nullptr;
+        ex.parallel_for("caustic_photons", n, 256, [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i) {
+            if (gb.object.pixels[i] != object) continue;
+            const SurfaceParams& s = gb.surface.pixels[i];
+            if (!generator_material(s)) continue;
+            const glm::vec3 p1 = gb.position.pixels[i];
+            const glm::vec3 v = directional ? glm::normalize(light.direction) : glm::normalize(p1 - light.position);
+            // Power: I(ω) Ω_texel (Ω = the texel's unit-plane area × cos³θ), or E × the texel's
+            // area for a directional light. sample_light gives E = I window cone / d² at p1.
+            const LightSample ls = sample_light(light, p1);
+            glm::vec3 flux;
+            if (directional) {
+              flux = ls.irradiance * (pixel_area * dist_to_centre * dist_to_centre);
+            } else {
+              const float cos_t = glm::dot(v, forward);
+              flux = ls.irradiance * (ls.distance * ls.distance) * (pixel_area * cos_t * cos_t * cos_t);
+            }
+            if (flux == glm::vec3(0.0f)) continue;
+            arriving[i] = flux;
+            glm::vec3 x(0.0f), r(0.0f);
+            if (s.is_refractor() && !surface_reflection) {
+              glm::vec3 n1 = gb.normal.pixels[i];
+              if (glm::dot(n1, v) >= 0.0f) n1 = -n1;
+              if (!impostor) continue;
+              RefractionPath path = enter_refractor(p1, v, n1, s.ior);
+              glm::vec3 p2, n2;
+              if (!find_impostor_exit(*impostor, p1, path.inside, opt.exit_search, p2, n2)) {
+                state[i] = 3;
+                continue;
+              }
+              leave_refractor(path, p2, n2, s.ior);
+              if (path.total_internal) {
+                state[i] = 2;
+                continue;
+              }
+              const glm::vec3 t = s.transmission * s.base_color;
+              flux *= t * (1.0f - path.f_entry) * t * (1.0f - path.f_exit);
+              x = p2;
+              r = glm::normalize(path.exit_direction);
+            } else if (s.is_refractor()) {
+              // The refractor's surface reflection, weighted as the reference weights it:
+              // transmission × exact Fresnel F.
+              glm::vec3 n1 = gb.normal.pixels[i];
+              if (glm::dot(n1, v) > 0.0f) n1 = -n1;
+              flux *= s.transmission * fresnel_dielectric(-glm::dot(n1, v), s.ior);
+              x = p1;
+              r = reflect(v, n1);
+            } else {
+              glm::vec3 n1 = gb.normal.pixels[i];
+              if (glm::dot(n1, v) > 0.0f) n1 = -n1;
+              flux *= specular_reflectance(s, -glm::dot(n1, v));
+              x = p1;
+              r = reflect(v, n1);
+            }
+            const DistanceSearchResult found = search_distance_map(env, x, r, opt.receiver_search);
+            const float stored = std::isfinite(found.d) ? env.distance_towards(found.direction) : kInf;
+            if (!std::isfinite(stored)) {
+              state[i] = 3;
+              continue;
+            }
+            img.hit[i] = env.centre + glm::normalize(found.direction) * stored;
+            const glm::vec3 back = x - img.hit[i];
+            img.wi[i] = glm::dot(back, back) > 0.0f ? glm::normalize(back) : -r;
+            img.flux[i] = flux;
+            img.valid[i] = 1;
+            state[i] = 1;
+          }
+        });
+        for (std::size_t i = 0; i < n; ++i) {
+          if (arriving[i] == glm::vec3(0.0f)) continue;
+          if (!surface_reflection) {  // each texel's arriving power counted once
+            ++out.photons;
+            out.generator_flux += glm::dvec3(arriving[i]);
+          }
+          if (state[i] == 1) {
+            ++out.stored;
+            out.stored_flux += glm::dvec3(img.flux[i]);
+          } else if (state[i] == 2) {
+            ++out.total_internal;
+          } else if (state[i] == 3) {
+            ++out.no_receiver;
+          }
+        }
+        out.images.push_back(std::move(img));
+      }
+    }
+  }
+  return out;
+}
+
+float cube_texel_solid_angle(int x, int y, int size) {
+  const float s = static_cast<float>(size);
+  const float u = 2.0f * (static_cast<float>(x) + 0.5f) / s - 1.0f, v = 2.0f * (static_cast<float>(y) + 0.5f) / s - 1.0f;
+  const float q = 1.0f + u * u + v * v;
+  return (2.0f / s) * (2.0f / s) / (q * std::sqrt(q));
+}
+
+glm::dvec3 caustic_map_flux(const CubeMap& map) {
+  glm::dvec3 sum(0.0);
+  for (int f = 0; f < kCubeFaces; ++f)
+    for (const glm::vec4& c : map.colour[f].pixels) sum += glm::dvec3(c.x, c.y, c.z);
+  return sum;
+}
+
+CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const CausticPhotons& photons,
+                               const CausticMapOptions& opt) {
+  if (opt.size < 1 || opt.size > 4096) throw InputError("caustic_map", "size out of range (1..4096)");
+  CausticMaps out;
+  out.map_of_object.assign(scene.objects.size(), -1);
+  std::vector<std::pair<int, int>> scratch;
+  // The photons land in the order of the images and their texels (a serial blend stage:
+  // the same sums for any thread count).
+  for (const PhotonImage& img : photons.images) {
+    if (out.map_of_object[img.object] < 0) {
+      out.map_of_object[img.object] = static_cast<int>(out.cubes.size());
+      CubeMap m;
+      m.size = opt.size;
+      m.centre = img.centre;
+      for (int f = 0; f < kCubeFaces; ++f) {
+        m.colour[f] = ImageRGBA(opt.size, opt.size, glm::vec4(0.0f));
+        m.distance[f] = ImageF(opt.size, opt.size, 0.0f);
+      }
+      out.cubes.push_back(std::move(m));
+      out.objects.push_back(img.object);
+      CubeDirections inc;
+      for (int f = 0; f < kCubeFaces; ++f) inc[f] = Buffer2D<glm::vec3>(opt.size, opt.size, glm::vec3(0.0f));
+      out.incident.push_back(std::move(inc));
+    }
+    const std::size_t mi = static_cast<std::size_t>(out.map_of_object[img.object]);
+    CubeMap& m = out.cubes[mi];
+    MapTarget target{m, out.incident[mi]};
+    const int res = img.res;
+    auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
+    if (opt.filter == CausticFilter::Splat) {
+      for (int y = 0; y < res; ++y)
+        for (int x = 0; x < res; ++x) {
+          const std::size_t i = idx(x, y);
+          if (!img.valid[i]) continue;
+          const glm::vec3 d = img.hit[i] - m.centre;
+          const float dist = glm::length(d);
+          int radius = opt.splat_radius;
+          if (opt.adaptive) {
+            // The photon's reach: the farthest of its photon-image neighbours on the same
+            // receiver (distances within 20 %), in caustic-map texels, so sparse photons
+            // leave no holes and dense ones stay sharp.
+            const CubeCoord c = cube_coord(d, m.size);
+            float spacing = 0.0f;
+            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+            for (int k = 0; k < 4; ++k) {
+              if (nx[k] < 0 || ny[k] < 0 || nx[k] >= res || ny[k] >= res) continue;
+              const std::size_t j = idx(nx[k], ny[k]);
+              if (!img.valid[j]) continue;
+              const glm::vec3 dj = img.hit[j] - m.centre;
+              const float lj = glm::length(dj);
+              if (std::max(lj, dist) > 1.2f * std::min(lj, dist)) continue;
+              glm::vec2 pj;
+              if (face_pixel(dj, c.face, m.size, pj)) spacing = std::max(spacing, glm::length(pj - c.pixel));
+            }
+            radius = std::max(radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
+          }
+          splat(target, d, img.flux[i], dist, img.wi[i], radius);
+        }
+      continue;
+    }
+    // Caustic triangles (§6.3.2): a cell of four neighbouring photons whose receiver
+    // distances agree within 20 % (one receiver surface) makes two triangles, drawn on the
+    // face of the cell's mean direction. Each photon's flux is shared equally by the cells it
+    // is a corner of; a photon in none is splatted into its texel.
+    const int cells = res - 1;
+    std::vector<std::uint8_t> cell_ok(static_cast<std::size_t>(std::max(cells, 0)) * std::max(cells, 0), 0);
+    std::vector<float> dists(img.valid.size(), 0.0f);
+    for (std::size_t i = 0; i < img.valid.size(); ++i)
+      if (img.valid[i]) dists[i] = glm::length(img.hit[i] - m.centre);
+    std::vector<int> corner_of(img.valid.size(), 0);
+    for (int y = 0; y < cells; ++y)
+      for (int x = 0; x < cells; ++x) {
+        const std::size_t c[4] = {idx(x, y), idx(x + 1, y), idx(x + 1, y + 1), idx(x, y + 1)};
+        bool ok = true;
+        float lo = kInf, hi = 0.0f;
+        for (std::size_t k : c) {
+          ok = ok && img.valid[k];
+          lo = std::min(lo, dists[k]);
+          hi = std::max(hi, dists[k]);
+        }
+        if (!ok || hi > 1.2f * lo) continue;
+        cell_ok[static_cast<std::size_t>(y) * cells + x] = 1;
+        for (std::size_t k : c) ++corner_of[k];
+      }
+    for (std::size_t i = 0; i < img.valid.size(); ++i)
+      if (img.valid[i] && corner_of[i] == 0) splat(target, img.hit[i] - m.centre, img.flux[i], dists[i], img.wi[i], 0);
+    for (int y = 0; y < cells; ++y)
+      for (int x = 0; x < cells; ++x) {
+        if (!cell_ok[static_cast<std::size_t>(y) * cells + x]) continue;
+        const std::size_t c[4] = {idx(x, y), idx(x + 1, y), idx(x + 1, y + 1), idx(x, y + 1)};
+        glm::vec3 flux(0.0f), wi(0.0f);
+        float dist = 0.0f;
+        glm::vec2 p[4];
+        glm::vec3 mean_dir(0.0f);
+        for (int k = 0; k < 4; ++k) {
+          flux += img.flux[c[k]] / static_cast<float>(corner_of[c[k]]);
+          dist += 0.25f * dists[c[k]];
+          wi += 0.25f * img.wi[c[k]];
+          mean_dir += (img.hit[c[k]] - m.centre) / dists[c[k]];
+        }
+        const int face = cube_coord(mean_dir, m.size).face;
+        bool projected = true;
+        for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, face, m.size, p[k]);
+        if (!projected) {  // a cell wider than a face's half space: its corners as points
+          for (int k = 0; k < 4; ++k)
+            splat(target, img.hit[c[k]] - m.centre, img.flux[c[k]] / static_cast<float>(corner_of[c[k]]), dists[c[k]],
+                  img.wi[c[k]], 0);
+          continue;
+        }
+        const glm::vec2 t0[3] = {p[0], p[1], p[2]}, t1[3] = {p[0], p[2], p[3]};
+        raster_triangle(target, face, t0, flux * 0.5f, dist, wi, scratch);
+        raster_triangle(target, face, t1, flux * 0.5f, dist, wi, scratch);
+      }
+  }
+  if (opt.filter == CausticFilter::Triangles)
+    for (std::size_t k = 0; k < out.cubes.size(); ++k) blur(out.cubes[k], out.incident[k]);
+  // Distances: the flux-weighted means; +inf where nothing landed.
+  for (std::size_t k = 0; k < out.cubes.size(); ++k)
+    for (int f = 0; f < kCubeFaces; ++f) {
+      CubeMap& m = out.cubes[k];
+      for (std::size_t i = 0; i < m.distance[f].pixels.size(); ++i) {
+        glm::vec4& c = m.colour[f].pixels[i];
+        float& d = m.distance[f].pixels[i];
+        glm::vec3& wi = out.incident[k][f].pixels[i];
+        d = c.w > 0.0f ? d / c.w : kInf;
+        wi = glm::dot(wi, wi) > 0.0f ? glm::normalize(wi) : glm::vec3(0.0f);
+        c.w = 1.0f;
+      }
+    }
+  return out;
+}
+
+ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps& maps, const ImageRGBA& direct,
+                          float tolerance) {
+  if (direct.width != g.width || direct.height != g.height)
+    throw InputError("caustic_gather", "direct light and G-buffer differ in size");
+  ImageRGBA out = direct;
+  const std::size_t n = static_cast<std::size_t>(g.width) * g.height;
+  ex.parallel_for("caustic_gather", n, 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (!g.covered(i)) continue;
+      const SurfaceParams& s = g.surface.pixels[i];
+      if (s.is_refractor()) continue;
+      const glm::vec3 p = g.position.pixels[i], nrm = g.normal.pixels[i], v = g.view_direction(i);
+      glm::vec3 sum(0.0f);
+      for (std::size_t k = 0; k < maps.cubes.size(); ++k) {
+        if (g.object.pixels[i] == maps.objects[k]) continue;  // a generator is not its own receiver
+        const CubeMap& m = maps.cubes[k];
+        const glm::vec3 d = p - m.centre;
+        const float dist = glm::length(d);
+        if (!(dist > 0.0f)) continue;
+        const float stored = m.distance_towards(d);
+        // The shadow-map-like test: only the receiver the photons found is lit. Across one
+        // texel (angle ≈ 2/size) a receiver at angle α to the line of sight from the centre
+        // changes its distance by about d (2/size) tanα, so grazing receivers are allowed
+        // that much more (tanα capped at 16, beyond which no texel resolves the surface).
+        const float cos_view = std::fabs(glm::dot(nrm, d)) / dist;
+        const float tan_view = std::min(16.0f, std::sqrt(std::max(0.0f, 1.0f - cos_view * cos_view)) / std::max(cos_view, 1e-3f));
+        const float slack = tolerance * stored + 2.0f * dist * tan_view * (2.0f / static_cast<float>(m.size));
+        if (!std::isfinite(stored) || std::fabs(dist - stored) > slack) continue;
+        const CubeCoord c = cube_coord(d, m.size);
+        const int x = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
+        const int y = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
+        const glm::vec3 flux = glm::vec3(m.colour_towards(d));
+        const glm::vec3 wi = maps.incident[k][c.face].at(x, y);
+        // The texel's flux lands on the receiver area Ω d² / |cosα| it subtends (α between
+        // the normal and the line from the centre): irradiance Φ |cosα| / (Ω d²), arriving
+        // from wi. shade_light returns f (N·L) E, so it is given E / (N·wi).
+        const float cos_alpha = std::fabs(glm::dot(nrm, d)) / dist, cos_in = glm::dot(nrm, wi);
+        if (cos_in <= 1e-4f) continue;
+        LightSample ls;
+        ls.direction = wi;
+        ls.distance = dist;
+        ls.irradiance = flux * (cos_alpha / (cube_texel_solid_angle(x, y, m.size) * dist * dist * cos_in));
+        sum += shade_light(s, nrm, v, ls);
+      }
+      out.pixels[i] += glm::vec4(sum, 0.0f);
+    }
+  });
+  return out;
+}
+
+CausticPhotons CausticPhotonsPass::operator()(par::NodeContext& c, const ReflectorMaps& maps,
+                                              const RefractorImpostors* impostors) const {
+  CausticPhotons p = trace_photon_images(c.executor(), *scene, maps, impostors, options);
+  c.count("photons", static_cast<double>(p.photons));
+  c.count("stored", static_cast<double>(p.stored));
+  c.count("total_internal", static_cast<double>(p.total_internal));
+  c.count("no_receiver", static_cast<double>(p.no_receiver));
+  return p;
+}
+
+CausticMaps CausticMapPass::operator()(par::NodeContext& c, const CausticPhotons& photons) const {
+  CausticMaps m = build_caustic_maps(c.executor(), *scene, photons, options);
+  c.count("maps", static_cast<double>(m.cubes.size()));
+  return m;
+}
+
+ReflectorMaps CausticReflectorMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                                   const EnvironmentMap& environment, const GBuffer& gbuffer,
+                                                   const CausticMaps& caustics) const {
+  ReflectorMaps maps = render_reflector_maps(
+      c.executor(), *scene, shadows, environment, size, &gbuffer, ReflectorSelection::all,
+      [&](const GBuffer& face, const ImageRGBA& direct) {
+        return gather_caustics(c.executor(), face, caustics, direct, tolerance);
+      });
+  c.count("cube_maps", static_cast<double>(maps.cubes.size()));
+  return maps;
+}
+
+ImageRGBA CausticGatherPass::operator()(par::NodeContext& c, const GBuffer& gbuffer, const CausticMaps& maps,
+                                        const ImageRGBA& direct) const {
+  return gather_caustics(c.executor(), gbuffer, maps, direct, tolerance);
+}
+
+}  // namespace speculum::raster
