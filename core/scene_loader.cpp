@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <string_view>
 
 #include "core/camera_rays.h"
 #include "core/did_you_mean.h"
@@ -48,14 +49,26 @@ double parse_number(const std::string& source, const std::string& key, const std
   return v;
 }
 
-Scene build_builtin(const std::string& spec, const SceneOptions& options) {
+// True when `key` is one of the names in `extra_params` ("n=8 (bump frequency), amplitude=0.06"):
+// a whole name, so "" or "mplitude" is an unknown option rather than a match inside one.
+bool takes_option(std::string_view extra_params, const std::string& key) {
+  if (key.empty()) return false;
+  for (std::size_t at = extra_params.find(key + "="); at != std::string_view::npos;
+       at = extra_params.find(key + "=", at + 1))
+    if (at == 0 || extra_params[at - 1] == ' ') return true;
+  return false;
+}
+
+}  // namespace
+
+BuiltinSpec parse_builtin_spec(const std::string& spec, std::uint64_t default_size) {
   const std::size_t colon = spec.find(':');
   const std::string name = spec.substr(0, colon);
   const BuiltinScene* def = find_builtin_scene(name);
   if (!def)
     throw InputError(spec, "no such built-in scene" + scene_suggestion(spec) + " (see `speculum scenes list`)");
   BuiltinParams params;
-  params.size = options.size ? options.size : def->default_size;
+  params.size = default_size ? default_size : def->default_size;
   if (colon != std::string::npos) {
     std::string rest = spec.substr(colon + 1);
     std::replace(rest.begin(), rest.end(), ':', ',');
@@ -72,7 +85,7 @@ Scene build_builtin(const std::string& spec, const SceneOptions& options) {
       if (key == "size") {
         if (value < 0 || value > 1e12) throw InputError(spec, "size out of range");
         params.size = static_cast<std::uint64_t>(value);
-      } else if (std::string(def->extra_params).find(key + "=") != std::string::npos) {
+      } else if (takes_option(def->extra_params, key)) {
         params.extra[key] = value;
       } else {
         throw InputError(spec, "unknown option '" + key + "' (scene takes size=N" +
@@ -89,7 +102,14 @@ Scene build_builtin(const std::string& spec, const SceneOptions& options) {
     throw InputError(spec, "amplitude must be in [0, 0.5]");
   if (const double r = params.get("reflectors", 8.0); !(r >= 8.0 && r <= 40.0 && r == std::floor(r)))
     throw InputError(spec, "reflectors must be a whole number in [8, 40]");
-  Scene scene = def->build(params);
+  return {def, std::move(params)};
+}
+
+namespace {
+
+Scene build_builtin(const std::string& spec, const SceneOptions& options) {
+  const BuiltinSpec parsed = parse_builtin_spec(spec, options.size);
+  Scene scene = parsed.scene->build(parsed.params);
   scene.name = spec;
   return scene;
 }

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/procedural_scenes.h"
 #include "core/scene.h"
 
 namespace speculum {
@@ -41,6 +42,16 @@ struct SceneOptions {
 // scene name with an optional ":size=N" suffix. The result has passed Scene::validate()
 // and has at least one material and one camera. Throws InputError naming the source.
 Scene load_scene(const std::string& file_or_name, const SceneOptions& options = {});
+
+// A built-in scene spec "NAME[:size=N][,key=value...]" checked and parsed, not yet built:
+// the scene, and its parameters with size in [kMinSceneSize, kMaxSceneSize] (`default_size`,
+// when not 0, replaces the scene's default; a size in the spec wins). Throws InputError(spec,
+// problem) for an unknown name or key, a value that is not a number, or one out of range.
+struct BuiltinSpec {
+  const BuiltinScene* scene = nullptr;
+  BuiltinParams params;
+};
+BuiltinSpec parse_builtin_spec(const std::string& spec, std::uint64_t default_size = 0);
 
 // The scene `speculum render` uses when none is given.
 const char* default_scene_name();

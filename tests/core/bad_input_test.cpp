@@ -111,7 +111,11 @@ TEST(BadInput, MissingFileAndUnknownName) {
                                  std::string("sphere-in-room:size=12"),
                                  std::string("sphere-in-room:size=abc"),
                                  std::string("sphere-in-room:colour=3"),
-                                 std::string("bumpy-sphere:n=-1")}) {
+                                 std::string("bumpy-sphere:n=-1"),
+                                 // Option names match whole: not a piece of one, not empty.
+                                 std::string("bumpy-sphere:mplitude=0.1"),
+                                 std::string("bumpy-sphere:=0.1"),
+                                 std::string("sphere-in-room:size=10000000000")}) {
     SCOPED_TRACE(name);
     try {
       (void)load_scene(name);
