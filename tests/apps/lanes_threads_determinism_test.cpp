@@ -48,6 +48,8 @@ TEST(LanesThreadsDeterminism, EnvmapSameBytesForEveryWidthAndThreadCount) {
 
 TEST(LanesThreadsDeterminism, VertexProjectionSameBytesForEveryWidthAndThreadCount) {
   expect_same_bytes_for_every_width_and_thread_count("vertex-projection");
+}
+
 TEST(LanesThreadsDeterminism, SoffSameBytesForEveryWidthAndThreadCount) {
   expect_same_bytes_for_every_width_and_thread_count("soff");
 }
