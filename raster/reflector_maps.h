@@ -32,11 +32,14 @@ struct ReflectorMaps {
 
 // Specular objects: at least one triangle's material reflects or refracts
 // (is_specular(surface_params(material))).
-// `camera_view` (may be null) is the camera's G-buffer, used for flat reflectors.
+// `camera_view` (may be null) is the camera's G-buffer, used for flat reflectors. Objects
+// flagged in `skip` (indexed by object id; may be null) get no map: a technique that
+// handles them otherwise (vertex-projection's mirrors).
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
-                                    const GBuffer* camera_view = nullptr);
+                                    const GBuffer* camera_view = nullptr,
+                                    const std::vector<std::uint8_t>* skip = nullptr);
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {
