@@ -56,13 +56,14 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size,
                                     const GBuffer* camera_view, ReflectorSelection which,
-                                    const FaceLight& add_light) {
+                                    const FaceLight& add_light, const std::vector<std::uint8_t>* skip) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   const TriangleMesh& m = scene.mesh;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
+    if (skip && o < skip->size() && (*skip)[o]) continue;
     bool specular = false, refracts = false;
     float widest_lobe = 1e6f;  // smallest Phong exponent the map is read with
     Bounds b;

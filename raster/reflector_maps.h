@@ -43,12 +43,15 @@ const char* to_string(ReflectorSelection which);
 // `add_light` (may be empty) adds light to each face's direct light before the composite,
 // from the face's G-buffer (the caustics technique gathers its caustics there).
 using FaceLight = std::function<ImageRGBA(const GBuffer& face, const ImageRGBA& direct)>;
+// Objects flagged in `skip` (indexed by object id; may be null) get no map either: a
+// technique that handles them otherwise (vertex-projection's mirrors).
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
                                     const GBuffer* camera_view = nullptr,
                                     ReflectorSelection which = ReflectorSelection::all,
-                                    const FaceLight& add_light = {});
+                                    const FaceLight& add_light = {},
+                                    const std::vector<std::uint8_t>* skip = nullptr);
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {

@@ -434,6 +434,17 @@ ReflectorParams ReflectorParamPass::operator()(par::NodeContext& c) const {
   return out;
 }
 
+ReflectorMaps FallbackCubeMapsPass::operator()(par::NodeContext& c, const ReflectorParams& params,
+                                              const ShadowMaps& shadows, const EnvironmentMap& environment,
+                                              const GBuffer& gbuffer) const {
+  std::vector<std::uint8_t> skip(scene->objects.size(), 0);
+  for (const ReflectorParam& p : params.reflectors) skip[p.object] = 1;
+  ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
+                                             ReflectorSelection::all, {}, &skip);
+  c.count("cube_maps", double(maps.cubes.size()));
+  return maps;
+}
+
 ProjectedVertices VertexProjectPass::operator()(par::NodeContext& c, const ReflectedGeometry& geometry,
                                                 const ReflectorParams& params, const GBuffer& gbuffer) const {
   ProjectionStats stats;

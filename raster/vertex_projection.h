@@ -23,6 +23,7 @@
 #include "raster/environment.h"
 #include "raster/fermat_projection.h"
 #include "raster/gbuffer.h"
+#include "raster/reflector_maps.h"
 #include "raster/shadow_map.h"
 
 namespace speculum::raster {
@@ -144,6 +145,20 @@ struct ReflectorParamPass {
   int size = 256;
   void parameters(par::Params& p) const { p.set("size", size); }
   ReflectorParams operator()(par::NodeContext& c) const;
+};
+
+// Pass "reflector_cube_maps" of this technique: the environment-map fallback's cube maps
+// for the specular objects that have no parameterization (glossy ones, mirrors that are not
+// star-shaped); a projected mirror never reads its own.
+struct FallbackCubeMapsPass {
+  static constexpr const char* description =
+      "Per specular object without a parameterization (glossy, not star-shaped), a colour + "
+      "distance cube map at its reference point for the environment-map fallback (SURVEY §3.1).";
+  const Scene* scene = nullptr;
+  int size = 256;
+  void parameters(par::Params& p) const { p.set("size", size); }
+  ReflectorMaps operator()(par::NodeContext& c, const ReflectorParams& params, const ShadowMaps& shadows,
+                           const EnvironmentMap& environment, const GBuffer& gbuffer) const;
 };
 
 // Pass "vertex_project".

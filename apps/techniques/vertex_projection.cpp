@@ -3,7 +3,6 @@
 #include "apps/techniques/frame_passes.h"
 #include "apps/techniques/recipes.h"
 #include "raster/envmap_reflect.h"
-#include "raster/reflector_maps.h"
 #include "raster/vertex_projection.h"
 
 namespace speculum::pipeline {
@@ -12,13 +11,13 @@ using namespace speculum::raster;
 
 FrameOutputs add_vertex_projection_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   const SurfaceResources s = add_surface_passes(g, scene, f);
-  // Specular samples the projection does not handle (glossy reflectors, reflectors that are
-  // not star-shaped) keep the environment-map layer.
-  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size},
-                    s.shadow_maps, s.environment, s.gbuffer);
-  auto fallback = g.add("envmap_reflect", EnvmapReflectPass{}, s.gbuffer, s.environment, maps);
   auto geometry = g.add("tessellate", TessellatePass{scene, f.param("edge")});
   auto param = g.add("reflector_param", ReflectorParamPass{scene, int(f.param("param_size"))});
+  // Specular samples the projection does not handle (glossy reflectors, reflectors that are
+  // not star-shaped) keep the environment-map layer; only they get cube maps.
+  auto maps = g.add("reflector_cube_maps", FallbackCubeMapsPass{scene, f.cube_map_size}, param, s.shadow_maps,
+                    s.environment, s.gbuffer);
+  auto fallback = g.add("envmap_reflect", EnvmapReflectPass{}, s.gbuffer, s.environment, maps);
   FermatSettings fermat;
   fermat.max_iterations = int(f.param("max_iterations"));
   fermat.pixel_tolerance = f.param("pixel_tolerance");

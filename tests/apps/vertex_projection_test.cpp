@@ -186,6 +186,9 @@ TEST(VertexProjection, AgreesWithTheExactSpecularReference) {
   EXPECT_EQ(counter(room, "vertex_project/maxima"), 0.0);
   EXPECT_LT(counter(room, "vertex_project/middle_zone_vertices"), 0.01 * converged);
   EXPECT_LT(counter(room, "vertex_projection_shade/environment_samples"), 50.0);
+  // Cube maps only for what the projection leaves to the fallback: the room's glossy ball.
+  EXPECT_EQ(counter(room, "reflector_cube_maps/cube_maps"), 1.0);
+  EXPECT_EQ(counter(cell("vertex-projection@ellipsoid"), "reflector_cube_maps/cube_maps"), 0.0);
 
   // The bowl: the ball lies in the near zone and reflects upright (minima of the path);
   // stationary points of the middle zone (saddles) are counted and their triangles dropped.
