@@ -15,9 +15,10 @@
 // fixed chunks, each chunk collects its own splats, and the splats are added to the image
 // serially in chunk order, so the image is the same bytes for any thread count.
 //
-// Not traced: paths that reach the eye through a specular surface after their diffuse
-// arrival (a caustic seen in a mirror or through glass), glossy (non-delta) surfaces as
-// caustic generators, and environment light.
+// The arrivals also feed the reference's photon map (trace/photon_map.h), which gives the
+// caustics a camera path sees after a specular bounce (in a mirror, through glass): a
+// direct connection to the eye cannot pass a delta surface. Not traced: glossy (non-delta)
+// surfaces as caustic generators, and environment light.
 #pragma once
 
 #include <cstdint>

@@ -48,7 +48,9 @@ struct Tracer {
     return any_hit(bvh, r, &counters);
   }
 
-  glm::vec3 radiance(const Ray& ray, int depth) {
+  // `weight`: the largest channel of the product of the specular weights on the way here
+  // (1 at the camera); the photon map is queried only where it can still matter.
+  glm::vec3 radiance(const Ray& ray, int depth, float weight = 1.0f) {
     const Hit h = closest_hit(bvh, ray, &counters);
     const glm::vec3 dir = glm::normalize(ray.direction);
     if (!h.hit()) return environment_radiance(scene.environment, dir);
@@ -76,8 +78,11 @@ struct Tracer {
     }
     // Caustics: seen directly they are the light tracer's (render_caustics); seen through a
     // mirror, a refractor or a glossy lobe, the photon map's.
-    // (Refractors and pure metals reflect no photon light the query could find: skipped.)
-    if (photons && depth > 0 && !s.is_refractor() && !(s.is_mirror_lobe() && s.metallic >= 1.0f))
+    // (Refractors and pure metals reflect no photon light the query could find, and a path
+    // whose specular weight has fallen under 1/1024 (deep internal reflections) adds less
+    // than the estimate's own noise: both skipped, which saves most of the queries.)
+    if (photons && depth > 0 && weight >= 1.0f / 1024.0f && !s.is_refractor() &&
+        !(s.is_mirror_lobe() && s.metallic >= 1.0f))
       L += photons->radiance(p, n, v, s);
     // Environment light, occluded, on the lobes no specular ray follows: the diffuse lobe
     // (cosine-sampled, weight f_d cos / (cos/π) = π f_d of the coupled BRDF) and, on rough
@@ -100,29 +105,33 @@ struct Tracer {
       if (s.is_refractor() || s.is_mirror_lobe() || s.is_glossy_lobe()) ++stats.depth_limited;
       return L;
     }
-    auto trace_dir = [&](const glm::vec3& origin, const glm::vec3& d) {
+    const auto largest = [](const glm::vec3& c) { return std::max({c.x, c.y, c.z}); };
+    auto trace_dir = [&](const glm::vec3& origin, const glm::vec3& d, float factor) {
       ++stats.specular_rays;
       Ray r;
       r.origin = origin;
       r.direction = d;
-      return radiance(r, depth + 1);
+      return radiance(r, depth + 1, weight * factor);
     };
     if (s.is_refractor()) {
       const float nu = entering ? s.ior : 1.0f / s.ior;
       glm::vec3 tdir(0.0f);  // written by refract() when it returns true
       const bool ok = refract(dir, n, nu, tdir);
       const float F = ok ? fresnel_dielectric(cos_nv, nu) : 1.0f;
-      glm::vec3 Ls = F * trace_dir(above, reflect(dir, n));
-      if (ok && F < 1.0f) Ls += (1.0f - F) * s.base_color * trace_dir(offset_ray_origin(p, -ng), glm::normalize(tdir));
+      glm::vec3 Ls = F * trace_dir(above, reflect(dir, n), s.transmission * F);
+      if (ok && F < 1.0f)
+        Ls += (1.0f - F) * s.base_color *
+              trace_dir(offset_ray_origin(p, -ng), glm::normalize(tdir), s.transmission * (1.0f - F) * largest(s.base_color));
       L += s.transmission * Ls;
     } else if (s.is_mirror_lobe()) {
-      L += specular_reflectance(s, cos_nv) * trace_dir(above, reflect(dir, n));
+      const glm::vec3 f = specular_reflectance(s, cos_nv);
+      L += f * trace_dir(above, reflect(dir, n), largest(f));
     } else if (s.is_glossy_lobe()) {
       // The ground truth samples the GGX lobe itself (visible normals), weighted f cos / p
       // = F(V·H) G2/G1 (core/brdf.h): the same BRDF the techniques' lobes are weighted by.
       const LobeSample ls = sample_specular_lobe(s, n, v, {rnd(depth, 2), rnd(depth, 3)});
       if (ls.weight == glm::vec3(0.0f) || glm::dot(ls.direction, ng) <= 0.0f) ++stats.below_horizon;
-      else L += ls.weight * trace_dir(above, ls.direction);
+      else L += ls.weight * trace_dir(above, ls.direction, largest(ls.weight));
     }
     return L;
   }

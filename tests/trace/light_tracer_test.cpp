@@ -1,7 +1,7 @@
 // The reference's caustics (trace/light_tracer.h) against analytic optics: a planar mirror's
 // caustic is a virtual point light, a ball lens focuses paraxial light at νD/(4(ν−1)) from
 // its centre, the light-traced image converges as photons grow, and the bytes do not depend
-// on the thread count.
+// on the thread count; the photon map estimates the mirror caustic too.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +17,7 @@
 #include "parallel/executor.h"
 #include "trace/bvh.h"
 #include "trace/light_tracer.h"
+#include "trace/photon_map.h"
 #include "trace/reference_tracer.h"
 
 namespace speculum::trace {
@@ -195,6 +196,38 @@ TEST(LightTracer, BadPhotonCountIsAnInputError) {
   PhotonOptions o;
   o.photons = 0;
   EXPECT_THROW(trace_caustic_photons(s, bvh, o, ex), InputError);
+}
+
+}  // namespace
+}  // namespace speculum::trace
+
+namespace speculum::trace {
+namespace {
+
+// The photon map's density estimate of the planar mirror's caustic: the floor's radiance is
+// f · F(θ) I cosθ / |x − L'|², averaged over nine points (the estimate of one point has the
+// noise of its k photons and the blur of their disc).
+TEST(LightTracer, PhotonMapEstimatesThePlanarMirrorCaustic) {
+  const Scene s = mirror_over_floor();
+  par::Executor ex(2);
+  const Bvh bvh = Bvh::build(s.mesh, ex);
+  PhotonOptions o;
+  o.photons = 1 << 21;
+  const PhotonMap map(trace_caustic_photons(s, bvh, o, ex), 256, 0.5f);
+  const SurfaceParams floor_s = surface_params(s.materials[0]), mirror_s = surface_params(s.materials[1]);
+  const glm::vec3 virtual_light(0.0f, 3.0f, 0.0f), n(0.0f, 1.0f, 0.0f), v = glm::normalize(glm::vec3(0, 1, 1));
+  double estimated = 0.0, expected = 0.0;
+  for (float x : {-1.0f, 0.0f, 1.0f})
+    for (float z : {-1.0f, 0.0f, 1.0f}) {
+      const glm::vec3 p(x, 0.0f, z), d = virtual_light - p;
+      const float r2 = glm::dot(d, d), cos_t = d.y / std::sqrt(r2);
+      LightSample ls;
+      ls.direction = d / std::sqrt(r2);
+      ls.irradiance = glm::vec3(specular_reflectance(mirror_s, cos_t).x * 10.0f / r2);
+      expected += shade_light(floor_s, n, v, ls).x;
+      estimated += map.radiance(p, n, v, floor_s).x;
+    }
+  EXPECT_NEAR(estimated, expected, 0.05 * expected);
 }
 
 }  // namespace
