@@ -475,8 +475,6 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
       }
     });
   }
-  out.triangles_set_up = st.triangles_set_up;
-  st.objects_culled = 0;
   if (stats) *stats = st;
   return out;
 }

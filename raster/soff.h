@@ -134,15 +134,13 @@ struct SoffDepthImages {
   std::vector<std::size_t> offsets;
   std::vector<float> inv_z;         // 1/z along the camera axis; 0: empty (nothing seen)
   std::vector<glm::vec3> colour;    // direct shading of the surface seen, or the environment
-  std::uint64_t triangles_set_up = 0;  // triangles that survived the per-cluster frustum cull
   std::uint64_t pixels = 0;
 };
 
 struct SoffDepthStats {
   std::uint64_t images = 0;
-  std::uint64_t triangles_set_up = 0;
+  std::uint64_t triangles_set_up = 0;  // triangles that survived the per-cluster frustum cull
   std::uint64_t triangles_culled = 0;
-  std::uint64_t objects_culled = 0;
 };
 
 SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, const SoffClusters& clusters,

@@ -101,12 +101,13 @@ const std::vector<Technique>& techniques() {
        "and reflector, a pinhole camera and a rasterized depth image per cluster, reflected rays "
        "walked through it pixel by pixel; glossy: several lobe rays",
        add_soff_passes,
-       // Each cluster renders the scene once: the bins bound the clusters (reflectors × θ × φ),
-       // and max_image_side bounds each depth image (4096²: 64M pixels, ~1.5 GB with its
-       // G-buffer); glossy_rays multiplies the intersection work per glossy sample.
+       // Each cluster renders the scene once: the bins bound the clusters (reflectors × θ × φ).
+       // The depth images hold at most 4 × image_scale² pixels per clustered sample (~20 bytes
+       // each, kept for the frame): at the 2²³-sample limit and scale 2, ~2.7 GB; each side is
+       // also bounded by max_image_side. glossy_rays multiplies the walks per glossy sample.
        {{"theta_bins", 13, 1, 64, true, "MAXTHETABINS: normal azimuth bins (clusters grow with it)"},
         {"phi_bins", 8, 1, 32, true, "MAXPHIBINS: normal polar bins (clusters grow with it)"},
-        {"image_scale", 1, 0.125, 4, false, "depth-image resolution × this (SOFF Table 5)"},
+        {"image_scale", 1, 0.125, 2, false, "depth-image resolution × this (SOFF Table 5; ≤ 16 pixels per sample at 2)"},
         {"max_image_side", 1024, 16, 4096, true, "largest depth-image side (clamped images are counted)"},
         {"glossy_rays", 8, 1, 64, true, "reflected rays per glossy sample (SOFF §3.5: 8 to 49)"},
         {"glossy_far", 1, 0.05, 1, false, "glossy clusters' far plane at this × the scene diameter (§3.5)"},
