@@ -328,6 +328,7 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
   } else if (!draw_trace_output(o, executor, d)) {
     d.drawable = false;
   }
+  if (d.views.empty()) d.drawable = false;  // e.g. no reflector of that kind: nothing to show
   return d;
 }
 

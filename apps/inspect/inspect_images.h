@@ -1,7 +1,8 @@
 // How `inspect` draws a captured node output (parallel/graph.h CapturedOutput): each known
 // type becomes one or more views — a PNG picture (false colour for ids, normalised ramps for
 // depth, distance and counters, n·0.5+0.5 for normals, tone-mapped radiance, cube maps as a
-// cross) plus its raw values for an EXR. Unknown types are reported as not drawable.
+// cross) plus its raw values for an EXR. Unknown types, and outputs with nothing to show (no cube
+// map in a list of them), are reported as not drawable.
 #pragma once
 
 #include <array>

@@ -42,9 +42,10 @@ ImageRGBA reference_display(const Scene& s, int depth, par::Executor& ex) {
 }
 
 // Cells that still break the rule, bounded at their current count so they cannot get worse
-// (a bound may only be lowered): in living-room, yu-lod's glass ball falls back to the
-// environment, which is dark inside the room, and ray-hierarchy's chrome balls see a few
-// black hits at the table's edge; in water-slab, rays that refract into the closed slab
+// (a bound may only be lowered): in living-room and bathroom, yu-lod's rays that hit a
+// surface in shadow find it black (its hit shading is direct light plus the environment's
+// unoccluded irradiance, with no light bounced between surfaces, which the reference has), and
+// ray-hierarchy's chrome balls see a few black hits at the table's edge; in water-slab, rays that refract into the closed slab
 // reach its floor-side face from inside, where ray-hierarchy's one bounce and the layered
 // tracer's layers end.
 struct OpenCell {
@@ -53,6 +54,7 @@ struct OpenCell {
   std::size_t max_black;
 };
 constexpr OpenCell kOpenCells[] = {{"yu-lod", "living-room", 124},
+                                   {"yu-lod", "bathroom", 63},
                                    {"ray-hierarchy", "living-room", 35},
                                    {"ray-hierarchy", "water-slab", 1273},
                                    {"layered-distance-map", "water-slab", 608}};
@@ -105,7 +107,8 @@ TEST_P(NoBlackRegions, EveryTechniqueAgainstTheReference) {
 
 INSTANTIATE_TEST_SUITE_P(BuiltinScenes, NoBlackRegions,
                          ::testing::Values("sphere-in-room", "glossy-plane", "mirror-corridor", "living-room",
-                                           "glass-sphere", "bowl", "bumpy-sphere", "caustic-ring", "water-slab"),
+                                           "glass-sphere", "bowl", "bumpy-sphere", "caustic-ring", "water-slab",
+                                           "ellipsoid", "bathroom"),
                          [](const auto& info) {
                            std::string n = info.param;
                            for (char& c : n) if (c == '-') c = '_';
