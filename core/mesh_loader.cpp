@@ -222,6 +222,31 @@ void check_declared_counts(const std::string& path, const std::string& ext, std:
       const unsigned long long nf = whole("face count");
       too_many(nv, "vertices", 6);
       too_many(nf, "faces", 2);
+      // OpenMesh reads each vertex from its own line, then the faces as a stream of values:
+      // a corner count and that many indices, trusting the count (a face claiming 444400000
+      // corners made it append handles until memory ran out). Each count must fit in the
+      // values left in the file. A value that is not a whole number means the faces carry
+      // colours, which OpenMesh parses its own way: the walk stops there.
+      std::string line;
+      std::getline(in, line);  // the rest of the counts line
+      for (unsigned long long left = nv; left > 0 && std::getline(in, line);) {
+        std::istringstream ls(line);
+        std::string first;
+        if ((ls >> first) && first[0] != '#') --left;
+      }
+      std::vector<std::string> values;
+      for (std::string t; in >> t;) values.push_back(std::move(t));
+      std::size_t at = 0;
+      for (unsigned long long f = 0; f < nf && at < values.size(); ++f) {
+        const std::string& count = values[at++];
+        if (count.size() > 12 || count.find_first_not_of("0123456789") != std::string::npos) break;
+        const unsigned long long n = std::stoull(count);
+        if (n > values.size() - at)
+          throw InputError(path, "OFF face " + std::to_string(f) + " claims " + count +
+                                     " corners but the file holds only " + std::to_string(values.size() - at) +
+                                     " more values");
+        at += static_cast<std::size_t>(n);
+      }
     }
   } else if (ext == ".ply") {
     const PlyLayout layout = check_ply_header(path, in, size);
