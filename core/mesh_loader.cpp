@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -196,10 +197,22 @@ void check_declared_counts(const std::string& path, const std::string& ext, std:
                                  " but the file has only " + std::to_string(size) + " bytes");
   };
   if (ext == ".off") {
-    std::string magic;
-    in >> magic;
-    if (magic.find("OFF") == std::string::npos) throw InputError(path, "missing OFF header");
-    if (magic.find("BINARY") == std::string::npos) {
+    // The first line is the keyword alone, "[ST][C][N][4][n]OFF" (Geomview's OFF), or it and
+    // BINARY: OpenMesh reads the counts from the lines after it, so a keyword line with
+    // anything else on it would leave them unread.
+    std::string first_line;
+    std::getline(in, first_line);
+    std::istringstream fl(first_line);
+    std::string magic, binary_word, extra;
+    fl >> magic >> binary_word >> extra;
+    static const std::regex kKeyword("(ST)?C?N?4?n?OFF");
+    if (!std::regex_match(magic, kKeyword)) {
+      if (magic.find("OFF") == std::string::npos) throw InputError(path, "missing OFF header");
+      throw InputError(path, "OFF header: '" + magic.substr(0, 20) + "' is not an OFF keyword ([ST][C][N][4][n]OFF)");
+    }
+    if ((!binary_word.empty() && binary_word != "BINARY") || !extra.empty())
+      throw InputError(path, "OFF header: the first line must hold only the keyword (and BINARY)");
+    if (binary_word.empty()) {
       // The counts "nv nf ne" follow the keyword ("[ST][C][N][4][n]OFF"; nOFF first gives the
       // dimension), after any '#' comment lines. Every variant's counts are checked: OpenMesh
       // reserves what they claim.
