@@ -11,6 +11,8 @@
 #include <map>
 #include <utility>
 
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -643,12 +645,44 @@ void check_before_parsing(const std::string& path, const char* json, std::size_t
 // tinygltf's own image decoder, except that an image it cannot decode is kept empty instead
 // of failing the whole file: MaterialTable then names it and leaves the texture out (or
 // fails under --strict), as for a missing image file.
-bool tolerant_image_loader(tinygltf::Image* image, const int index, std::string*, std::string* warn,
-                           int width, int height, const unsigned char* bytes, int size, void* user) {
-  std::string err;
-  if (tinygltf::LoadImageData(image, index, &err, warn, width, height, bytes, size, user)) return true;
+// Decodes a glTF image (PNG or JPEG, glTF 2.0 §3.9.1 "image.mimeType") into 8-bit channels with
+// OpenImageIO (libpng, libjpeg), reading from memory. tinygltf's own decoder, Debian's libstb,
+// overflows a heap buffer on some malformed images (found by fuzzing .glb files), so it is
+// not used. An image that is neither, too large or undecodable is left empty: the material
+// loader treats it as a missing texture (gltf_material.cpp).
+bool tolerant_image_loader(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                           const unsigned char* bytes, int size, void*) {
   image->image.clear();
   image->width = image->height = 0;
+  static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  static constexpr unsigned char kJpeg[3] = {0xff, 0xd8, 0xff};
+  const char* name = size >= 8 && std::memcmp(bytes, kPng, 8) == 0    ? "image.png"
+                     : size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0 ? "image.jpg"
+                                                                      : nullptr;
+  if (!name) return true;
+  // The PNG or JPEG reader alone: ImageInput::open would fall back to every other format,
+  // and OpenImageIO 2.4's DPX reader reads past the end of a memory buffer.
+  OIIO::Filesystem::IOMemReader reader(bytes, static_cast<std::size_t>(size));
+  auto in = OIIO::ImageInput::create(name);
+  OIIO::ImageSpec spec;
+  if (!in || !in->set_ioproxy(&reader) || !in->open(name, spec)) {
+    if (in) (void)in->geterror();  // clears OpenImageIO's pending messages
+    (void)OIIO::geterror();
+    return true;
+  }
+  constexpr long long kMaxPixels = 1ll << 28;  // as read_image (core/image_io.cpp)
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 ||
+      static_cast<long long>(spec.width) * spec.height > kMaxPixels)
+    return true;
+  const int nc = std::min(spec.nchannels, 4);
+  std::vector<unsigned char> pixels(static_cast<std::size_t>(spec.width) * spec.height * nc);
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, pixels.data())) return true;
+  image->image = std::move(pixels);
+  image->width = spec.width;
+  image->height = spec.height;
+  image->component = nc;
+  image->bits = 8;
+  image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
   return true;
 }
 

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -33,10 +35,34 @@ std::string lower_ext(const std::string& path) {
   return e;
 }
 
+// The layout a PLY header declares: per element its count and properties.
+struct PlyProperty {
+  bool list = false;
+  int count_bytes = 0;  // list: size of the count's type
+  int item_bytes = 0;   // the scalar's size, or each list item's
+  bool count_signed = false;
+};
+struct PlyElement {
+  unsigned long long count = 0;
+  std::vector<PlyProperty> properties;
+};
+struct PlyLayout {
+  bool binary = false, big_endian = false;
+  std::vector<PlyElement> elements;
+};
+
+int ply_type_bytes(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "double" || t == "float64") return 8;
+  return 4;
+}
+
 // A strict PLY header check: OpenMesh's PLY reader reads out of bounds on some malformed
 // headers (found by mutating tests/data/good/tetra.ply under ASan), so only well-formed
 // headers reach it.
-void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t size) {
+PlyLayout check_ply_header(const std::string& path, std::istream& in, std::uintmax_t size) {
+  PlyLayout layout;
   static const std::set<std::string> kTypes = {
       "char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8", "uint8",
       "int16", "uint16", "int32", "uint32", "float32", "float64"};
@@ -60,7 +86,8 @@ void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t 
       // Checked here because OpenMesh rejects some face-less files (e.g. point clouds with
       // extra properties) with no reason given.
       if (!face) throw InputError(path, "contains no faces (the header declares no face element)");
-      return;
+      layout.binary = binary;
+      return layout;
     }
     if (w[0] == "format") {
       if (w.size() != 3 || w[2] != "1.0" ||
@@ -68,6 +95,7 @@ void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t 
         bad();
       format = true;
       binary = w[1] != "ascii";
+      layout.big_endian = w[1] == "binary_big_endian";
     } else if (w[0] == "element") {
       if (w.size() != 3 || w[2].find_first_not_of("0123456789") != std::string::npos || w[2].size() > 12) bad();
       const unsigned long long n = std::stoull(w[2]);
@@ -75,14 +103,19 @@ void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t 
         throw InputError(path, "header declares " + w[2] + " " + w[1] + " elements but the file has only " +
                                    std::to_string(size) + " bytes");
       element = true;
+      layout.elements.push_back({n, {}});
       vertex = vertex || w[1] == "vertex";
       face = face || w[1] == "face";
     } else if (w[0] == "property") {
       if (!element) bad();
       if (w.size() == 3) {
         if (!kTypes.count(w[1])) bad();
+        layout.elements.back().properties.push_back({false, 0, ply_type_bytes(w[1]), false});
       } else if (w.size() == 5 && w[1] == "list") {
         if (!kTypes.count(w[2]) || !kTypes.count(w[3])) bad();
+        if (w[2] == "float" || w[2] == "double" || w[2] == "float32" || w[2] == "float64") bad();
+        layout.elements.back().properties.push_back(
+            {true, ply_type_bytes(w[2]), ply_type_bytes(w[3]), w[2][0] != 'u'});
       } else {
         bad();
       }
@@ -91,6 +124,66 @@ void check_ply_header(const std::string& path, std::istream& in, std::uintmax_t 
     }
   }
   throw InputError(path, "PLY header has no end_header line");
+}
+
+// Walks the data a PLY header declares, before OpenMesh does: OpenMesh trusts every list
+// count (a face claiming 4 billion corners made it append vertex handles until memory ran
+// out), so each count must be a whole number >= 0 whose items the file still holds, and the
+// file must hold every element the header declares (PLY's element data follow the header in
+// declaration order, each property in turn; ASCII separates values by white space).
+void check_ply_body(const std::string& path, std::istream& in, const PlyLayout& layout) {
+  auto truncated = [&](const char* what) {
+    throw InputError(path, std::string("PLY data truncated or malformed: ") + what);
+  };
+  if (!layout.binary) {
+    std::string tok;
+    for (const PlyElement& e : layout.elements)
+      for (unsigned long long i = 0; i < e.count; ++i)
+        for (const PlyProperty& p : e.properties) {
+          if (!(in >> tok)) truncated("fewer values than the header declares");
+          if (!p.list) continue;
+          if (tok.empty() || tok.size() > 9 || tok.find_first_not_of("0123456789") != std::string::npos)
+            throw InputError(path, "PLY list count '" + tok.substr(0, 20) + "' is not a whole number below 10^9");
+          for (unsigned long n = std::stoul(tok); n > 0; --n)
+            if (!(in >> tok)) truncated("a list is longer than the data left");
+        }
+    return;
+  }
+  const std::string body{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::size_t at = 0;
+  auto need = [&](unsigned long long bytes) {
+    if (bytes > body.size() - at) truncated("fewer bytes than the header declares");
+  };
+  for (const PlyElement& e : layout.elements) {
+    const bool has_list = std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.list; });
+    if (!has_list) {
+      unsigned long long stride = 0;
+      for (const PlyProperty& p : e.properties) stride += static_cast<unsigned long long>(p.item_bytes);
+      if (stride && e.count > (body.size() - at) / stride) truncated("fewer bytes than the header declares");
+      at += static_cast<std::size_t>(stride * e.count);
+      continue;
+    }
+    for (unsigned long long i = 0; i < e.count; ++i)
+      for (const PlyProperty& p : e.properties) {
+        if (!p.list) {
+          need(static_cast<unsigned long long>(p.item_bytes));
+          at += static_cast<std::size_t>(p.item_bytes);
+          continue;
+        }
+        need(static_cast<unsigned long long>(p.count_bytes));
+        unsigned char b[4] = {};
+        std::memcpy(b, body.data() + at, static_cast<std::size_t>(p.count_bytes));
+        at += static_cast<std::size_t>(p.count_bytes);
+        if (layout.big_endian) std::reverse(b, b + p.count_bytes);
+        std::uint32_t raw = 0;
+        for (int k = p.count_bytes - 1; k >= 0; --k) raw = (raw << 8) | b[k];
+        long long n = raw;
+        if (p.count_signed && (raw >> (8 * p.count_bytes - 1)) & 1u) n = -1;
+        if (n < 0) throw InputError(path, "PLY list count is negative");
+        need(static_cast<unsigned long long>(n) * static_cast<unsigned long long>(p.item_bytes));
+        at += static_cast<std::size_t>(n) * static_cast<std::size_t>(p.item_bytes);
+      }
+  }
 }
 
 // Rejects headers that promise more elements than the file could hold (each vertex or
@@ -104,23 +197,73 @@ void check_declared_counts(const std::string& path, const std::string& ext, std:
                                  " but the file has only " + std::to_string(size) + " bytes");
   };
   if (ext == ".off") {
-    std::string magic;
-    in >> magic;
-    if (magic.find("OFF") == std::string::npos) throw InputError(path, "missing OFF header");
-    if (magic.find("ST") != std::string::npos || magic.find("n") != std::string::npos ||
-        magic.find("4") != std::string::npos) {
-      // Exotic OFF variants: let OpenMesh judge the header.
-    } else if (magic.find("BINARY") == std::string::npos) {
-      long long nv = -1, nf = -1, ne = -1;
-      in >> nv >> nf >> ne;
-      // Headers with comments are left to OpenMesh; a plain counts line is checked here.
-      if (in && nv >= 0 && nf >= 0) {
-        too_many(static_cast<unsigned long long>(nv), "vertices", 6);
-        too_many(static_cast<unsigned long long>(nf), "faces", 8);
+    // The first line is the keyword alone, "[ST][C][N][4][n]OFF" (Geomview's OFF), or it and
+    // BINARY: OpenMesh reads the counts from the lines after it, so a keyword line with
+    // anything else on it would leave them unread.
+    std::string first_line;
+    std::getline(in, first_line);
+    std::istringstream fl(first_line);
+    std::string magic, binary_word, extra;
+    fl >> magic >> binary_word >> extra;
+    static const std::regex kKeyword("(ST)?C?N?4?n?OFF");
+    if (!std::regex_match(magic, kKeyword)) {
+      if (magic.find("OFF") == std::string::npos) throw InputError(path, "missing OFF header");
+      throw InputError(path, "OFF header: '" + magic.substr(0, 20) + "' is not an OFF keyword ([ST][C][N][4][n]OFF)");
+    }
+    if ((!binary_word.empty() && binary_word != "BINARY") || !extra.empty())
+      throw InputError(path, "OFF header: the first line must hold only the keyword (and BINARY)");
+    if (binary_word.empty()) {
+      // The counts "nv nf ne" follow the keyword ("[ST][C][N][4][n]OFF"; nOFF first gives the
+      // dimension), after any '#' comment lines. Every variant's counts are checked: OpenMesh
+      // reserves what they claim.
+      auto next = [&](std::string& tok) {
+        while (in >> tok) {
+          if (tok[0] != '#') return true;
+          std::string rest;
+          std::getline(in, rest);
+        }
+        return false;
+      };
+      auto whole = [&](const char* what) {
+        std::string tok;
+        if (!next(tok) || tok.size() > 12 || tok.find_first_not_of("0123456789") != std::string::npos)
+          throw InputError(path, std::string("OFF header: the ") + what + " is not a whole number");
+        return std::stoull(tok);
+      };
+      if (magic.find('n') != std::string::npos) (void)whole("dimension");
+      const unsigned long long nv = whole("vertex count");
+      const unsigned long long nf = whole("face count");
+      too_many(nv, "vertices", 6);
+      too_many(nf, "faces", 2);
+      // OpenMesh reads each vertex from its own line, then the faces as a stream of values:
+      // a corner count and that many indices, trusting the count (a face claiming 444400000
+      // corners made it append handles until memory ran out). Each count must fit in the
+      // values left in the file. A value that is not a whole number means the faces carry
+      // colours, which OpenMesh parses its own way: the walk stops there.
+      std::string line;
+      std::getline(in, line);  // the rest of the counts line
+      for (unsigned long long left = nv; left > 0 && std::getline(in, line);) {
+        std::istringstream ls(line);
+        std::string first;
+        if ((ls >> first) && first[0] != '#') --left;
+      }
+      std::vector<std::string> values;
+      for (std::string t; in >> t;) values.push_back(std::move(t));
+      std::size_t at = 0;
+      for (unsigned long long f = 0; f < nf && at < values.size(); ++f) {
+        const std::string& count = values[at++];
+        if (count.size() > 12 || count.find_first_not_of("0123456789") != std::string::npos) break;
+        const unsigned long long n = std::stoull(count);
+        if (n > values.size() - at)
+          throw InputError(path, "OFF face " + std::to_string(f) + " claims " + count +
+                                     " corners but the file holds only " + std::to_string(values.size() - at) +
+                                     " more values");
+        at += static_cast<std::size_t>(n);
       }
     }
   } else if (ext == ".ply") {
-    check_ply_header(path, in, size);
+    const PlyLayout layout = check_ply_header(path, in, size);
+    check_ply_body(path, in, layout);
   } else if (ext == ".stl") {
     char head[84] = {};
     in.read(head, 84);

@@ -252,7 +252,8 @@ void check_vertex_lines(const std::string& path, const std::string& text) {
     std::size_t end = text.find('\n', at);
     if (end == std::string::npos) end = text.size();
     std::size_t p = text.find_first_not_of(" \t", at);
-    if (p + 1 < end && text[p] == 'v' && (text[p + 1] == ' ' || text[p + 1] == '\t')) {
+    // p is npos when only blanks are left (p + 1 would wrap to 0).
+    if (p != std::string::npos && p + 1 < end && text[p] == 'v' && (text[p + 1] == ' ' || text[p + 1] == '\t')) {
       ++vertex;
       std::istringstream ls(text.substr(p + 2, end - p - 2));
       std::string token;

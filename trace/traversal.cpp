@@ -252,9 +252,6 @@ bool any_hit_oracle(const std::vector<glm::vec3>& p, const std::vector<std::uint
   return false;
 }
 
-void RayStream::resize(std::size_t n) {
-  for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax}) v->resize(n);
-}
 void RayStream::set(std::size_t i, const Ray& r) {
   ox[i] = r.origin.x; oy[i] = r.origin.y; oz[i] = r.origin.z;
   dx[i] = r.direction.x; dy[i] = r.direction.y; dz[i] = r.direction.z;

@@ -60,7 +60,10 @@ bool any_hit_oracle(const std::vector<glm::vec3>& positions, const std::vector<s
 struct RayStream {
   std::vector<float> ox, oy, oz, dx, dy, dz, tmin, tmax;
   std::size_t size() const { return ox.size(); }
-  void resize(std::size_t n);
+  // Inline so the SPRY reader (trace/ray_file.cpp) stands alone, as its fuzzer builds it.
+  void resize(std::size_t n) {
+    for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax}) v->resize(n);
+  }
   void set(std::size_t i, const Ray& r);
   Ray get(std::size_t i) const;
 };

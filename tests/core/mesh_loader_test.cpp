@@ -2,10 +2,15 @@
 // geometry, with area-weighted normals matching a hand-computed oracle.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/mesh_normals.h"
 #include "core/scene_loader.h"
 #include "scene_test_util.h"
@@ -44,6 +49,49 @@ TEST(MeshLoader, TetrahedronInAllFormats) {
       EXPECT_NEAR(n.z, -1.0f / std::sqrt(3.0f), 1e-5f);
     }
   }
+}
+
+// OpenMesh trusts the corner count of every face; the loader walks the data first. A binary
+// PLY triangle loads; the same file whose face claims 4 billion (or 200) corners, or whose
+// corner count is negative, is one InputError; an OFF face claiming more corners than the file
+// holds values likewise.
+TEST(MeshLoader, FaceCornerCountsMustFitInTheFile) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "speculum_corner_counts";
+  fs::create_directories(dir);
+  auto binary_ply = [&](const char* count_type, const std::string& count_bytes) {
+    std::string head = std::string("ply\nformat binary_little_endian 1.0\nelement vertex 3\n") +
+                       "property float x\nproperty float y\nproperty float z\nelement face 1\n" +
+                       "property list " + count_type + " int vertex_indices\nend_header\n";
+    const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const std::int32_t idx[3] = {0, 1, 2};
+    std::string body(reinterpret_cast<const char*>(v), sizeof v);
+    body += count_bytes;
+    body.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    const fs::path p = dir / "tri.ply";
+    std::ofstream(p, std::ios::binary) << head << body;
+    return p.string();
+  };
+  auto problem = [](const std::string& path) -> std::string {
+    try {
+      (void)load_scene(path);
+    } catch (const InputError& e) {
+      return e.problem();
+    }
+    return "loaded";
+  };
+  EXPECT_EQ(load_scene(binary_ply("uchar", std::string(1, '\3'))).mesh.triangle_count(), 1u);
+  EXPECT_EQ(problem(binary_ply("uint", std::string(4, '\xff'))),
+            "PLY data truncated or malformed: fewer bytes than the header declares");
+  EXPECT_EQ(problem(binary_ply("uchar", std::string(1, '\xc8'))),
+            "PLY data truncated or malformed: fewer bytes than the header declares");
+  EXPECT_EQ(problem(binary_ply("char", std::string(1, '\xff'))), "PLY list count is negative");
+  const fs::path off = dir / "tri.off";
+  std::ofstream(off) << "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n400000000 0 1\n";
+  EXPECT_EQ(problem(off.string()), "OFF face 1 claims 400000000 corners but the file holds only 2 more values");
+  std::ofstream(off) << "OFF\n# a comment\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(load_scene(off.string()).mesh.triangle_count(), 1u);
+  fs::remove_all(dir);
 }
 
 TEST(MeshNormals, AreaWeightingOracle) {

@@ -73,10 +73,17 @@ TEST(FuzzCorpus, CorpusFilesLoadOrAreRejected) {
   }
 }
 
-TEST(FuzzCorpus, CrashReproducersAreRejected) {
+// Each file made a fuzzer crash, leak or time out before the loader was fixed; some are
+// rejected now, some load (a .glb whose embedded image stb_image overflowed on loads without
+// that texture).
+TEST(FuzzCorpus, CrashReproducersLoadOrAreRejected) {
+  int replayed = 0;
   for (const Target& t : speculum::fuzz::targets())
-    for (const fs::path& f : files_in(kFuzzDir / "crashes" / t.name))
-      EXPECT_EQ(replay(t, f), Outcome::rejected) << f;
+    for (const fs::path& f : files_in(kFuzzDir / "crashes" / t.name)) {
+      EXPECT_TRUE(replay(t, f).has_value()) << f;
+      ++replayed;
+    }
+  EXPECT_GE(replayed, 7);
 }
 
 // The harness is the loader: the good files load and the bad ones are rejected through it, as

@@ -43,8 +43,12 @@ std::string_view as_text(std::span<const std::uint8_t> bytes) {
 std::string write_parts(std::span<const std::uint8_t> bytes, const char* ext, const char* companion_ext) {
   const std::string_view text = as_text(bytes);
   const fs::path main = work_dir() / (std::string("fuzz") + ext);
-  const fs::path companion = work_dir() / (std::string("fuzz") + companion_ext);
   const std::size_t at = companion_ext ? text.find(kPartMarker) : std::string_view::npos;
+  if (!companion_ext) {
+    write_file(main, text);
+    return main.string();
+  }
+  const fs::path companion = work_dir() / (std::string("fuzz") + companion_ext);
   std::error_code ec;
   fs::remove(companion, ec);
   if (at == std::string_view::npos) {

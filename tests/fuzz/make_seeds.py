@@ -86,6 +86,9 @@ def main():
             subprocess.run(["oiiotool", "--pattern", "checker:width=4:height=4", "8x4", "3",
                             "-d", fmt, "-o", str(f)], check=True)
             put(out, "image", "tiny" + ext, f.read_bytes())
+    checker = (DATA / "good" / "checker.png").read_bytes()
+    put(out, "image", "truncated.png", checker[:len(checker) // 2])
+    put(out, "image", "not_an_image.hdr", b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 999999 +X 999999\n")
     specs = ["sphere-in-room", "glossy-plane:size=2000", "mirror-corridor:size=1000",
              "living-room:size=3000", "glass-sphere:size=1k", "bowl:size=1500",
              "bumpy-sphere:size=2000,n=4,amplitude=0.1", "bumpy-sphere:n=1000", "bowl:size=1e12",
