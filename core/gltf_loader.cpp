@@ -656,16 +656,16 @@ bool tolerant_image_loader(tinygltf::Image* image, const int, std::string*, std:
   image->width = image->height = 0;
   static constexpr unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   static constexpr unsigned char kJpeg[3] = {0xff, 0xd8, 0xff};
-  const char* name = size >= 8 && std::memcmp(bytes, kPng, 8) == 0    ? "image.png"
-                     : size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0 ? "image.jpg"
-                                                                      : nullptr;
-  if (!name) return true;
+  const char* format = size >= 8 && std::memcmp(bytes, kPng, 8) == 0    ? "png"
+                       : size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0 ? "jpeg"
+                                                                        : nullptr;
+  if (!format) return true;
   // The PNG or JPEG reader alone: ImageInput::open would fall back to every other format,
   // and OpenImageIO 2.4's DPX reader reads past the end of a memory buffer.
   OIIO::Filesystem::IOMemReader reader(bytes, static_cast<std::size_t>(size));
-  auto in = OIIO::ImageInput::create(name);
+  auto in = OIIO::ImageInput::create(format);  // a format name: no file is opened
   OIIO::ImageSpec spec;
-  if (!in || !in->set_ioproxy(&reader) || !in->open(name, spec)) {
+  if (!in || !in->set_ioproxy(&reader) || !in->open(std::string("image.") + format, spec)) {
     if (in) (void)in->geterror();  // clears OpenImageIO's pending messages
     (void)OIIO::geterror();
     return true;

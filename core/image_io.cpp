@@ -1,4 +1,8 @@
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -30,10 +34,60 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
+// OpenEXR sizes each header attribute's value before reading it (OpenEXR 3.1 allocated 2 GB
+// for a string attribute of a 40-byte file, found by fuzzing): the header is walked first and
+// every attribute must fit in the file. The layout ("OpenEXR file layout", "Header"): magic
+// and version (4 bytes each), then per part a list of attributes, each a name and a type name
+// (NUL-terminated, at most 255 bytes with the long-names flag, else 31) and an int32 size,
+// ended by an empty name; a multi-part file ends its list of headers with an empty header.
+void check_exr_header(const std::string& path, const std::string& bytes) {
+  auto bad = [&](const std::string& what) { throw InputError(path, "malformed EXR header: " + what); };
+  if (bytes.size() < 8) bad("truncated");
+  const std::uint32_t version = static_cast<unsigned char>(bytes[4]) | static_cast<unsigned char>(bytes[5]) << 8 |
+                                static_cast<unsigned char>(bytes[6]) << 16 |
+                                static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[7])) << 24;
+  const bool multipart = version & 0x1000;
+  const std::size_t max_name = (version & 0x400) ? 255 : 31;
+  std::size_t at = 8;
+  auto name = [&]() {
+    const std::size_t end = bytes.find('\0', at);
+    if (end == std::string::npos) bad("truncated");
+    if (end - at > max_name) bad("name longer than " + std::to_string(max_name) + " bytes");
+    std::string n = bytes.substr(at, end - at);
+    at = end + 1;
+    return n;
+  };
+  for (int part = 0;; ++part) {
+    int attributes = 0;
+    for (std::string n = name(); !n.empty(); n = name(), ++attributes) {
+      (void)name();  // the type name
+      if (bytes.size() - at < 4) bad("truncated");
+      std::int32_t size = 0;
+      std::memcpy(&size, bytes.data() + at, 4);
+      at += 4;
+      if (size < 0 || static_cast<std::size_t>(size) > bytes.size() - at)
+        bad("attribute '" + n.substr(0, 40) + "' claims " + std::to_string(size) + " bytes, the file holds " +
+            std::to_string(bytes.size() - at) + " more");
+      at += static_cast<std::size_t>(size);
+    }
+    if (!multipart || attributes == 0 || part > 10000) return;
+  }
+}
+
 }  // namespace
 
 ImageRGBA read_image(const std::string& path, bool to_linear) {
   if (!std::filesystem::exists(path)) throw InputError(path, "no such file");
+  {
+    std::ifstream file(path, std::ios::binary);
+    char magic[4] = {};
+    file.read(magic, 4);
+    if (file && std::memcmp(magic, "\x76\x2f\x31\x01", 4) == 0) {
+      file.seekg(0);
+      const std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+      check_exr_header(path, bytes);
+    }
+  }
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string msg = OIIO::geterror();

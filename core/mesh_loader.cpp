@@ -235,23 +235,32 @@ void check_declared_counts(const std::string& path, const std::string& ext, std:
       const unsigned long long nf = whole("face count");
       too_many(nv, "vertices", 6);
       too_many(nf, "faces", 2);
-      // OpenMesh reads each vertex from its own line, then the faces as a stream of values:
-      // a corner count and that many indices, trusting the count (a face claiming 444400000
-      // corners made it append handles until memory ran out). Each count must fit in the
-      // values left in the file. A value that is not a whole number means the faces carry
-      // colours, which OpenMesh parses its own way: the walk stops there.
+      // OpenMesh reads the vertices and then the faces as a stream of values (a vertex with
+      // colours from its own line), each face a corner count and that many indices, trusting
+      // the count: a face claiming 444400000 corners, or -50, made it append handles until
+      // memory ran out. Each count must be >= 0 and fit in the values left in the file. A
+      // value that is not a whole number means the faces carry colours, which OpenMesh parses
+      // its own way: the walk stops there.
+      const bool colours = magic.find('C') != std::string::npos;
+      const std::size_t per_vertex = (magic.find('n') != std::string::npos ? 0 : magic.find('4') != std::string::npos ? 4 : 3) +
+                                     (magic.find('N') != std::string::npos ? 3 : 0) +
+                                     (magic.starts_with("ST") ? 2 : 0);
       std::string line;
       std::getline(in, line);  // the rest of the counts line
-      for (unsigned long long left = nv; left > 0 && std::getline(in, line);) {
-        std::istringstream ls(line);
-        std::string first;
-        if ((ls >> first) && first[0] != '#') --left;
-      }
+      if (colours || per_vertex < 3)
+        for (unsigned long long left = nv; left > 0 && std::getline(in, line);) {
+          std::istringstream ls(line);
+          std::string first;
+          if ((ls >> first) && first[0] != '#') --left;
+        }
       std::vector<std::string> values;
       for (std::string t; in >> t;) values.push_back(std::move(t));
       std::size_t at = 0;
+      if (!(colours || per_vertex < 3)) at = static_cast<std::size_t>(std::min<unsigned long long>(nv * per_vertex, values.size()));
       for (unsigned long long f = 0; f < nf && at < values.size(); ++f) {
         const std::string& count = values[at++];
+        if (count.size() > 1 && count[0] == '-' && count.find_first_not_of("0123456789", 1) == std::string::npos)
+          throw InputError(path, "OFF face " + std::to_string(f) + " has a negative corner count " + count.substr(0, 20));
         if (count.size() > 12 || count.find_first_not_of("0123456789") != std::string::npos) break;
         const unsigned long long n = std::stoull(count);
         if (n > values.size() - at)
