@@ -64,7 +64,7 @@ for t in "${list[@]}"; do
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
   result=ok
   if [ "$rc" != 0 ]; then
-    result="FAILED (exit $rc): $(grep -m1 -E '^(==[0-9]+==ERROR|SUMMARY|.*runtime error|ALARM|terminate called)' "$log" || tail -n 1 "$log")"
+    result="FAILED (exit $rc): $(grep -m1 -E '==[0-9]+== ?ERROR|runtime error|terminate called' "$log" || tail -n 1 "$log")"
     status=1
   fi
   printf '%-11s %12s %8s %s\n' "$t" "${runs:-?}" "$(( $(date +%s) - start ))" "$result" | tee -a "$build/fuzz-summary.txt"
