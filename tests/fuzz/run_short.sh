@@ -6,20 +6,24 @@
 # where the ordinary test suite replays it). New inputs found go to BUILD/new-corpus/<target>/,
 # never into the source tree.
 #
-#   tests/fuzz/run_short.sh [--seconds N] [--targets a,b] [--build DIR] [--nice N]
+#   tests/fuzz/run_short.sh [--seconds N | --runs N] [--targets a,b] [--build DIR] [--nice N]
 #   tests/fuzz/run_short.sh --merge SEEDS   # minimize SEEDS/<target> + the corpus into the corpus
 #
-# --seconds: per target (default 30; FUZZ_SECONDS too). --targets: default all nine.
+# --seconds: per target (default 30; FUZZ_SECONDS too). --runs N: instead, exactly N inputs per
+# target from a fixed seed (-seed=1), so a run gives the same result on any machine: what CI
+# uses, since a time-limited run explores further on a faster machine. --targets: default all nine.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds="${FUZZ_SECONDS:-30}"
 build=build-fuzz
 targets="gltf,glb,obj,ply,off,stl,ray_file,image,scene_spec"
 merge=""
+runs=""
 nice_level=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
+    --runs) runs="$2"; shift 2 ;;
     --targets) targets="$2"; shift 2 ;;
     --build) build="$2"; shift 2 ;;
     --merge) merge="$2"; shift 2 ;;
@@ -29,6 +33,10 @@ while [ $# -gt 0 ]; do
   esac
 done
 case "$seconds" in ''|*[!0-9]*) echo "run_short.sh: --seconds expects a whole number, got '$seconds'" >&2; exit 2 ;; esac
+case "$runs" in *[!0-9]*) echo "run_short.sh: --runs expects a whole number, got '$runs'" >&2; exit 2 ;; esac
+# A fixed run also allows 5 s per input instead of 1 s: the same inputs on a slower or busier
+# machine must not turn into a false "hang".
+if [ -n "$runs" ]; then limit=(-seed=1 -runs="$runs" -timeout=5); else limit=(-max_total_time="$seconds" -timeout=1); fi
 
 export CC="${FUZZ_CC:-clang-14}" CXX="${FUZZ_CXX:-clang++-14}"
 IFS=, read -r -a list <<< "$targets"
@@ -40,7 +48,7 @@ corpus=tests/fuzz/corpus
 # Leaks inside the uninstrumented Debian libraries, each with its proof in the file.
 export LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 # Inputs are small files; 64 KiB keeps each run fast while reaching every header path.
-common=(-timeout=1 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1)
+common=(-rss_limit_mb=2048 -max_len=65536 -print_final_stats=1)
 status=0
 printf '%-11s %12s %8s %s\n' target executions seconds result > "$build/fuzz-summary.txt"
 for t in "${list[@]}"; do
@@ -57,17 +65,17 @@ for t in "${list[@]}"; do
   log="$build/fuzz-$t.log"
   start=$(date +%s)
   set +e
-  nice -n "$nice_level" "$bin" "${common[@]}" -max_total_time="$seconds" \
+  nice -n "$nice_level" "$bin" "${common[@]}" "${limit[@]}" \
     -artifact_prefix="$build/artifacts/$t/" "$build/new-corpus/$t" "$corpus/$t" > "$log" 2>&1
   rc=$?
   set -e
-  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  executed=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
   result=ok
   if [ "$rc" != 0 ]; then
     result="FAILED (exit $rc): $(grep -m1 -E '==[0-9]+== ?ERROR|runtime error|terminate called' "$log" || tail -n 1 "$log")"
     status=1
   fi
-  printf '%-11s %12s %8s %s\n' "$t" "${runs:-?}" "$(( $(date +%s) - start ))" "$result" | tee -a "$build/fuzz-summary.txt"
+  printf '%-11s %12s %8s %s\n' "$t" "${executed:-?}" "$(( $(date +%s) - start ))" "$result" | tee -a "$build/fuzz-summary.txt"
 done
 [ -n "$merge" ] && exit 0
 if [ "$status" != 0 ]; then
