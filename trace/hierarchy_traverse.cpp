@@ -20,6 +20,29 @@ constexpr std::size_t kPairChunk = 4096;
 constexpr std::size_t kTriangleChunk = 4096;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// A triangle's plane as the leaf test reads it: a vertex, the unnormalized normal (b−a)×(c−a),
+// its length, and max(1, |a|'s largest component) for the test's tolerance. Built once per
+// traversal, not per (ray, triangle) pair.
+struct TrianglePlane {
+  glm::vec3 a{0.0f}, normal{0.0f};
+  float normal_length = 0.0f, a_magnitude = 1.0f;
+};
+
+std::vector<TrianglePlane> triangle_planes(par::Executor& ex, const std::vector<glm::vec3>& p,
+                                           const std::vector<std::uint32_t>& idx) {
+  std::vector<TrianglePlane> planes(idx.size() / 3);
+  ex.parallel_for("hierarchy_planes", planes.size(), kTriangleChunk, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t) {
+      TrianglePlane& q = planes[t];
+      q.a = p[idx[3 * t]];
+      q.normal = glm::cross(p[idx[3 * t + 1]] - q.a, p[idx[3 * t + 2]] - q.a);
+      q.normal_length = glm::length(q.normal);
+      q.a_magnitude = std::max({1.0f, std::fabs(q.a.x), std::fabs(q.a.y), std::fabs(q.a.z)});
+    }
+  });
+  return planes;
+}
+
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -31,6 +54,7 @@ struct Traversal {
   const RayHierarchy& h;
   const RayStream& rays;
   const std::vector<BoundingSphere>& spheres;
+  const std::vector<TrianglePlane>& planes;
   std::size_t capacity, block_size;
   HierarchyTraverseStats& stats;
   HitStream& best;  // merged over batches
@@ -79,13 +103,10 @@ struct Traversal {
   bool ray_can_reach_plane(std::size_t leaf, std::uint32_t t) const {
     const std::size_t i = (leaf / std::size_t(h.side)) * std::size_t(h.width) + leaf % std::size_t(h.side);
     const glm::vec3 o(rays.ox[i], rays.oy[i], rays.oz[i]), d(rays.dx[i], rays.dy[i], rays.dz[i]);
-    const std::uint32_t* tr = &indices[3 * std::size_t(t)];
-    const glm::vec3 a = positions[tr[0]];
-    const glm::vec3 normal = glm::cross(positions[tr[1]] - a, positions[tr[2]] - a);
-    const float side = glm::dot(normal, o - a), towards = glm::dot(normal, d);
-    const float scale = std::max({1.0f, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z), std::fabs(a.x),
-                                  std::fabs(a.y), std::fabs(a.z)});
-    const float tolerance = 1e-5f * scale * glm::length(normal);
+    const TrianglePlane& plane = planes[t];
+    const float side = glm::dot(plane.normal, o - plane.a), towards = glm::dot(plane.normal, d);
+    const float scale = std::max({plane.a_magnitude, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
+    const float tolerance = 1e-5f * scale * plane.normal_length;
     if (side > tolerance) return towards < 0.0f;
     if (side < -tolerance) return towards > 0.0f;
     return true;
@@ -220,10 +241,11 @@ void hierarchy_closest_hits(par::Executor& ex, const std::vector<glm::vec3>& pos
   for (const ConeSphere& leaf : hierarchy.nodes[hierarchy.levels]) stats.active_rays += !leaf.empty();
   const auto t_spheres = std::chrono::steady_clock::now();
   const std::vector<BoundingSphere> spheres = triangle_bounding_spheres(ex, positions, indices);
+  const std::vector<TrianglePlane> planes = triangle_planes(ex, positions, indices);
   stats.tests_ms += ms_since(t_spheres);
   const std::size_t side = std::size_t(hierarchy.side);
   const std::size_t capacity = std::max(options.pair_capacity, 4 * side * side);
-  Traversal tr{ex, positions, indices, hierarchy, rays, spheres, capacity, std::max<std::size_t>(1, options.block_size),
+  Traversal tr{ex, positions, indices, hierarchy, rays, spheres, planes, capacity, std::max<std::size_t>(1, options.block_size),
                stats, hits, {}, {}, {}, {}, {}, {}, {}};
   tr.run(0, std::uint32_t(indices.size() / 3));
   for (std::size_t i = 0; i < hits.triangle.size(); ++i) stats.hits += hits.triangle[i] != kNoHit;
