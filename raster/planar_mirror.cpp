@@ -73,6 +73,7 @@ struct Recursion {
   PlanarMirrorSettings settings;
   PlanarMirrorStats stats;
   DistanceReflectStats search;  // the curved reflectors' searches, in every view
+  std::vector<std::uint8_t> is_mirror;  // per object id: 1 for the planar mirrors
 
   // Radiance of a mirrored view: the whole per-view pipeline (visibility → G-buffer →
   // direct light → specular layer) for `camera` in the clipped scene.
@@ -97,8 +98,8 @@ struct Recursion {
                                 : envmap_reflect(executor, g, env);
     if (level >= settings.depth) {
       // The mirrors seen here are not rendered again: they keep the environment lookup.
-      for (std::size_t i = 0; i < g.object.size(); ++i)
-        for (const PlanarMirror& mirror : mirrors) stats.depth_exhausted += g.object.pixels[i] == mirror.object;
+      for (const std::uint32_t object : g.object.pixels)
+        stats.depth_exhausted += object < is_mirror.size() && is_mirror[object];
       return specular;
     }
     for (const PlanarMirror& mirror : mirrors) {
@@ -145,7 +146,9 @@ ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
   PlanarMirrorSettings s = settings;
   s.width = g.width;
   s.height = g.height;
-  Recursion r{executor, scene, mirrors, shadows, env, curved, s, {}, {}};
+  Recursion r{executor, scene, mirrors, shadows, env, curved, s, {}, {}, std::vector<std::uint8_t>(scene.objects.size(), 0)};
+  for (const PlanarMirror& mirror : mirrors)
+    if (mirror.object < r.is_mirror.size()) r.is_mirror[mirror.object] = 1;
   ImageRGBA specular = r.reflect(g, camera, 0);
   r.stats.search_missed = r.search.missed;
   if (stats) *stats = r.stats;
