@@ -241,6 +241,37 @@ float search_layer(const CubeLayer& layer, int size, const glm::vec3& x, const g
 
 }  // namespace
 
+namespace {
+
+// The light a specular surface at x (stored normal n_stored, seen along unit r) sends back
+// towards -r: F times its mirror reflection and, for a refractor, (1 − F) × transmission ×
+// base colour times the refracted ray (all reflected on total internal reflection) —
+// SURVEY §4.3's refraction traced through the same layers as reflections. `depth` is the
+// continuations' depth: traced while it is within the bounce limit, else the environment
+// (counted per continuation, so the count equals the searches one more bounce would add).
+glm::vec3 specular_continuation(const LayeredDistanceMap& map, const EnvironmentMap& env, const glm::vec3& x,
+                                const glm::vec3& r, const glm::vec3& n_stored, const SurfaceParams& s,
+                                const LayeredTraceOptions& o, int depth, LayeredTraceStats& stats) {
+  auto follow = [&](const glm::vec3& dir) -> glm::vec3 {
+    if (depth > o.bounces) {
+      ++stats.depth_exhausted;
+      return env.radiance(dir, 1e6f);
+    }
+    return trace_layered(map, env, x, dir, o, depth, stats);
+  };
+  const bool entering = glm::dot(n_stored, r) < 0.0f;
+  const glm::vec3 n = entering ? n_stored : -n_stored;  // faces the incident side
+  const float cos_i = std::max(-glm::dot(n, r), 0.0f);
+  if (!s.is_refractor()) return specular_reflectance(s, cos_i) * follow(reflect(r, n));
+  const float nu = entering ? s.ior : 1.0f / s.ior;
+  glm::vec3 t;
+  if (!refract(r, n, nu, t)) return s.transmission * follow(reflect(r, n));
+  const float F = fresnel_dielectric(cos_i, nu);
+  return F * follow(reflect(r, n)) + s.transmission * (1.0f - F) * s.base_color * follow(glm::normalize(t));
+}
+
+}  // namespace
+
 glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env,
                         const glm::vec3& x_world, const glm::vec3& r,
                         const LayeredTraceOptions& o, int depth, LayeredTraceStats& stats) {
@@ -266,17 +297,8 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
   glm::vec3 radiance = glm::vec3(layer.colour[c.face].pixels[i]);
   const SurfaceParams& s = g.surface.pixels[i];
   if (!g.covered(i) || !is_specular(s)) return radiance;
-  // A specular hit: its direct light (already in `colour`) plus F times the light along the
-  // mirror direction — traced further while bounces remain, else from the environment.
-  glm::vec3 n = g.normal.pixels[i];
-  if (glm::dot(n, r) > 0.0f) n = -n;
-  const glm::vec3 reflected = reflect(r, n);
-  const glm::vec3 f = specular_reflectance(s, -glm::dot(n, r));
-  stats.depth_exhausted += depth >= o.bounces;
-  const glm::vec3 incoming = depth < o.bounces
-                                 ? trace_layered(map, env, map.centre + l, reflected, o, depth + 1, stats)
-                                 : env.radiance(reflected, 1e6f);
-  return radiance + f * incoming;
+  // A specular hit: its direct light (already in `colour`) plus what its continuations bring.
+  return radiance + specular_continuation(map, env, map.centre + l, r, g.normal.pixels[i], s, o, depth + 1, stats);
 }
 
 ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const LayeredDistanceMap& map,
@@ -292,12 +314,8 @@ ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const Layer
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface.pixels[i];
       if (!is_specular(s)) continue;
-      const glm::vec3 v = g.view_direction(i);
-      glm::vec3 n = g.normal.pixels[i];
-      if (glm::dot(n, v) < 0.0f) n = -n;  // refractors keep geometric normals: reflect only
-      const glm::vec3 r = reflect(-v, n);
-      const glm::vec3 radiance = specular_reflectance(s, glm::dot(n, v)) *
-                                 trace_layered(map, env, g.position.pixels[i], r, options, 1, st);
+      const glm::vec3 radiance = specular_continuation(map, env, g.position.pixels[i], -g.view_direction(i),
+                                                       g.normal.pixels[i], s, options, 1, st);
       out.pixels[i] = glm::vec4(radiance, 1.0f);
     }
   });

@@ -57,7 +57,7 @@ struct LayeredTraceStats {
   std::uint64_t rays = 0;
   std::uint64_t lookups = 0;
   std::uint64_t misses = 0;  // rays that found no layer hit (environment used)
-  std::uint64_t depth_exhausted = 0;  // specular hits past the last bounce (environment used)
+  std::uint64_t depth_exhausted = 0;  // continuations past the last bounce (environment used)
 };
 
 // Radiance arriving at x from direction r (unit) through the layered map.
@@ -66,7 +66,8 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
                         int depth, LayeredTraceStats& stats);
 
 // The specular layer of a G-buffer: F · trace_layered along R for specular samples (glossy
-// lobes use their mirror direction; refractors reflect only).
+// lobes use their mirror direction); refractors add (1 − F) × their tint times the refracted
+// ray, traced through the same layers.
 ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const LayeredDistanceMap& map,
                           const EnvironmentMap& env, const LayeredTraceOptions& options,
                           LayeredTraceStats* stats = nullptr);

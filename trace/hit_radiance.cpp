@@ -47,6 +47,30 @@ SurfacePoint surface_point(const Scene& scene, std::uint32_t t, float u, float v
 
 }  // namespace
 
+namespace {
+
+// The points of a triangle where its lighting is baked: the centroid and one point towards
+// each corner (barycentrics (2/3, 1/6, 1/6) and its rotations), so an object that covers only
+// part of a large triangle (a mirror hung on a wall) shades it partly, not all or nothing.
+constexpr int kBakePoints = 4;
+constexpr float kBakeU[kBakePoints] = {1.0f / 3.0f, 1.0f / 6.0f, 2.0f / 3.0f, 1.0f / 6.0f};
+constexpr float kBakeV[kBakePoints] = {1.0f / 3.0f, 1.0f / 6.0f, 1.0f / 6.0f, 2.0f / 3.0f};
+
+// A ray origin just above bake point j of triangle t, on the side its shading normal shows.
+struct BakePoint {
+  SurfacePoint sp;
+  glm::vec3 ng, above;
+};
+BakePoint bake_point(const Scene& scene, std::uint32_t t, int j) {
+  BakePoint b;
+  b.sp = surface_point(scene, t, kBakeU[j], kBakeV[j]);
+  b.ng = glm::dot(b.sp.ng, b.sp.n) < 0.0f ? -b.sp.ng : b.sp.ng;
+  b.above = offset_ray_origin(b.sp.p, b.ng);
+  return b;
+}
+
+}  // namespace
+
 TriangleLighting bake_triangle_lighting(par::Executor& ex, const Scene& scene, const Bvh& bvh,
                                         const RadianceBakeOptions& opt) {
   const std::size_t nt = scene.mesh.triangle_count();
@@ -55,44 +79,48 @@ TriangleLighting bake_triangle_lighting(par::Executor& ex, const Scene& scene, c
   out.visibility.assign(nt * out.light_count, 0.0f);
   out.environment_irradiance.assign(nt, glm::vec3(0.0f));
   out.radiance.assign(nt, glm::vec3(0.0f));
+  // Per triangle: the lit fraction of its bake points for every light, and the occluded
+  // environment irradiance from cosine rays spread over the same points (no interreflection,
+  // as in the reference tracer).
   const int ks = std::max(0, opt.environment_samples);
   ex.parallel_for("radiance_bake", nt, 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t t = b; t < e; ++t) {
-      const SurfacePoint sp = surface_point(scene, static_cast<std::uint32_t>(t), 1.0f / 3.0f, 1.0f / 3.0f);
-      // Orient the geometric normal to the shading normal's side (the side the mesh shows).
-      const glm::vec3 ng = glm::dot(sp.ng, sp.n) < 0.0f ? -sp.ng : sp.ng;
-      const glm::vec3 above = offset_ray_origin(sp.p, ng);
+      const auto tri = static_cast<std::uint32_t>(t);
       glm::vec3 lights_e(0.0f);
-      for (std::size_t l = 0; l < out.light_count; ++l) {
-        const LightSample ls = sample_light(scene.lights[l], sp.p);
-        if (ls.irradiance == glm::vec3(0.0f) || glm::dot(ng, ls.direction) <= 0.0f) continue;
-        Ray r;
-        r.origin = above;
-        r.direction = ls.direction;
-        r.tmax = std::isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : 3.0e38f;
-        if (any_hit(bvh, r)) continue;
-        out.visibility[t * out.light_count + l] = 1.0f;
-        lights_e += ls.irradiance * std::max(glm::dot(sp.n, ls.direction), 0.0f);
+      for (int j = 0; j < kBakePoints; ++j) {
+        const BakePoint bp = bake_point(scene, tri, j);
+        for (std::size_t l = 0; l < out.light_count; ++l) {
+          const LightSample ls = sample_light(scene.lights[l], bp.sp.p);
+          if (ls.irradiance == glm::vec3(0.0f) || glm::dot(bp.ng, ls.direction) <= 0.0f) continue;
+          Ray r;
+          r.origin = bp.above;
+          r.direction = ls.direction;
+          r.tmax = std::isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) : 3.0e38f;
+          if (any_hit(bvh, r)) continue;
+          out.visibility[t * out.light_count + l] += 1.0f / kBakePoints;
+          lights_e += ls.irradiance * std::max(glm::dot(bp.sp.n, ls.direction), 0.0f) / float(kBakePoints);
+        }
       }
       glm::vec3 env_e(0.0f);
       if (ks > 0) {
-        const Onb frame(sp.n);
-        const glm::vec2 shift = random_float2(static_cast<std::uint32_t>(t), 0, 0, opt.seed);
+        const glm::vec2 shift = random_float2(tri, 0, 0, opt.seed);
         for (int k = 0; k < ks; ++k) {
+          const BakePoint bp = bake_point(scene, tri, k % kBakePoints);
           const glm::vec2 u = rotate_unit_square(hamersley(static_cast<std::uint32_t>(k),
                                                            static_cast<std::uint32_t>(ks)), shift);
-          const glm::vec3 wi = frame.to_world(sample_cosine_hemisphere(u));
-          if (glm::dot(wi, ng) <= 0.0f) continue;
+          const glm::vec3 wi = Onb(bp.sp.n).to_world(sample_cosine_hemisphere(u));
+          if (glm::dot(wi, bp.ng) <= 0.0f) continue;
           Ray r;
-          r.origin = above;
+          r.origin = bp.above;
           r.direction = wi;
           if (!any_hit(bvh, r)) env_e += environment_radiance(scene.environment, wi);
         }
         env_e *= kPi / static_cast<float>(ks);  // E = π × mean radiance under cosine sampling
       }
       out.environment_irradiance[t] = env_e;
-      out.radiance[t] = sp.s.emissive + diffuse_albedo_over_pi(sp.s, 1.0f) * (lights_e + env_e) +
-                        specular_f0(sp.s) * (env_e / kPi);
+      const SurfaceParams s = surface_point(scene, tri, 1.0f / 3.0f, 1.0f / 3.0f).s;
+      out.radiance[t] = s.emissive + diffuse_albedo_over_pi(s, 1.0f) * (lights_e + env_e) +
+                        specular_f0(s) * (env_e / kPi);
     }
   });
   return out;
@@ -122,10 +150,11 @@ glm::vec3 hit_radiance(const Scene& scene, const LodBvh& lod, const TriangleLigh
   // Level 0: the exact shading model at the hit, with the triangle's baked visibility.
   glm::vec3 L = sp.s.emissive;
   for (std::size_t l = 0; l < lighting.light_count; ++l) {
-    if (lighting.visibility[t * lighting.light_count + l] == 0.0f) continue;
+    const float lit = lighting.visibility[t * lighting.light_count + l];
+    if (lit == 0.0f) continue;
     const LightSample ls = sample_light(scene.lights[l], sp.p);
     if (ls.irradiance == glm::vec3(0.0f) || glm::dot(ng, ls.direction) <= 0.0f) continue;
-    L += shade_light(sp.s, n, v, ls);
+    L += lit * shade_light(sp.s, n, v, ls);
   }
   L += diffuse_albedo_over_pi(sp.s, cos_nv) * lighting.environment_irradiance[t];
   if (!sp.s.is_refractor() && (sp.s.is_mirror_lobe() || sp.s.is_glossy_lobe()))

@@ -2,7 +2,7 @@
 // it. YU filters a radiance texture; for general meshes the pre-filtered radiance is a
 // pyramid whose level-0 texels are the triangles (A_texel = the triangle's area) and whose
 // coarser levels are the BVH ancestors' area-weighted mean radiance (trace/lod_bvh.h).
-// Lighting is baked once per triangle at its centroid: shadow-ray visibility of every light
+// Lighting is baked once per triangle at four points: the lit fraction of every light
 // and the occluded environment irradiance (cosine samples), both view-independent; a hit
 // then shades exactly at level 0 (the material at the hit's uv, shared model of
 // core/shading.h) and blends towards the ancestors as the eq.9 level grows. Glossy/mirror
@@ -32,14 +32,14 @@ struct RadianceBakeOptions {
 // Per original triangle.
 struct TriangleLighting {
   std::size_t light_count = 0;
-  std::vector<float> visibility;                  // [triangle * light_count + light]: 0 or 1
+  std::vector<float> visibility;                  // [triangle * light_count + light]: lit fraction
   std::vector<glm::vec3> environment_irradiance;  // occluded E from the environment
   // View-independent radiance the LOD levels average: emission + diffuse (lights and sky)
   // + a view-averaged specular F0 E_env / π.
   std::vector<glm::vec3> radiance;
 };
 
-// Kernel "radiance_bake": shadow and sky rays from each triangle's centroid.
+// Kernel "radiance_bake": shadow and sky rays from each triangle's bake points.
 TriangleLighting bake_triangle_lighting(par::Executor& executor, const Scene& scene, const Bvh& bvh,
                                         const RadianceBakeOptions& options = {});
 

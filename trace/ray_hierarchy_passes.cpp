@@ -67,8 +67,13 @@ ImageRGBA ShadeHitsPass::operator()(par::NodeContext& c, const SecondaryRays& ra
   ImageRGBA specular = earlier_bounces ? *earlier_bounces : ImageRGBA(width, height, glm::vec4(0.0f));
   shade_hits(c.executor(), *scene, rays, hits, shadows, specular);
   // Hits that would reflect or refract again are shaded as they are (direct light and the
-  // ambient term), without their specular continuation: the depth is exhausted.
-  if (last) c.count("fallback_depth_exhausted", bounce_rays(c.executor(), *scene, rays, hits).count);
+  // ambient term) and their specular continuation reads the environment instead of being
+  // traced: the depth is exhausted.
+  if (last) {
+    const SecondaryRays next = bounce_rays(c.executor(), *scene, rays, hits);
+    add_environment_fallback(c.executor(), *scene, next, specular);
+    c.count("fallback_depth_exhausted", next.count);
+  }
   return specular;
 }
 

@@ -180,4 +180,12 @@ void shade_hits(par::Executor& ex, const Scene& scene, const SecondaryRays& gen,
   });
 }
 
+void add_environment_fallback(par::Executor& ex, const Scene& scene, const SecondaryRays& gen, ImageRGBA& out) {
+  ex.parallel_for("environment_fallback", gen.active.size(), kPixelChunk, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      if (gen.active[i])
+        out.pixels[i] += glm::vec4(gen.weight[i] * environment_radiance(scene.environment, glm::normalize(gen.rays.get(i).direction)), 0.0f);
+  });
+}
+
 }  // namespace speculum::trace

@@ -66,4 +66,11 @@ SecondaryRays shadow_rays(par::Executor& executor, const Scene& scene, const Lig
 void shade_hits(par::Executor& executor, const Scene& scene, const SecondaryRays& gen, const HitStream& hits,
                 const std::vector<HitStream>& shadow_hits, ImageRGBA& out);
 
+// The fallback where the depth is exhausted: `gen` are the continuations that would be
+// traced next (bounce_rays of the last generation); each adds weight × the environment along
+// its direction to `out`, so a mirror, glossy or glass surface at the end of the chain shows
+// the environment it would reflect or transmit rather than its black diffuse shading.
+// Kernel "environment_fallback".
+void add_environment_fallback(par::Executor& executor, const Scene& scene, const SecondaryRays& gen, ImageRGBA& out);
+
 }  // namespace speculum::trace

@@ -42,22 +42,16 @@ ImageRGBA reference_display(const Scene& s, int depth, par::Executor& ex) {
 }
 
 // Cells that still break the rule, bounded at their current count so they cannot get worse
-// (a bound may only be lowered): in living-room and bathroom, yu-lod's rays that hit a
-// surface in shadow find it black (its hit shading is direct light plus the environment's
-// unoccluded irradiance, with no light bounced between surfaces, which the reference has), and
-// ray-hierarchy's chrome balls see a few black hits at the table's edge; in water-slab, rays that refract into the closed slab
-// reach its floor-side face from inside, where ray-hierarchy's one bounce and the layered
-// tracer's layers end.
+// (a bound may only be lowered): in living-room and bathroom, some of yu-lod's glossy pixels
+// come out black on the floor in the lights' shadow inside the closed rooms, where the
+// reference (which has no interreflection either) is dark but not black; the cause is not
+// pinned down yet.
 struct OpenCell {
   const char* technique;
   const char* scene;
   std::size_t max_black;
 };
-constexpr OpenCell kOpenCells[] = {{"yu-lod", "living-room", 124},
-                                   {"yu-lod", "bathroom", 63},
-                                   {"ray-hierarchy", "living-room", 35},
-                                   {"ray-hierarchy", "water-slab", 1273},
-                                   {"layered-distance-map", "water-slab", 608}};
+constexpr OpenCell kOpenCells[] = {{"yu-lod", "living-room", 118}, {"yu-lod", "bathroom", 49}};
 
 const nlohmann::json& frame_error_bounds() {
   static const nlohmann::json bounds = [] {
