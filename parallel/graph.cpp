@@ -174,7 +174,7 @@ void Graph::run_node(std::size_t index, Executor& executor, const CaptureHook& c
       if (it != source.end()) in[d.port] = it->second;
     }
   }
-  NodeContext ctx(executor, entry.name, entry.ports, in, out);
+  NodeContext ctx(executor, entry.name, entry.ports, in, out, static_cast<bool>(capture));
   record.name = entry.name;
   record.start_ns = executor.now_ns();
   {
@@ -194,6 +194,8 @@ void Graph::run_node(std::size_t index, Executor& executor, const CaptureHook& c
       capture({entry.name, d.port, d.resource, d.type_name, d.type, it->second.value.get()});
     values_[d.resource] = std::move(it->second);
   }
+  for (const auto& [name, value] : ctx.published())
+    capture({entry.name, name, "", value.type_name, value.type, value.value.get()});
 }
 
 RunReport Graph::run(Executor& executor, const CaptureHook& capture) {

@@ -65,7 +65,8 @@ struct RunReport {
 };
 
 // One output as it was produced (the `inspect` hook). Called once per output of every run
-// node, serialized by the graph (the hook need not be thread-safe).
+// node, then once per value the node published (NodeContext::publish; resource empty),
+// serialized by the graph (the hook need not be thread-safe).
 struct CapturedOutput {
   std::string node, port, resource, type_name;
   std::type_index type = typeid(void);

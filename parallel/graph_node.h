@@ -79,8 +79,9 @@ class NodeContext {
  public:
   NodeContext(Executor& executor, std::string node, const std::vector<PortDecl>& ports,
               std::map<std::string, ResourceValue>& inputs,
-              std::map<std::string, ResourceValue>& outputs)
-      : executor_(executor), node_(std::move(node)), ports_(ports), inputs_(inputs), outputs_(outputs) {}
+              std::map<std::string, ResourceValue>& outputs, bool capturing = false)
+      : executor_(executor), node_(std::move(node)), ports_(ports), inputs_(inputs), outputs_(outputs),
+        capturing_(capturing) {}
 
   Executor& executor() { return executor_; }
   const std::string& node_name() const { return node_; }
@@ -138,6 +139,19 @@ class NodeContext {
     return counters_;
   }
 
+  // Whether the run is being captured (`inspect`). A pass may then publish what it did beyond
+  // its output — a per-pixel view such as a fallback mask — under a name of its own; the
+  // capture hook sees it after the node's outputs, with port = name and no resource. Outside a
+  // capture, passes skip the work of building such views (and publish drops them).
+  bool capturing() const { return capturing_; }
+  template <class T>
+  void publish(std::string name, T value) {
+    if (!capturing_) return;
+    std::lock_guard lock(mutex_);
+    published_.emplace_back(std::move(name), ResourceValue{std::make_shared<T>(std::move(value)), typeid(T), type_name<T>()});
+  }
+  const std::vector<std::pair<std::string, ResourceValue>>& published() const { return published_; }
+
  private:
   template <class T>
   const PortDecl& check(std::string_view port, bool output) const {
@@ -157,6 +171,8 @@ class NodeContext {
   const std::vector<PortDecl>& ports_;
   std::map<std::string, ResourceValue>& inputs_;
   std::map<std::string, ResourceValue>& outputs_;
+  bool capturing_ = false;
+  std::vector<std::pair<std::string, ResourceValue>> published_;
   mutable std::mutex mutex_;
   std::map<std::string, double> counters_;
 };

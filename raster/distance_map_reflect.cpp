@@ -27,7 +27,8 @@ constexpr float kGlossySearchExponent = 1e4f;
 
 ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
                                const EnvironmentMap& env, const ReflectorMaps& maps,
-                               const DistanceSearchOptions& options, DistanceReflectStats* stats) {
+                               const DistanceSearchOptions& options, DistanceReflectStats* stats,
+                               FallbackMask* fallbacks) {
   constexpr std::size_t kChunk = 2048;
   ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   std::vector<DistanceReflectStats> per_chunk((out.size() + kChunk - 1) / kChunk);
@@ -68,8 +69,10 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
         }
         return used > 0 ? sum / float(used) : search(d, exponent);
       };
+      const std::uint64_t missed_before = st.missed;
       const glm::vec3 radiance = specular_radiance(s, n, g.view_direction(i), lookup);
       out.pixels[i] = glm::vec4(radiance, 1.0f);
+      if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
     }
   });
   if (stats)
@@ -86,7 +89,9 @@ ImageRGBA DistanceMapReflectPass::operator()(par::NodeContext& c, const GBuffer&
                                             const EnvironmentMap& environment,
                                             const ReflectorMaps& maps) const {
   DistanceReflectStats st;
-  ImageRGBA specular = distance_map_reflect(c.executor(), gbuffer, environment, maps, search, &st);
+  FallbackMask fallbacks = c.capturing() ? FallbackMask(gbuffer.width, gbuffer.height) : FallbackMask();
+  ImageRGBA specular = distance_map_reflect(c.executor(), gbuffer, environment, maps, search, &st, &fallbacks);
+  c.publish("fallback", std::move(fallbacks));
   c.count("searches", st.searches);
   c.count("distance_lookups", st.lookups);
   c.count("bracketed", st.bracketed);

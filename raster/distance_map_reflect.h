@@ -7,6 +7,7 @@
 
 #include <cstdint>
 
+#include "core/fallback_mask.h"
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
 #include "raster/distance_map_search.h"
@@ -25,11 +26,12 @@ struct DistanceReflectStats {
 
 // The specular layer (zero on diffuse samples). Works on any G-buffer, including a cube
 // face's (eye = the face centre), which is how multi-reflection shades reflectors seen in
-// other reflectors' maps. `stats` (may be null) is summed in chunk order.
+// other reflectors' maps. `stats` (may be null) is summed in chunk order; `fallbacks` (may
+// be null or empty: nothing is marked) marks the samples with a search that missed.
 ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
                                const EnvironmentMap& env, const ReflectorMaps& maps,
                                const DistanceSearchOptions& options,
-                               DistanceReflectStats* stats = nullptr);
+                               DistanceReflectStats* stats = nullptr, FallbackMask* fallbacks = nullptr);
 
 // Pass "distance_map_reflect": the specular layer searched in the reflectors' distance maps.
 struct DistanceMapReflectPass {

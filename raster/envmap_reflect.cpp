@@ -3,6 +3,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/fallback_mask.h"
 #include "raster/specular_radiance.h"
 
 namespace speculum::raster {
@@ -50,9 +51,14 @@ ImageRGBA RefractorEnvironmentPass::operator()(par::NodeContext& c, const GBuffe
                                                const EnvironmentMap& environment,
                                                const ReflectorMaps* refractor_maps) const {
   std::uint64_t refractor_samples = 0;
+  FallbackMask fallbacks = c.capturing() ? FallbackMask(gbuffer.width, gbuffer.height) : FallbackMask();
   for (std::size_t i = 0; i < gbuffer.surface.size(); ++i)
-    refractor_samples += gbuffer.covered(i) && gbuffer.surface.pixels[i].is_refractor();
+    if (gbuffer.covered(i) && gbuffer.surface.pixels[i].is_refractor()) {
+      ++refractor_samples;
+      fallbacks.mark(i, Fallback::refractor_environment);
+    }
   c.count("fallback_refractor_environment", refractor_samples);
+  c.publish("fallback", std::move(fallbacks));
   return refractor_environment(c.executor(), gbuffer, environment, refractor_maps);
 }
 

@@ -303,7 +303,7 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
 
 ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const LayeredDistanceMap& map,
                           const EnvironmentMap& env, const LayeredTraceOptions& options,
-                          LayeredTraceStats* stats) {
+                          LayeredTraceStats* stats, FallbackMask* fallbacks) {
   constexpr std::size_t kChunk = 1024;
   ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   std::vector<LayeredTraceStats> per_chunk((out.size() + kChunk - 1) / kChunk);
@@ -314,9 +314,12 @@ ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const Layer
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface.pixels[i];
       if (!is_specular(s)) continue;
+      const LayeredTraceStats before = st;
       const glm::vec3 radiance = specular_continuation(map, env, g.position.pixels[i], -g.view_direction(i),
                                                        g.normal.pixels[i], s, options, 1, st);
       out.pixels[i] = glm::vec4(radiance, 1.0f);
+      if (fallbacks && st.misses > before.misses) fallbacks->mark(i, Fallback::search_missed);
+      if (fallbacks && st.depth_exhausted > before.depth_exhausted) fallbacks->mark(i, Fallback::depth_exhausted);
     }
   });
   if (stats)
@@ -338,7 +341,9 @@ ImageRGBA LayeredReflectPass::operator()(par::NodeContext& c, const GBuffer& gbu
                                         const LayeredDistanceMap& map,
                                         const EnvironmentMap& environment) const {
   LayeredTraceStats st;
-  ImageRGBA specular = layered_reflect(c.executor(), gbuffer, map, environment, options, &st);
+  FallbackMask fallbacks = c.capturing() ? FallbackMask(gbuffer.width, gbuffer.height) : FallbackMask();
+  ImageRGBA specular = layered_reflect(c.executor(), gbuffer, map, environment, options, &st, &fallbacks);
+  c.publish("fallback", std::move(fallbacks));
   c.count("searches", st.rays);
   c.count("distance_lookups", st.lookups);
   c.count("fallback_search_missed", st.misses);

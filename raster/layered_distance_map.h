@@ -9,6 +9,7 @@
 #include <array>
 #include <vector>
 
+#include "core/fallback_mask.h"
 #include "core/image.h"
 #include "core/scene.h"
 #include "parallel/executor.h"
@@ -68,9 +69,10 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
 // The specular layer of a G-buffer: F · trace_layered along R for specular samples (glossy
 // lobes use their mirror direction); refractors add (1 − F) × their tint times the refracted
 // ray, traced through the same layers.
+// `fallbacks` (may be null or empty) marks the samples whose paths missed or ran out of bounces.
 ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const LayeredDistanceMap& map,
                           const EnvironmentMap& env, const LayeredTraceOptions& options,
-                          LayeredTraceStats* stats = nullptr);
+                          LayeredTraceStats* stats = nullptr, FallbackMask* fallbacks = nullptr);
 
 // Pass "layered_distance_map": the scene peeled into layers around `centre`.
 struct LayeredDistanceMapPass {

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "core/fallback_mask.h"
+
 namespace speculum::trace {
 
 namespace {
@@ -73,6 +75,12 @@ ImageRGBA ShadeHitsPass::operator()(par::NodeContext& c, const SecondaryRays& ra
     const SecondaryRays next = bounce_rays(c.executor(), *scene, rays, hits);
     add_environment_fallback(c.executor(), *scene, next, specular);
     c.count("fallback_depth_exhausted", next.count);
+    if (c.capturing()) {
+      FallbackMask fallbacks(width, height);
+      for (std::size_t i = 0; i < next.active.size(); ++i)
+        if (next.active[i]) fallbacks.mark(i, Fallback::depth_exhausted);
+      c.publish("fallback", std::move(fallbacks));
+    }
   }
   return specular;
 }

@@ -31,8 +31,10 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
       cmd.add_option("--height", o.height,
                      "Image height (default: from a glTF camera's aspect ratio when it has one)")
           ->check(CLI::Range(1, 16384))->capture_default_str();
-  cmd.add_option("--spp", o.spp, "Samples per pixel (a square is k×k supersampling for feed-forward techniques)")
-      ->check(CLI::Range(1, 65536))->capture_default_str();
+  cmd.add_option("--spp", o.spp,
+                 "Samples per pixel (a square is k×k supersampling for feed-forward techniques; yu-lod: glossy "
+                 "rays per pixel; 0: the technique's default: 8 for yu-lod, else 1)")
+      ->check(CLI::Range(0, 65536))->capture_default_str();
   cmd.add_option("--seed", o.seed, "Random seed")->capture_default_str();
   cmd.add_option("--exposure", o.exposure,
                  "Exposure before tone mapping: a multiplier > 0 (1: the radiance unscaled), or auto (meters the frame's "
@@ -133,7 +135,7 @@ FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
   // A square spp is k×k supersampling for feed-forward techniques; any other count only
   // reaches sample-based techniques (reference, yu-lod) through FrameSettings::spp.
   int k = static_cast<int>(std::lround(std::sqrt(static_cast<double>(o.spp))));
-  if (k * k != o.spp) k = 1;
+  if (o.spp <= 0 || k * k != o.spp) k = 1;
   FrameSettings f;
   f.width = o.width;
   f.height = o.height;
@@ -151,7 +153,7 @@ FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
   // The side a camera's aspect ratio derived counts against the same limit.
   check_sample_count(find_technique(o.technique), f.width, f.height, o.spp);
   f.supersample = k;
-  f.spp = o.spp;
+  f.spp = find_technique(o.technique).resolve_spp(o.spp, f.width, f.height);
   f.seed = o.seed;
   const Exposure exposure = parse_exposure(o.exposure);
   f.exposure = exposure.value;

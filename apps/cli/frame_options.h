@@ -20,7 +20,7 @@ struct FrameOptions {
   std::string technique = "envmap";
   int width = 320;
   int height = 240;
-  int spp = 1;
+  int spp = 0;  // 0: the technique's default
   std::uint32_t seed = 0;
   std::string exposure = "1";  // a multiplier > 0, or "auto" (render's default)
   std::string env;             // --env FILE|sky|COLOR; empty: the scene's own environment

@@ -110,7 +110,7 @@ fs::path write_inspect_report(const pipeline::FrameOptions& options, const fs::p
       report.files.push_back(file.exr);
       info.images.push_back(std::move(file));
     }
-    size_of_resource[out.resource] = d.size;
+    if (!out.resource.empty()) size_of_resource[out.resource] = d.size;
     captured[{out.node, out.port}] = std::move(info);
   };
 
@@ -147,6 +147,9 @@ fs::path write_inspect_report(const pipeline::FrameOptions& options, const fs::p
         }
       }
     }
+    // What the node published beyond its outputs (NodeContext::publish: no resource).
+    for (const auto& [key, info] : captured)
+      if (key.first == rec.name && info.resource.empty()) n.outputs.push_back(info);
     for (const auto& l : launches)
       if (l.scope == rec.name) n.launches.push_back({l.name, l.elements, l.chunks, l.duration_ns * 1e-6});
     report.nodes.push_back(std::move(n));

@@ -8,6 +8,7 @@
 
 #include "apps/inspect/inspect_trace_images.h"
 #include "apps/techniques/frame_settings.h"
+#include "core/fallback_mask.h"
 #include "core/shading.h"
 #include "raster/composite.h"
 #include "raster/cube_map.h"
@@ -257,10 +258,43 @@ ImageRGBA cube_cross(const std::array<ImageRGBA, 6>& faces) {
   return out;
 }
 
+namespace {
+
+// A fallback mask: each reason in its own colour, the rest black; the size line counts them.
+// The EXR keeps the Fallback codes.
+void draw_fallbacks(Drawing& d, const FallbackMask& m) {
+  struct Reason {
+    Fallback why;
+    const char* name;
+    const char* colour_name;
+    glm::vec3 colour;  // sRGB
+  };
+  constexpr Reason kReasons[] = {{Fallback::search_missed, "search missed", "red", {1.0f, 0.2f, 0.2f}},
+                                 {Fallback::depth_exhausted, "depth exhausted", "blue", {0.3f, 0.5f, 1.0f}},
+                                 {Fallback::refractor_environment, "refractor environment", "green", {0.2f, 0.9f, 0.3f}}};
+  ImageRGBA picture(m.reason.width, m.reason.height, glm::vec4(0, 0, 0, 1));
+  ImageF raw(m.reason.width, m.reason.height);
+  std::string legend;
+  for (const Reason& r : kReasons)
+    legend += std::string(legend.empty() ? "" : ", ") + r.name + " " + std::to_string(m.count(r.why)) + " (" +
+              r.colour_name + ")";
+  for (std::size_t i = 0; i < m.reason.size(); ++i) {
+    raw.pixels[i] = m.reason.pixels[i];
+    for (const Reason& r : kReasons)
+      if (m.reason.pixels[i] == static_cast<std::uint8_t>(r.why)) picture.pixels[i] = from_srgb(r.colour);
+  }
+  d.size = dims(m.reason.width, m.reason.height) + "; " + legend;
+  d.views.push_back({"", "fallback per pixel: " + legend + "; black: none", picture, {}, raw});
+}
+
+}  // namespace
+
 Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
   Drawing d;
   d.drawable = true;
-  if (const auto* img = o.as<ImageRGBA>()) {
+  if (const auto* fallbacks = o.as<FallbackMask>()) {
+    draw_fallbacks(d, *fallbacks);
+  } else if (const auto* img = o.as<ImageRGBA>()) {
     d.size = dims(img->width, img->height);
     if (o.resource == pipeline::kDisplay)
       d.views.push_back({"", "display colour (already tone-mapped)", *img, *img, {}});

@@ -18,7 +18,8 @@ struct FrameSettings {
   int width = 640;
   int height = 480;
   int supersample = 1;  // k: k×k samples per pixel (feed-forward techniques)
-  int spp = 1;          // samples per pixel as asked (= k² for feed-forward techniques)
+  int spp = 0;          // samples per pixel as asked (= k² for feed-forward techniques);
+                        // 0: the technique's default (Technique::default_spp)
   Camera camera;
   std::uint32_t seed = 0;
   int shadow_map_size = 512;

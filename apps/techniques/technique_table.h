@@ -30,10 +30,16 @@ struct Technique {
   // sample (visibility, G-buffer, layers: memory); the sampled ones keep pixels and pay for
   // samples in time. Each figure is set from the technique's measured peak.
   double max_samples = double(1 << 23);
+  // Samples per pixel when none are asked for (FrameSettings::spp = 0), lowered where the
+  // frame would exceed max_samples.
+  int default_spp = 1;
 
-  // `settings` with every parameter of the table present (defaults where not given).
+  // `settings` with every parameter of the table present (defaults where not given) and
+  // spp resolved (default_spp where 0).
   // Throws InputError for an unknown, out-of-range or fractional-where-whole parameter.
   FrameSettings with_defaults(FrameSettings settings) const;
+  // `spp`, or default_spp (lowered to fit max_samples, at least 1) where it is 0.
+  int resolve_spp(int spp, int width, int height) const;
   // Adds the technique's passes to `graph` (the recipe, on with_defaults(settings)).
   FrameOutputs add_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings) const {
     return recipe(graph, scene, with_defaults(settings));

@@ -2,7 +2,7 @@
 // a pixel the technique leaves black (all channels below 1/255 after tone mapping, exposure
 // 1) must be black in the reference too — at its full specular depth or at one bounce (a
 // first-order technique is not asked to show a mirror inside a mirror). At most 0.5 % of the
-// pixels may break this, per technique × scene, except the cells listed in kOpenCells.
+// pixels may break this, per technique × scene.
 // Each cell's frame error (mae8 against the same reference) is also held to its bound in
 // tests/data/frame_error_bounds.json, set from the output with a small margin: a regression
 // in any cell fails, and a bound may only be lowered.
@@ -41,18 +41,6 @@ ImageRGBA reference_display(const Scene& s, int depth, par::Executor& ex) {
   return raster::tonemap(ex, trace::render_reference(s, s.cameras.front(), o, ex), 1.0f);
 }
 
-// Cells that still break the rule, bounded at their current count so they cannot get worse
-// (a bound may only be lowered): in living-room and bathroom, some of yu-lod's glossy pixels
-// come out black on the floor in the lights' shadow inside the closed rooms, where the
-// reference (which has no interreflection either) is dark but not black; the cause is not
-// pinned down yet.
-struct OpenCell {
-  const char* technique;
-  const char* scene;
-  std::size_t max_black;
-};
-constexpr OpenCell kOpenCells[] = {{"yu-lod", "living-room", 118}, {"yu-lod", "bathroom", 49}};
-
 const nlohmann::json& frame_error_bounds() {
   static const nlohmann::json bounds = [] {
     std::ifstream in(SPECULUM_TEST_DATA "/frame_error_bounds.json");
@@ -82,9 +70,7 @@ TEST_P(NoBlackRegions, EveryTechniqueAgainstTheReference) {
     std::size_t wrong = 0;
     for (std::size_t i = 0; i < img.pixels.size(); ++i)
       if (black(img.pixels[i]) && !black(full.pixels[i]) && !black(first.pixels[i])) ++wrong;
-    std::size_t bound = img.pixels.size() / 200;  // 0.5 %
-    for (const OpenCell& c : kOpenCells)
-      if (t.name == c.technique && GetParam() == c.scene) bound = c.max_black;
+    const std::size_t bound = img.pixels.size() / 200;  // 0.5 %
     EXPECT_LE(wrong, bound) << t.name << " on " << GetParam() << ": " << wrong << " black pixels the reference lacks";
 
     const std::string id = t.name + "@" + GetParam();
