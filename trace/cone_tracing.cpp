@@ -124,6 +124,7 @@ ConeHits cone_triangle_hits(par::Executor& ex, const Scene& scene, const PixelCo
   out.triangle.assign(npix * K, kNoHit);
   out.count.assign(npix, 0);
   out.total.assign(npix, 0);
+  out.dropped.assign(npix, 0.0f);
   const auto& pos = scene.mesh.positions;
   const auto& idx = scene.mesh.indices;
   const RayStream& rays = cones.axes.rays;
@@ -161,6 +162,11 @@ ConeHits cone_triangle_hits(par::Executor& ex, const Scene& scene, const PixelCo
           continue;
         }
         if (tri[k] == cones.self[i]) continue;
+        // Back faces (seen from the cone's origin) are hidden behind the front faces of the
+        // same closed surface; the saturate blend would count that surface twice (ROGER
+        // §5.2.4: the blend is wrong where one triangle masks another), so cones skip them.
+        const glm::vec3 pa = pos[t[0]];
+        if (glm::dot(glm::cross(pos[t[1]] - pa, pos[t[2]] - pa), pa - o) >= 0.0f) continue;
         Cone cone;
         cone.origin = o;
         cone.axis = glm::normalize(d);
@@ -205,7 +211,11 @@ ConeHits cone_triangle_hits(par::Executor& ex, const Scene& scene, const PixelCo
           std::uint32_t* T = &out.triangle[p * K];
           std::uint32_t c = out.count[p];
           auto before = [&](std::uint32_t j) { return dk < D[j] || (dk == D[j] && tk < T[j]); };
-          if (c == K && !before(c - 1)) continue;
+          if (c == K && !before(c - 1)) {
+            out.dropped[p] += cov[k];
+            continue;
+          }
+          if (c == K) out.dropped[p] += out.coverage[p * K + c - 1];
           std::uint32_t j = c == K ? c - 1 : c;  // the slot to fill (the farthest drops out)
           while (j > 0 && before(j - 1)) {
             D[j] = D[j - 1];
@@ -300,7 +310,7 @@ SecondaryRays blend_layers(par::Executor& ex, const Scene& scene, const PixelCon
 }
 
 ImageRGBA gather_layers(par::Executor& ex, const Scene& scene, const PixelCones& cones, const ConeHits& hits,
-                        const ImageRGBA& layers) {
+                        const ImageRGBA& layers, bool fill_dropped) {
   const LayerGrid grid = layer_grid(hits);
   ImageRGBA out(hits.width, hits.height, glm::vec4(0.0f));
   const std::size_t npix = std::size_t(hits.width) * std::size_t(hits.height), K = std::size_t(hits.kept);
@@ -315,7 +325,13 @@ ImageRGBA gather_layers(par::Executor& ex, const Scene& scene, const PixelCones&
         acc += share;
         c += layers.pixels[grid.index(p, j)];
       }
-      const float rest = 1.0f - acc;
+      float rest = 1.0f - acc;
+      if (rest > 0.0f && fill_dropped && hits.dropped[p] > 0.0f && acc > 0.0f) {
+        // The dropped hits' saturate share, in the kept hits' mean colour.
+        const float share = std::min(hits.dropped[p], rest);
+        c = glm::vec4(glm::vec3(c) * ((acc + share) / acc), c.w);
+        rest -= share;
+      }
       if (rest > 0.0f) {
         const glm::vec3 dir = glm::normalize(cones.axes.rays.get(p).direction);
         c += glm::vec4(cones.axes.weight[p] * rest * environment_radiance(scene.environment, dir), 0.0f);
@@ -323,6 +339,98 @@ ImageRGBA gather_layers(par::Executor& ex, const Scene& scene, const PixelCones&
       out.pixels[p] = c;
     }
   });
+  return out;
+}
+
+SecondaryRays first_layer_bounce(par::Executor& ex, const Scene& scene, const SecondaryRays& layers,
+                                 const HitStream& layer_hits, const ConeHits& hits, std::uint64_t* dropped) {
+  const LayerGrid grid = layer_grid(hits);
+  const SecondaryRays all = bounce_rays(ex, scene, layers, layer_hits);
+  SecondaryRays out;
+  out.width = hits.width;
+  out.height = hits.height;
+  const std::size_t npix = std::size_t(hits.width) * std::size_t(hits.height);
+  out.rays.resize(npix);
+  out.active.assign(npix, 0);
+  out.weight.assign(npix, glm::vec3(0.0f));
+  const std::uint32_t layer_count = std::uint32_t(grid.tx * grid.ty);
+  ex.parallel_for("cone_first_layer", npix, kPixelChunk, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) {
+      std::size_t first = 0;
+      bool found = false;
+      glm::vec3 w(0.0f);
+      for (std::uint32_t j = 0; j < layer_count; ++j) {
+        const std::size_t q = grid.index(p, j);
+        if (!all.active[q]) continue;
+        if (!found) {
+          first = q;
+          found = true;
+          w = all.weight[q];
+        } else {
+          w += all.weight[q];
+        }
+      }
+      if (!found) continue;
+      out.rays.set(p, all.rays.get(first));
+      out.active[p] = 1;
+      out.weight[p] = w;
+    }
+  });
+  out.count = count_flags(out.active);
+  if (dropped) *dropped = all.count - out.count;
+  return out;
+}
+
+SecondaryRays first_layer(par::Executor& ex, const SecondaryRays& layers, const HitStream& layer_hits,
+                          const ConeHits& hits, HitStream& first_hits) {
+  const LayerGrid grid = layer_grid(hits);
+  SecondaryRays out;
+  out.width = hits.width;
+  out.height = hits.height;
+  const std::size_t npix = std::size_t(hits.width) * std::size_t(hits.height);
+  out.rays.resize(npix);
+  out.active.assign(npix, 0);
+  out.weight.assign(npix, glm::vec3(0.0f));
+  first_hits.resize(npix);
+  ex.parallel_for("cone_first_layer", npix, kPixelChunk, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) {
+      const std::size_t q = grid.index(p, 0);
+      first_hits.t[p] = layer_hits.t[q];
+      first_hits.u[p] = layer_hits.u[q];
+      first_hits.v[p] = layer_hits.v[q];
+      first_hits.triangle[p] = layer_hits.triangle[q];
+      if (!layers.active[q]) continue;
+      out.rays.set(p, layers.rays.get(q));
+      out.active[p] = 1;
+      out.weight[p] = layers.weight[q];
+    }
+  });
+  out.count = count_flags(out.active);
+  return out;
+}
+
+std::vector<HitStream> spread_first_layer_shadows(par::Executor& ex, const std::vector<HitStream>& first,
+                                                  const ConeHits& hits) {
+  const LayerGrid grid = layer_grid(hits);
+  const std::size_t n = std::size_t(grid.width) * std::size_t(grid.tx) * std::size_t(grid.height) *
+                        std::size_t(grid.ty);
+  const std::size_t npix = std::size_t(hits.width) * std::size_t(hits.height);
+  const std::uint32_t layers = std::uint32_t(grid.tx * grid.ty);
+  std::vector<HitStream> out(first.size());
+  for (std::size_t l = 0; l < first.size(); ++l) {
+    HitStream& o = out[l];
+    o.resize(n);
+    ex.parallel_for("cone_shadow_spread", npix, kPixelChunk, [&](std::size_t b, std::size_t e) {
+      for (std::size_t p = b; p < e; ++p)
+        for (std::uint32_t j = 0; j < layers; ++j) {
+          const std::size_t q = grid.index(p, j);
+          o.t[q] = first[l].t[p];
+          o.u[q] = first[l].u[p];
+          o.v[q] = first[l].v[p];
+          o.triangle[q] = first[l].triangle[p];
+        }
+    });
+  }
   return out;
 }
 

@@ -72,6 +72,7 @@ struct ConeHits {
   std::vector<std::uint32_t> triangle;
   std::vector<std::uint32_t> count;  // hits kept per pixel (<= kept)
   std::vector<std::uint32_t> total;  // hits found per pixel (beyond kept: overflow)
+  std::vector<float> dropped;        // summed coverage of the hits dropped per pixel
   std::uint64_t pairs = 0;           // (cone, triangle) pairs tested exactly
   std::uint64_t hits = 0;            // pairs with a non-zero coverage
   std::uint64_t overflow = 0;        // hits dropped because a pixel already kept n nearer ones
@@ -84,7 +85,8 @@ RayHierarchy build_cone_hierarchy(par::Executor& executor, const PixelCones& con
 
 // Traverses the cone hierarchy (hierarchy_candidates) and intersects every surviving pair:
 // a ray leaf by the watertight test (coverage 1 at its hit), a cone leaf by
-// cone_triangle_coverage (§5.2.5). Each batch's hits are grouped by pixel (stable
+// cone_triangle_coverage (§5.2.5) on the triangles that face its origin (a closed surface's
+// back faces, hidden behind its front faces, would add its coverage twice in the blend). Each batch's hits are grouped by pixel (stable
 // partition) and merged into the pixel's n nearest (kernels "cone_triangle_coverage",
 // "cone_hits_compact", "cone_hits_partition", "cone_keep_nearest"): the kept set is the
 // same whatever the batches.
@@ -114,10 +116,30 @@ LayerGrid layer_grid(const ConeHits& hits);
 SecondaryRays blend_layers(par::Executor& executor, const Scene& scene, const PixelCones& cones,
                            const ConeHits& hits, HitStream& layer_hits);
 
-// The specular layer: the layers' shaded radiance summed per pixel in layer order, plus the
-// uncovered rest 1 − accumulated times the axis weight times the environment along the axis
-// (§5.2.4's filling colour). Kernel "cone_gather".
+// The specular layer: the layers' shaded radiance summed per pixel in layer order, then the
+// uncovered rest 1 − accumulated filled: with `fill_dropped`, first by the hits dropped
+// beyond the n nearest (their saturate share min(dropped coverage, rest), in the mean colour
+// of the kept hits: their coverage is known, their colour is not), then by the axis weight
+// times the environment along the axis (§5.2.4's filling colour). Kernel "cone_gather".
 ImageRGBA gather_layers(par::Executor& executor, const Scene& scene, const PixelCones& cones,
-                        const ConeHits& hits, const ImageRGBA& layers);
+                        const ConeHits& hits, const ImageRGBA& layers, bool fill_dropped);
+
+// Layer 0 (each pixel's nearest kept hit) of the layer generation, on the pixel grid.
+// Kernel "cone_first_layer".
+SecondaryRays first_layer(par::Executor& executor, const SecondaryRays& layers, const HitStream& layer_hits,
+                          const ConeHits& hits, HitStream& first_hits);
+
+// Shadow hits of layer 0 (per light, on the pixel grid) spread to every layer of the pixel:
+// the layers of a pixel share the shadow of its nearest hit. Kernel "cone_shadow_spread".
+std::vector<HitStream> spread_first_layer_shadows(par::Executor& executor, const std::vector<HitStream>& first,
+                                                  const ConeHits& hits);
+
+// The next generation from the layers' hits, on the pixel grid: each pixel continues along
+// the continuation of its nearest layer that has one, weighted by the sum of all its layers'
+// continuation weights (its farther specular layers follow the nearest one's path); the
+// number of continuations merged so is counted in `dropped`. With one layer it is
+// bounce_rays itself. Kernel "cone_first_layer".
+SecondaryRays first_layer_bounce(par::Executor& executor, const Scene& scene, const SecondaryRays& layers,
+                                 const HitStream& layer_hits, const ConeHits& hits, std::uint64_t* dropped);
 
 }  // namespace speculum::trace

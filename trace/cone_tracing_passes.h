@@ -9,6 +9,7 @@
 #include "core/scene.h"
 #include "parallel/graph_node.h"
 #include "trace/cone_tracing.h"
+#include "trace/ray_hierarchy_passes.h"
 
 namespace speculum::trace {
 
@@ -78,15 +79,52 @@ struct ConeLayerHitsPass {
   }
 };
 
+// Pass "shadow_rays" of cone tracing: the shadow rays of each pixel's nearest layer traced
+// as ray-hierarchy traces them, their result shared by the pixel's farther layers (ROGER
+// §5.2.3 shades a triangle's contribution locally; one shadow ray per pixel keeps the cost
+// of ray tracing).
+struct ConeShadowRaysPass {
+  static constexpr const char* description =
+      "Shadow rays of each pixel's nearest kept hit, reversed to start at each point light and "
+      "traced through their own hierarchy (ROGER §3.3.5); the pixel's farther layers share them.";
+  const Scene* scene = nullptr;
+  HierarchyTraverseOptions options;
+  ShadowHits operator()(par::NodeContext& c, const SecondaryRays& layers, const HitStream& layer_hits,
+                        const ConeHits& hits) const {
+    HitStream first_hits;
+    const SecondaryRays first = first_layer(c.executor(), layers, layer_hits, hits, first_hits);
+    const ShadowHits shadows = ShadowRaysPass{scene, options, 0, 0}(c, first, first_hits);
+    return spread_first_layer_shadows(c.executor(), shadows, hits);
+  }
+};
+
 // Pass "cone_gather": the shaded layers summed per pixel plus the environment for the rest.
 struct ConeGatherPass {
   static constexpr const char* description =
       "The shaded layers summed per pixel; the coverage the kept hits leave is filled from the "
       "environment along the axis (ROGER §5.2.4, §5.2.6).";
   const Scene* scene = nullptr;
+  bool fill_dropped = true;
+  void parameters(par::Params& p) const { p.set("fill", fill_dropped ? 1 : 0); }
   ImageRGBA operator()(par::NodeContext& c, const PixelCones& cones, const ConeHits& hits,
                        const ImageRGBA& layers) const {
-    return gather_layers(c.executor(), *scene, cones, hits, layers);
+    return gather_layers(c.executor(), *scene, cones, hits, layers, fill_dropped);
+  }
+};
+
+// Pass "bounce_rays_2" of cone tracing: the second generation from each pixel's nearest layer.
+struct ConeBounceRaysPass {
+  static constexpr const char* description =
+      "The next generation rebuilt from each pixel's nearest continuing layer, weighted by all its "
+      "layers' continuations (ROGER §3.3.5 on the layers of §5.2.4).";
+  const Scene* scene = nullptr;
+  SecondaryRays operator()(par::NodeContext& c, const SecondaryRays& layers, const HitStream& layer_hits,
+                           const ConeHits& hits) const {
+    std::uint64_t dropped = 0;
+    SecondaryRays next = first_layer_bounce(c.executor(), *scene, layers, layer_hits, hits, &dropped);
+    c.count("rays", next.count);
+    c.count("merged_layer_continuations", dropped);
+    return next;
   }
 };
 

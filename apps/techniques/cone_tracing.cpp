@@ -42,21 +42,28 @@ FrameOutputs add_cone_tracing_passes(par::Graph& g, const Scene* scene, const Fr
                     hierarchy);
   par::Resource<trace::SecondaryRays> rays = g.add("cone_blend", trace::ConeBlendPass{scene}, cones, hits);
   par::Resource<trace::HitStream> layer_hits = g.add("cone_layer_hits", trace::ConeLayerHitsPass{scene}, cones, hits);
-  par::Resource<ImageRGBA> layers;
-  for (int b = 1; b <= bounces; ++b) {
-    const std::string suffix = b == 1 ? "" : "_" + std::to_string(b);
-    if (b > 1) {
+  // The first generation on the layer grid: shadowed and shaded by the ray hierarchy's
+  // passes, then gathered per pixel; later generations continue from each pixel's nearest
+  // layer on the pixel grid, exactly as ray-hierarchy's.
+  auto shadows = g.add("shadow_rays", trace::ConeShadowRaysPass{scene, traverse}, rays, layer_hits, hits);
+  auto layers = g.add("shade_hits", trace::ShadeHitsPass{scene, 0, 0, 1, bounces == 1}, rays, layer_hits, shadows,
+                      par::Resource<ImageRGBA>{});
+  par::Resource<ImageRGBA> specular =
+      g.add("cone_gather", trace::ConeGatherPass{scene, f.param("fill") != 0.0}, cones, hits, layers);
+  if (bounces > 1) {
+    rays = g.add("bounce_rays_2", trace::ConeBounceRaysPass{scene}, rays, layer_hits, hits);
+    for (int b = 2; b <= bounces; ++b) {
+      const std::string suffix = "_" + std::to_string(b);
       auto hierarchy_b = g.add("ray_hierarchy" + suffix, trace::RayHierarchyPass{0, 0, b}, rays);
-      layer_hits = g.add("hierarchy_traverse" + suffix, trace::HierarchyTraversePass{scene, traverse}, rays,
-                         hierarchy_b);
+      auto hits_b = g.add("hierarchy_traverse" + suffix, trace::HierarchyTraversePass{scene, traverse}, rays,
+                          hierarchy_b);
+      auto shadows_b = g.add("shadow_rays" + suffix, trace::ShadowRaysPass{scene, traverse, 0, 0}, rays, hits_b);
+      specular = g.add("shade_hits" + suffix, trace::ShadeHitsPass{scene, 0, 0, b, b == bounces}, rays, hits_b,
+                       shadows_b, specular);
+      if (b < bounces)
+        rays = g.add("bounce_rays_" + std::to_string(b + 1), trace::BounceRaysPass{scene, b + 1}, rays, hits_b);
     }
-    auto shadows = g.add("shadow_rays" + suffix, trace::ShadowRaysPass{scene, traverse, 0, 0}, rays, layer_hits);
-    layers = g.add("shade_hits" + suffix, trace::ShadeHitsPass{scene, 0, 0, b, b == bounces}, rays, layer_hits,
-                   shadows, layers);
-    if (b < bounces)
-      rays = g.add("bounce_rays_" + std::to_string(b + 1), trace::BounceRaysPass{scene, b + 1}, rays, layer_hits);
   }
-  auto specular = g.add("cone_gather", trace::ConeGatherPass{scene}, cones, hits, layers);
   return add_output_passes(g, f, s.direct, specular);
 }
 

@@ -168,6 +168,8 @@ const std::vector<Technique>& techniques() {
         {"lobe_energy", 0.9, 0.5, 0.999, false, "fraction of a material's Phong lobe its glossy cone holds"},
         {"far_blur", 0.5, 0, 100, false,
          "far plane where the glossy blur reaches this fraction of the scene radius (0: none)"},
+        {"fill", 1, 0, 1, true,
+         "1: the dropped hits' coverage filled in the kept hits' mean colour before the environment; 0: environment only"},
         {"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
         {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
        double(1 << 20)},  // 1024² pixels × kept 64 × ~24 bytes: ~1.6 GB of kept hits at the limit
