@@ -25,7 +25,7 @@ namespace speculum::trace {
 struct PixelConeOptions {
   float footprint = 1.0f;     // scale of the primary (pixel) cone; 0: no anti-aliasing
   float gloss_angle = -1.0f;  // θ_g for every reflecting pixel (rad); < 0: from the material
-  float lobe_energy = 0.9f;   // the glossy cone holds this fraction of the Phong lobe
+  float lobe_energy = 0.5f;   // the glossy cone holds this fraction of the Phong lobe
   float far_blur = 0.5f;      // far plane where θ_g blurs by this fraction of the scene
                               // radius; 0: no far plane
   float scene_radius = 1.0f;

@@ -165,7 +165,7 @@ const std::vector<Technique>& techniques() {
         {"footprint", 1, 0, 16, false, "pixel cone scale (1: the pixel's solid angle; 0: no anti-aliasing)"},
         {"gloss_angle", -1, -1, 0.5, false,
          "glossy cone half-angle for every reflecting pixel (rad); -1: from each material's lobe"},
-        {"lobe_energy", 0.9, 0.5, 0.999, false, "fraction of a material's Phong lobe its glossy cone holds"},
+        {"lobe_energy", 0.5, 0.1, 0.999, false, "fraction of a material's Phong lobe its glossy cone holds"},
         {"far_blur", 0.5, 0, 100, false,
          "far plane where the glossy blur reaches this fraction of the scene radius (0: none)"},
         {"fill", 1, 0, 1, true,
