@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <vector>
 #include <string>
 
 #include "apps/techniques/render_frame.h"
@@ -179,6 +181,32 @@ TEST(ConeTracing, GlossyConeIsCloserToTheConvergedGlossyReferenceThanTheLobeAxis
   const double cone = glossy_plane_specular_mae8("");
   std::printf("glossy-plane specular mae8: lobe axis %.3f, glossy cone %.3f\n", axis, cone);
   EXPECT_LT(cone, axis - 0.3);
+}
+
+TEST(ConeTracing, ExperimentRowsAndTheirTrends) {
+  // ROGER §5.3: wider gloss cones and finer scenes meet more triangles per pixel.
+  const auto dir = scratch_dir();
+  const auto r = run_speculum("-q experiment cone-tracing --quick --json", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::map<std::string, std::vector<nlohmann::json>> rows;
+  std::size_t start = 0;
+  while (start < r.out.size()) {
+    const std::size_t end = r.out.find('\n', start);
+    const std::string line = r.out.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    start = end == std::string::npos ? r.out.size() : end + 1;
+    if (line.empty()) continue;
+    const nlohmann::json row = nlohmann::json::parse(line);
+    for (const char* key : {"kind", "scene", "ms_cone", "ms_ray", "kept_median", "mae8"})
+      EXPECT_TRUE(row.contains(key)) << key << " in " << line;
+    rows[row.at("kind").get<std::string>()].push_back(row);
+  }
+  ASSERT_EQ(rows["cost"].size(), 1u);
+  ASSERT_EQ(rows["gloss"].size(), 3u);
+  ASSERT_EQ(rows["triangles"].size(), 2u);
+  ASSERT_EQ(rows["aa"].size(), 1u);
+  for (std::size_t i = 1; i < rows["gloss"].size(); ++i)
+    EXPECT_GT(rows["gloss"][i]["found_median"].get<double>(), rows["gloss"][i - 1]["found_median"].get<double>());
+  EXPECT_GT(rows["triangles"][1]["found_median"].get<double>(), rows["triangles"][0]["found_median"].get<double>());
 }
 
 }  // namespace
