@@ -50,8 +50,9 @@ TEST(PixelCones, FlatMirrorKeepsThePixelAngleConvexWidensConcaveFallsBack) {
   EXPECT_EQ(flat.self[0], 7u);
   EXPECT_GT(flat.near[0], 0.0f);
 
-  const PixelCones convex = OnePixel(0.5f, 0.0f, 0.0f).cones();
-  EXPECT_NEAR(convex.angle[0], beta + 2.0f * 0.5f * w, 1e-5f);
+  const PixelCones convex = OnePixel(0.1f, 0.0f, 0.0f).cones();
+  EXPECT_NEAR(convex.angle[0], beta + 2.0f * 0.1f * w, 1e-5f);
+  EXPECT_EQ(convex.horizon_clamped, 0u);
 
   // cos θ_i = cos 45°: the in-plane angle β + 2κw / cos θ_i < 0 for κ < −β cos θ_i / (2w).
   const float kappa = -1.1f * beta * std::sqrt(0.5f) / (2.0f * w);
