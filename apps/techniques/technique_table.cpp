@@ -159,8 +159,6 @@ const std::vector<Technique>& techniques() {
        "the pixel's mean curvature, plus the glossy angle) through the ray hierarchy with cone "
        "leaves; exact triangle ∩ cone coverage, the n nearest blended front to back; --bounces B",
        add_cone_tracing_passes,
-       // Every kept hit costs ~24 bytes per pixel and becomes a layer ray of the shading
-       // generations: kept × pixels is what the limits below bound.
        {{"kept", 20, 1, 64, true, "nearest triangles blended per pixel (ROGER: n <= 20; more are counted as overflow)"},
         {"footprint", 1, 0, 16, false, "pixel cone scale (1: the pixel's solid angle; 0: no anti-aliasing)"},
         {"gloss_angle", -1, -1, 0.5, false,
@@ -172,7 +170,9 @@ const std::vector<Technique>& techniques() {
          "1: the dropped hits' coverage filled in the kept hits' mean colour before the environment; 0: environment only"},
         {"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
         {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
-       double(1 << 20)},  // 1024² pixels × kept 64 × ~24 bytes: ~1.6 GB of kept hits at the limit
+       // Each pixel has `kept` slots of kept hits (24 bytes) and of the layer generation
+       // shaded from them (~80 bytes with its hits, shadows and image): 512² × 64 slots ≈ 1.7 GB.
+       double(1 << 18)},
       {"vertex-projection",
        "ROGER ch.2 vertex projection: each scene vertex moved to its Fermat reflection point on "
        "each star-shaped mirror (2-D secant iteration), triangles rasterized between them; "
