@@ -58,6 +58,7 @@ struct Traversal {
   std::size_t capacity, block_size;
   HierarchyTraverseStats& stats;
   HitStream& best;  // merged over batches
+  const CandidateConsumer* consume = nullptr;  // cone leaves: the pairs go here, not to the ray tests
 
   // Scratch reused across levels and batches.
   std::vector<std::uint32_t> node, tri, next_node, next_tri, kept, scratch;
@@ -82,7 +83,10 @@ struct Traversal {
     }
     level_pairs[h.levels] = node.size();
     const std::size_t m = node.size();
-    exact_tests_and_merge();
+    if (consume)
+      (*consume)(std::span<const std::uint32_t>(node), std::span<const std::uint32_t>(tri));
+    else
+      exact_tests_and_merge();
 
     if (stats.pairs_per_level.size() < level_pairs.size()) stats.pairs_per_level.resize(level_pairs.size(), 0);
     for (std::size_t l = 0; l < level_pairs.size(); ++l) stats.pairs_per_level[l] += level_pairs[l];
@@ -131,7 +135,8 @@ struct Traversal {
         for (int j = 0; j < 4; ++j) {
           const std::size_t c = (2 * y + std::size_t(j >> 1)) * row + 2 * x + std::size_t(j & 1);
           keep[4 * k + j] = !child[c].empty() && cone_sphere_intersects(child[c], sn[c], cs[c], s) &&
-                            (!leaves || ray_can_reach_plane(c, tri[k]));
+                            (!leaves || child[c].r != 0.0f || child[c].alpha != 0.0f ||
+                             ray_can_reach_plane(c, tri[k]));
         }
       }
     });
@@ -228,16 +233,13 @@ std::vector<BoundingSphere> triangle_bounding_spheres(par::Executor& ex, const s
   return s;
 }
 
-void hierarchy_closest_hits(par::Executor& ex, const std::vector<glm::vec3>& positions,
-                            const std::vector<std::uint32_t>& indices, const RayHierarchy& hierarchy,
-                            const RayStream& rays, HitStream& hits, const HierarchyTraverseOptions& options,
-                            HierarchyTraverseStats* stats_out) {
+namespace {
+
+void traverse(par::Executor& ex, const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
+              const RayHierarchy& hierarchy, const RayStream& rays, HitStream& hits,
+              const HierarchyTraverseOptions& options, HierarchyTraverseStats* stats_out,
+              const CandidateConsumer* consume) {
   HierarchyTraverseStats stats;
-  hits.resize(rays.size());
-  std::fill(hits.t.begin(), hits.t.end(), kInf);
-  std::fill(hits.u.begin(), hits.u.end(), 0.0f);
-  std::fill(hits.v.begin(), hits.v.end(), 0.0f);
-  std::fill(hits.triangle.begin(), hits.triangle.end(), kNoHit);
   for (const ConeSphere& leaf : hierarchy.nodes[hierarchy.levels]) stats.active_rays += !leaf.empty();
   const auto t_spheres = std::chrono::steady_clock::now();
   const std::vector<BoundingSphere> spheres = triangle_bounding_spheres(ex, positions, indices);
@@ -246,11 +248,33 @@ void hierarchy_closest_hits(par::Executor& ex, const std::vector<glm::vec3>& pos
   const std::size_t side = std::size_t(hierarchy.side);
   const std::size_t capacity = std::max(options.pair_capacity, 4 * side * side);
   Traversal tr{ex, positions, indices, hierarchy, rays, spheres, planes, capacity, std::max<std::size_t>(1, options.block_size),
-               stats, hits, {}, {}, {}, {}, {}, {}, {}};
+               stats, hits, consume, {}, {}, {}, {}, {}, {}, {}};
   tr.run(0, std::uint32_t(indices.size() / 3));
   for (std::size_t i = 0; i < hits.triangle.size(); ++i) stats.hits += hits.triangle[i] != kNoHit;
   if (stats.pairs_per_level.empty()) stats.pairs_per_level.assign(hierarchy.levels + 1, 0);
   if (stats_out) *stats_out = stats;
+}
+
+}  // namespace
+
+void hierarchy_closest_hits(par::Executor& ex, const std::vector<glm::vec3>& positions,
+                            const std::vector<std::uint32_t>& indices, const RayHierarchy& hierarchy,
+                            const RayStream& rays, HitStream& hits, const HierarchyTraverseOptions& options,
+                            HierarchyTraverseStats* stats_out) {
+  hits.resize(rays.size());
+  std::fill(hits.t.begin(), hits.t.end(), kInf);
+  std::fill(hits.u.begin(), hits.u.end(), 0.0f);
+  std::fill(hits.v.begin(), hits.v.end(), 0.0f);
+  std::fill(hits.triangle.begin(), hits.triangle.end(), kNoHit);
+  traverse(ex, positions, indices, hierarchy, rays, hits, options, stats_out, nullptr);
+}
+
+void hierarchy_candidates(par::Executor& ex, const std::vector<glm::vec3>& positions,
+                          const std::vector<std::uint32_t>& indices, const RayHierarchy& hierarchy,
+                          const RayStream& rays, const CandidateConsumer& consume,
+                          const HierarchyTraverseOptions& options, HierarchyTraverseStats* stats) {
+  HitStream none;
+  traverse(ex, positions, indices, hierarchy, rays, none, options, stats, &consume);
 }
 
 }  // namespace speculum::trace

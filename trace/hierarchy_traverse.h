@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -51,6 +53,19 @@ void hierarchy_closest_hits(par::Executor& executor, const std::vector<glm::vec3
                             const RayStream& rays, HitStream& hits,
                             const HierarchyTraverseOptions& options = {},
                             HierarchyTraverseStats* stats = nullptr);
+
+// The same descent, handing every batch's surviving (leaf, triangle) pairs to `consume`
+// instead of testing them as rays: leaf[k] is the hierarchy leaf index y·side + x, triangle[k]
+// its triangle; within a batch pairs come in ascending triangle order, and batches cover
+// ascending triangle ranges. The leaf's plane test (a ray moving away from a triangle's
+// plane cannot hit it) applies only to leaves that are rays (r = 0, α = 0). What cone
+// tracing (ROGER §5.2.1) intersects with its cone leaves.
+using CandidateConsumer =
+    std::function<void(std::span<const std::uint32_t> leaf, std::span<const std::uint32_t> triangle)>;
+void hierarchy_candidates(par::Executor& executor, const std::vector<glm::vec3>& positions,
+                          const std::vector<std::uint32_t>& indices, const RayHierarchy& hierarchy,
+                          const RayStream& rays, const CandidateConsumer& consume,
+                          const HierarchyTraverseOptions& options = {}, HierarchyTraverseStats* stats = nullptr);
 
 // The bounding sphere of every triangle (kernel "hierarchy_spheres").
 std::vector<BoundingSphere> triangle_bounding_spheres(par::Executor& executor,

@@ -63,7 +63,8 @@ int hierarchy_side(int width, int height) {
 }
 
 RayHierarchy build_ray_hierarchy(par::Executor& ex, const RayStream& rays, const std::vector<std::uint8_t>& active,
-                                 int width, int height) {
+                                 int width, int height, const std::vector<float>* leaf_radius,
+                                 const std::vector<float>* leaf_alpha) {
   RayHierarchy h;
   h.width = width;
   h.height = height;
@@ -88,9 +89,9 @@ RayHierarchy build_ray_hierarchy(par::Executor& ex, const RayStream& rays, const
       if (!finite3(o.x, o.y, o.z) || !finite3(d.x, d.y, d.z) || !(l > 0.0f) || rays.tmin[i] > rays.tmax[i])
         continue;
       leaves[k].c = o;
-      leaves[k].r = 0.0f;
+      leaves[k].r = leaf_radius ? std::max((*leaf_radius)[i], 0.0f) : 0.0f;
       leaves[k].d = d / l;
-      leaves[k].alpha = 0.0f;
+      leaves[k].alpha = leaf_alpha ? std::clamp((*leaf_alpha)[i], 0.0f, kPi) : 0.0f;
     }
   });
   for (int l = h.levels - 1; l >= 0; --l) {

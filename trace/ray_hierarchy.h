@@ -92,7 +92,14 @@ int hierarchy_side(int width, int height);
 // invalid values are empty leaves). Kernels "ray_hierarchy_leaves" then one
 // "ray_hierarchy_level_<l>" per level, bottom-up. Width and height need not be powers of
 // two: the grid is padded with empty leaves to side × side.
+// Cone leaves (ROGER §5.2.1: "leaves are cones"): with `leaf_radius` and `leaf_alpha`
+// (one value per ray, >= 0) leaf i is the sphere (origin, leaf_radius[i]) swept by the cone
+// of half-angle leaf_alpha[i] about the ray's direction, which bounds a cone of that
+// half-angle whose cross-section at the origin has that radius; the levels above are built
+// the same way. Without them every leaf is a ray (r = 0, α = 0).
 RayHierarchy build_ray_hierarchy(par::Executor& executor, const RayStream& rays,
-                                 const std::vector<std::uint8_t>& active, int width, int height);
+                                 const std::vector<std::uint8_t>& active, int width, int height,
+                                 const std::vector<float>* leaf_radius = nullptr,
+                                 const std::vector<float>* leaf_alpha = nullptr);
 
 }  // namespace speculum::trace

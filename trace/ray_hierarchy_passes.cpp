@@ -30,7 +30,8 @@ void count_traversal(par::NodeContext& c, const HierarchyTraverseStats& s) {
 }  // namespace
 
 RayHierarchy RayHierarchyPass::operator()(par::NodeContext& c, const SecondaryRays& rays) const {
-  RayHierarchy h = build_ray_hierarchy(c.executor(), rays.rays, rays.active, width, height);
+  RayHierarchy h = build_ray_hierarchy(c.executor(), rays.rays, rays.active, width ? width : rays.width,
+                                       width ? height : rays.height);
   c.count("levels", h.levels);
   c.count("leaves", double(h.side) * double(h.side));
   return h;
@@ -51,7 +52,8 @@ ShadowHits ShadowRaysPass::operator()(par::NodeContext& c, const SecondaryRays& 
   ShadowHits out(scene->lights.size(), HitStream{});
   for (std::size_t l = 0; l < scene->lights.size(); ++l) {
     const SecondaryRays sr = shadow_rays(c.executor(), *scene, scene->lights[l], rays, hits);
-    const RayHierarchy hi = build_ray_hierarchy(c.executor(), sr.rays, sr.active, width, height);
+    const RayHierarchy hi = build_ray_hierarchy(c.executor(), sr.rays, sr.active, width ? width : rays.width,
+                                                width ? height : rays.height);
     HierarchyTraverseStats st;
     hierarchy_closest_hits(c.executor(), scene->mesh.positions, scene->mesh.indices, hi, sr.rays,
                            out[l], options, &st);
@@ -66,7 +68,9 @@ ShadowHits ShadowRaysPass::operator()(par::NodeContext& c, const SecondaryRays& 
 ImageRGBA ShadeHitsPass::operator()(par::NodeContext& c, const SecondaryRays& rays,
                                     const HitStream& hits, const ShadowHits& shadows,
                                     const ImageRGBA* earlier_bounces) const {
-  ImageRGBA specular = earlier_bounces ? *earlier_bounces : ImageRGBA(width, height, glm::vec4(0.0f));
+  ImageRGBA specular = earlier_bounces ? *earlier_bounces
+                                       : ImageRGBA(width ? width : rays.width, width ? height : rays.height,
+                                                   glm::vec4(0.0f));
   shade_hits(c.executor(), *scene, rays, hits, shadows, specular);
   // Hits that would reflect or refract again are shaded as they are (direct light and the
   // ambient term) and their specular continuation reads the environment instead of being

@@ -22,7 +22,7 @@ using ShadowHits = std::vector<HitStream>;  // per scene light
 struct RayHierarchyPass {
   static constexpr const char* description =
       "Screen-space quad-tree of cone-spheres built bottom-up, one kernel per level (ROGER §3.3.2).";
-  int width = 0, height = 0;  // the generation's pixel grid
+  int width = 0, height = 0;  // the generation's pixel grid (0: the generation's own size)
   int bounce = 1;
   void parameters(par::Params& p) const { p.set("bounce", bounce); }
   RayHierarchy operator()(par::NodeContext& c, const SecondaryRays& rays) const;
@@ -50,7 +50,7 @@ struct ShadowRaysPass {
       "(ROGER §3.3.5).";
   const Scene* scene = nullptr;
   HierarchyTraverseOptions options;
-  int width = 0, height = 0;
+  int width = 0, height = 0;  // 0: the generation's own size
   ShadowHits operator()(par::NodeContext& c, const SecondaryRays& rays, const HitStream& hits) const;
 };
 
@@ -61,7 +61,7 @@ struct ShadeHitsPass {
       "The hits shaded with the shared model (environment on a miss), weighted and added to the "
       "specular layer (ROGER §3.3.5).";
   const Scene* scene = nullptr;
-  int width = 0, height = 0;
+  int width = 0, height = 0;  // 0: the generation's own size
   int bounce = 1;
   bool last = false;  // the last generation: specular hits end here (counted)
   void parameters(par::Params& p) const { p.set("bounce", bounce); }

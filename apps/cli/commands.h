@@ -41,6 +41,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global);
 void add_experiment_yu_fig9_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_survey_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_ray_hierarchy_subcommand(CLI::App& experiment, GlobalOptions& global);
+void add_experiment_cone_tracing_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_vertex_projection_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global);
 void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& global);

@@ -14,6 +14,7 @@ void add_experiment_command(CLI::App& app, GlobalOptions& global) {
   // One line per experiment (apps/cmd_experiment_*.cpp):
   add_experiment_survey_subcommand(*cmd, global);
   add_experiment_ray_hierarchy_subcommand(*cmd, global);
+  add_experiment_cone_tracing_subcommand(*cmd, global);
   add_experiment_yu_fig9_subcommand(*cmd, global);
   add_experiment_vertex_projection_subcommand(*cmd, global);
   add_experiment_soff_subcommand(*cmd, global);

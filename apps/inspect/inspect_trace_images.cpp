@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "raster/layered_distance_map.h"
+#include "trace/cone_tracing.h"
 #include "trace/glossy_rays.h"
 #include "trace/lod_trace.h"
 #include "trace/ray_hierarchy.h"
@@ -258,6 +259,55 @@ void draw_layered_map(Drawing& d, const raster::LayeredDistanceMap& m, par::Exec
   d.drawable = !d.views.empty();
 }
 
+void draw_pixel_cones(Drawing& d, const trace::PixelCones& c) {
+  const int w = c.axes.width, h = c.axes.height;
+  const std::size_t n = std::size_t(w) * std::size_t(h);
+  if (c.angle.size() != n || c.radius.size() != n || c.axes.active.size() != n) {
+    d.drawable = false;
+    return;
+  }
+  d.size = dims(w, h) + ", " + std::to_string(c.cones) + " cones, " + std::to_string(c.axes.count - c.cones) +
+           " rays";
+  const IdBuffer mask = mask_of(w, h, c.axes.active);
+  ImageF angle(w, h, 0.0f), radius(w, h, 0.0f);
+  for (std::size_t i = 0; i < n; ++i) angle.pixels[i] = c.angle[i], radius.pixels[i] = c.radius[i];
+  View a = scalar_view("angle", angle, &mask);
+  a.encoding = "leaf cone half-angle (rad: reflected pixel cone + glossy angle), " + a.encoding +
+               "; 0: traced as a ray";
+  View r = scalar_view("radius", radius, &mask);
+  r.encoding = "cone radius at its origin (world units), " + r.encoding;
+  d.views.push_back(std::move(a));
+  d.views.push_back(std::move(r));
+}
+
+void draw_cone_hits(Drawing& d, const trace::ConeHits& hits) {
+  const int w = hits.width, h = hits.height;
+  const std::size_t n = std::size_t(w) * std::size_t(h), K = std::size_t(std::max(hits.kept, 1));
+  if (hits.count.size() != n || hits.coverage.size() != n * K) {
+    d.drawable = false;
+    return;
+  }
+  d.size = dims(w, h) + ", up to " + std::to_string(hits.kept) + " kept, " + std::to_string(hits.overflow) +
+           " dropped";
+  ImageF kept(w, h, 0.0f), coverage(w, h, 0.0f), found(w, h, 0.0f);
+  for (std::size_t p = 0; p < n; ++p) {
+    kept.pixels[p] = float(hits.count[p]);
+    found.pixels[p] = float(hits.total[p]);
+    float acc = 0.0f;  // the saturate blend's accumulated coverage
+    for (std::uint32_t j = 0; j < hits.count[p]; ++j) acc += std::min(hits.coverage[p * K + j], 1.0f - acc);
+    coverage.pixels[p] = acc;
+  }
+  View k = scalar_view("kept", kept);
+  k.encoding = "hits kept per pixel (the n nearest), " + k.encoding;
+  View f = scalar_view("found", found);
+  f.encoding = "hits found per pixel (beyond kept: dropped), " + f.encoding;
+  View c = scalar_view("coverage", coverage);
+  c.encoding = "coverage the kept hits blend to (saturate; 1: the cone is covered), " + c.encoding;
+  d.views.push_back(std::move(k));
+  d.views.push_back(std::move(f));
+  d.views.push_back(std::move(c));
+}
+
 }  // namespace
 
 void forget_ray_grids() {
@@ -275,6 +325,10 @@ bool draw_trace_output(const par::CapturedOutput& o, par::Executor& executor, Dr
     draw_hits(d, *hits);
   } else if (const auto* shadow = o.as<std::vector<trace::HitStream>>()) {
     draw_shadow_hits(d, *shadow);
+  } else if (const auto* cones = o.as<trace::PixelCones>()) {
+    draw_pixel_cones(d, *cones);
+  } else if (const auto* cone_hits = o.as<trace::ConeHits>()) {
+    draw_cone_hits(d, *cone_hits);
   } else if (const auto* glossy = o.as<trace::GlossyRays>()) {
     draw_glossy_rays(d, *glossy);
   } else if (const auto* lod = o.as<std::vector<trace::LodHit>>()) {

@@ -3,6 +3,8 @@
 #pragma once
 
 #include "raster/gbuffer.h"
+#include "raster/visibility.h"
+#include "trace/cone_tracing.h"
 #include "trace/glossy_rays.h"
 #include "trace/secondary_rays.h"
 
@@ -36,6 +38,31 @@ struct SecondaryRaysPass {
                                                       gbuffer.surface, gbuffer.object, eye);
     c.count("rays", rays.count);
     return rays;
+  }
+};
+
+// Pass "pixel_cones": one cone per specular pixel (ROGER §5.2.2).
+struct PixelConesPass {
+  static constexpr const char* description =
+      "One cone per specular pixel: the pixel's footprint reflected off a sphere of the pixel's "
+      "mean curvature plus the material's glossy angle; double cones and refraction traced as "
+      "rays (ROGER §5.2.2).";
+  Camera camera;
+  trace::PixelConeOptions options;
+  void parameters(par::Params& p) const {
+    p.set("footprint", options.footprint).set("gloss_angle", options.gloss_angle)
+        .set("lobe_energy", options.lobe_energy).set("far_blur", options.far_blur);
+  }
+  trace::PixelCones operator()(par::NodeContext& c, const raster::GBuffer& gbuffer,
+                               const raster::VisibilityBuffer& visibility, const ImageF& curvature) const {
+    trace::PixelCones cones = trace::pixel_cones(c.executor(), gbuffer.position, gbuffer.normal, gbuffer.surface,
+                                                 gbuffer.object, visibility.triangle, curvature, camera, options);
+    c.count("rays", cones.axes.count);
+    c.count("cones", cones.cones);
+    c.count("fallback_double_cone", cones.ray_fallbacks);
+    c.count("refraction_rays", cones.refraction_rays);
+    c.count("horizon_clamped", cones.horizon_clamped);
+    return cones;
   }
 };
 

@@ -51,6 +51,10 @@ FrameOutputs add_yu_lod_passes_cached(par::Graph& graph, const Scene* scene,
 // ray-hierarchy (ROGER §3.3): secondary_rays, then per bounce b: ray_hierarchy →
 // hierarchy_traverse → shadow_rays → shade_hits (→ bounce_rays).
 FrameOutputs add_ray_hierarchy_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
+// cone-tracing (ROGER ch.5): pixel_curvature → pixel_cones → cone_hierarchy →
+// cone_triangle_coverage → cone_blend / cone_layer_hits, the layers shadowed, shaded and
+// bounced by the ray hierarchy's passes, then cone_gather.
+FrameOutputs add_cone_tracing_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 
 // The distance-map search of the parallax, linear, secant (0/1) and *_steps parameters.
 raster::DistanceSearchOptions distance_search_options(const FrameSettings& settings);

@@ -157,6 +157,25 @@ const std::vector<Technique>& techniques() {
        {{"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
         {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
        double(1 << 22)},  // ~770 bytes per pixel of ray streams and hierarchy: ~3.3 GB at the limit
+      {"cone-tracing",
+       "ROGER ch.5 cone tracing: one cone per specular pixel (footprint reflected off a sphere of "
+       "the pixel's mean curvature, plus the glossy angle) through the ray hierarchy with cone "
+       "leaves; exact triangle ∩ cone coverage, the n nearest blended front to back; --bounces B",
+       add_cone_tracing_passes,
+       {{"kept", 20, 1, 64, true, "nearest triangles blended per pixel (ROGER: n <= 20; more are counted as overflow)"},
+        {"footprint", 1, 0, 16, false, "pixel cone scale (1: the pixel's solid angle; 0: no anti-aliasing)"},
+        {"gloss_angle", -1, -1, 0.5, false,
+         "glossy cone half-angle for every reflecting pixel (rad); -1: from each material's lobe"},
+        {"lobe_energy", 0.5, 0.1, 0.999, false, "fraction of a material's Phong lobe its glossy cone holds"},
+        {"far_blur", 0.5, 0, 100, false,
+         "far plane where the glossy blur reaches this fraction of the scene radius (0: none)"},
+        {"fill", 1, 0, 1, true,
+         "1: the dropped hits' coverage filled in the kept hits' mean colour before the environment; 0: environment only"},
+        {"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
+        {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
+       // Each pixel has `kept` slots of kept hits (24 bytes) and of the layer generation
+       // shaded from them (~80 bytes with its hits, shadows and image): 512² × 64 slots ≈ 1.7 GB.
+       double(1 << 18)},
       {"vertex-projection",
        "ROGER ch.2 vertex projection: each scene vertex moved to its Fermat reflection point on "
        "each star-shaped mirror (2-D secant iteration), triangles rasterized between them; "

@@ -66,6 +66,24 @@ TEST(FallbackCounters, RayHierarchyDepthExhaustedIsTheNextGeneration) {
   }
 }
 
+// Cone tracing: a concave mirror bowl seen from beyond its focus reflects converging cones
+// (double cones), traced as rays and counted; a convex mirror never does. At footprint 1 every
+// specular pixel is a cone, a double-cone fallback or a refracted ray; hits beyond `kept` are
+// counted.
+TEST(FallbackCounters, ConeTracingDoubleConesOnTheBowlOnly) {
+  const Scene bowl = load_scene("bowl:size=3000"), room = load_scene("sphere-in-room:size=3000");
+  const FrameResult b = render(bowl, "cone-tracing", "", 0), r = render(room, "cone-tracing", "", 0);
+  EXPECT_GT(counter(b, "pixel_cones", "fallback_double_cone"), 100.0);
+  EXPECT_EQ(counter(r, "pixel_cones", "fallback_double_cone"), 0.0);
+  for (const FrameResult* f : {&b, &r})
+    EXPECT_EQ(counter(*f, "pixel_cones", "rays"),
+              counter(*f, "pixel_cones", "cones") + counter(*f, "pixel_cones", "fallback_double_cone") +
+                  counter(*f, "pixel_cones", "refraction_rays"));
+  const FrameResult few = render(room, "cone-tracing", "kept", 1);
+  EXPECT_GT(counter(few, "cone_triangle_coverage", "kept_overflow"), 0.0);
+  EXPECT_EQ(counter(few, "cone_triangle_coverage", "max_kept"), 1.0);
+}
+
 // Layered distance map: each specular hit past the last bounce is one more search at the
 // next bounce count.
 TEST(FallbackCounters, LayeredDepthExhaustedIsTheNextBouncesSearches) {

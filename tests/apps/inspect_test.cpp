@@ -81,6 +81,8 @@ void expect_complete_manifest(const fs::path& dir, const std::string& technique)
 // and every PNG loads with the output's content.
 const std::map<std::string, std::vector<std::string>> kTraceOutputs = {
     {"ray-hierarchy", {"secondary_rays", "ray_hierarchy", "hierarchy_traverse", "shadow_rays"}},
+    // The cone angles, the cone hierarchy, and the kept / found hits and blended coverage.
+    {"cone-tracing", {"pixel_cones", "cone_hierarchy", "cone_triangle_coverage"}},
     {"yu-lod", {"glossy_rays", "lod_trace"}},
     {"layered-distance-map", {"layered_distance_map"}},
     // The parameterization cube, the iteration-count image and the reflected layer.

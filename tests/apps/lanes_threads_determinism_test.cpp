@@ -38,6 +38,10 @@ TEST(LanesThreadsDeterminism, RayHierarchySameBytesForEveryWidthAndThreadCount) 
   expect_same_bytes_for_every_width_and_thread_count("ray-hierarchy");
 }
 
+TEST(LanesThreadsDeterminism, ConeTracingSameBytesForEveryWidthAndThreadCount) {
+  expect_same_bytes_for_every_width_and_thread_count("cone-tracing");
+}
+
 TEST(LanesThreadsDeterminism, SpecularReferenceSameBytesForEveryWidthAndThreadCount) {
   expect_same_bytes_for_every_width_and_thread_count("specular-reference");
 }
