@@ -1,4 +1,4 @@
-// 8-ray packet traversal of the 8-wide BVH (see packet_traversal.h). Culling is
+// 8- and 16-ray packet traversal of the 8-wide BVH (see packet_traversal.h). Culling is
 // conservative by monotonicity: every float operation of the single-ray slab test is
 // monotone in its operands, so the same operations applied to the packet's extreme
 // origins and reciprocals bound every ray's computed entry (from below) and exit (from
@@ -24,11 +24,12 @@ constexpr float kMaxDirectionSpread = 0.05f;  // per component of the normalized
 
 struct Packet {
   int count = 0;
+  int halves = 1;  // 8-lane halves in use: 1 for up to 8 rays, 2 for up to 16
   // Per ray (lanes), for the per-ray leaf box test.
-  alignas(32) float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
-  alignas(32) float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];
-  alignas(32) float tmin[kPacketSize], best_t[kPacketSize];
-  RayShear shear[kPacketSize];
+  alignas(32) float ox[kMaxPacketSize], oy[kMaxPacketSize], oz[kMaxPacketSize];
+  alignas(32) float ix[kMaxPacketSize], iy[kMaxPacketSize], iz[kMaxPacketSize];
+  alignas(32) float tmin[kMaxPacketSize], best_t[kMaxPacketSize];
+  RayShear shear[kMaxPacketSize];
   // Packet bounds for the interval node test.
   __m256 near_o[3], far_o[3], inv_lo[3], inv_hi[3], tmin_lo;
   std::uint32_t near_off[3], far_off[3];  // plane rows of a WideNode picked by the signs
@@ -60,13 +61,14 @@ struct Packet {
 
 // Child k's box against each ray (lanes) with its own best t: the single-ray box test of
 // wide_kernels.h, transposed. Bit r when ray r enters the box.
-[[gnu::always_inline]] inline unsigned rays_box_hits(const WideNode& n, int k, const Packet& p) {
+[[gnu::always_inline]] inline unsigned rays_box_hits_half(const WideNode& n, int k, const Packet& p, int half) {
   const float* rows = n.lo_x;
   auto bcast = [&](std::uint32_t off) {
     return _mm256_set1_ps(*reinterpret_cast<const float*>(reinterpret_cast<const char*>(rows) + off + 4u * k));
   };
-  const __m256 o[3] = {_mm256_load_ps(p.ox), _mm256_load_ps(p.oy), _mm256_load_ps(p.oz)};
-  const __m256 inv[3] = {_mm256_load_ps(p.ix), _mm256_load_ps(p.iy), _mm256_load_ps(p.iz)};
+  const int h = 8 * half;
+  const __m256 o[3] = {_mm256_load_ps(p.ox + h), _mm256_load_ps(p.oy + h), _mm256_load_ps(p.oz + h)};
+  const __m256 inv[3] = {_mm256_load_ps(p.ix + h), _mm256_load_ps(p.iy + h), _mm256_load_ps(p.iz + h)};
   __m256 entry = _mm256_set1_ps(-3.0e38f), exit = _mm256_set1_ps(3.0e38f);
   for (int a = 0; a < 3; ++a) {
     entry = _mm256_max_ps(entry, _mm256_mul_ps(_mm256_sub_ps(bcast(p.near_off[a]), o[a]), inv[a]));
@@ -77,15 +79,21 @@ struct Packet {
   entry = _mm256_min_ps(entry, big);
   exit = _mm256_max_ps(exit, _mm256_sub_ps(_mm256_setzero_ps(), big));
   const __m256 near = _mm256_max_ps(_mm256_sub_ps(entry, _mm256_mul_ps(_mm256_and_ps(entry, abs_mask), eps)),
-                                    _mm256_load_ps(p.tmin));
+                                    _mm256_load_ps(p.tmin + h));
   const __m256 far = _mm256_min_ps(_mm256_add_ps(exit, _mm256_mul_ps(_mm256_and_ps(exit, abs_mask), eps)),
-                                   _mm256_load_ps(p.best_t));
+                                   _mm256_load_ps(p.best_t + h));
   return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ)));
 }
 
-inline float lane_max(const float (&v)[kPacketSize]) {
-  float m = v[0];
-  for (int i = 1; i < kPacketSize; ++i) m = v[i] > m ? v[i] : m;
+[[gnu::always_inline]] inline unsigned rays_box_hits(const WideNode& n, int k, const Packet& p) {
+  unsigned bits = rays_box_hits_half(n, k, p, 0);
+  if (p.halves == 2) bits |= rays_box_hits_half(n, k, p, 1) << 8;
+  return bits;
+}
+
+inline float lane_max(const Packet& p) {
+  float m = p.best_t[0];
+  for (int i = 1; i < 8 * p.halves; ++i) m = p.best_t[i] > m ? p.best_t[i] : m;
   return m;
 }
 
@@ -108,7 +116,8 @@ bool prepare(const Ray* rays, int count, Packet& p) {
     if (dhi[a] - dlo[a] > kMaxDirectionSpread || (dlo[a] < 0.0f) != (dhi[a] < 0.0f)) return false;
   glm::vec3 olo(3.0e38f), ohi(-3.0e38f), ilo(3.0e38f), ihi(-3.0e38f);
   float tmin_lo = 3.0e38f;
-  for (int r = 0; r < kPacketSize; ++r) {
+  p.halves = count > 8 ? 2 : 1;
+  for (int r = 0; r < 8 * p.halves; ++r) {
     const Ray& ray = rays[r < count ? r : 0];
     const glm::vec3 inv = wide::safe_inverse(ray.direction);
     olo = glm::min(olo, ray.origin);
@@ -197,7 +206,7 @@ struct Entry {
 }  // namespace
 
 bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, TraversalCounters* counters) {
-  count = std::clamp(count, 0, kPacketSize);
+  count = std::clamp(count, 0, kMaxPacketSize);
   Packet p;
   if (count < 2 || bvh.wide_root() == kEmptyChild || (bvh.wide_root() & kLeafBit) || !prepare(rays, count, p)) {
     for (int r = 0; r < count; ++r) out[r] = closest_hit(bvh, rays[r], counters);
@@ -205,11 +214,11 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
   }
   TraversalCounters c;
   c.rays = static_cast<std::uint64_t>(count);
-  Hit best[kPacketSize];
+  Hit best[kMaxPacketSize];
   for (int r = 0; r < count; ++r) best[r].t = p.best_t[r];
   const WideNode* nodes = bvh.wide_nodes().data();
   const TrianglePack* packs = bvh.triangle_packs().data();
-  float max_t = lane_max(p.best_t);
+  float max_t = lane_max(p);
   Entry stack[kTraversalStackSize];
   int sp = 0;
   std::uint32_t cur = bvh.wide_root();
@@ -233,7 +242,7 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
       leaves &= leaves - 1;
       if (intersect_leaf(n, k, packs, p, best, c)) improved = true;
     }
-    if (improved) max_t = lane_max(p.best_t);
+    if (improved) max_t = lane_max(p);
     // Inner children: descend into the nearest, push the others far-to-near.
     if (bits) {
       Entry hits[kWideArity];
@@ -267,29 +276,45 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
 }
 
 void closest_hit_stream_packets(const Bvh& bvh, const RayStream& rays, HitStream& hits, par::Executor& ex,
-                                TraversalCounters* counters) {
-  static_assert(kRayChunk % kPacketSize == 0, "packets never straddle chunks");
+                                TraversalCounters* counters, int image_width) {
+  static_assert(kRayChunk % kMaxPacketSize == 0, "packets never straddle chunks");
   const std::size_t n = rays.size();
   hits.resize(n);
-  const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
+  // The packets: slot[kMaxPacketSize * q + l] is the ray of lane l of packet q (or n for an
+  // unused lane). An image's rays go in 4x4 pixel tiles (16 rays that share most of their
+  // node path), row-major tiles; other streams in runs of kPacketSize consecutive rays.
+  const bool tiles = image_width > 0 && n % static_cast<std::size_t>(image_width) == 0;
+  const std::size_t w = tiles ? static_cast<std::size_t>(image_width) : 0, h = tiles ? n / w : 0;
+  const std::size_t tiles_x = (w + 3) / 4, tiles_y = (h + 3) / 4;
+  const std::size_t packets = tiles ? tiles_x * tiles_y : (n + kPacketSize - 1) / kPacketSize;
+  const std::size_t per_chunk_packets = kRayChunk / (tiles ? kMaxPacketSize : kPacketSize);
+  const std::size_t chunks = (packets + per_chunk_packets - 1) / per_chunk_packets;
   std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
-  ex.parallel_for("trace_closest_packets", n, kRayChunk, [&](std::size_t b, std::size_t e) {
+  ex.parallel_for("trace_closest_packets", packets, per_chunk_packets, [&](std::size_t b, std::size_t e) {
     TraversalCounters c;
-    for (std::size_t i = b; i < e; i += kPacketSize) {
-      const int count = static_cast<int>(std::min<std::size_t>(kPacketSize, e - i));
-      Ray r[kPacketSize];
-      Hit h[kPacketSize];
-      for (int k = 0; k < count; ++k) r[k] = rays.get(i + static_cast<std::size_t>(k));
-      closest_hit_packet(bvh, r, count, h, &c);
+    for (std::size_t q = b; q < e; ++q) {
+      std::size_t slot[kMaxPacketSize];
+      int count = 0;
+      if (tiles) {
+        const std::size_t x0 = (q % tiles_x) * 4, y0 = (q / tiles_x) * 4;
+        for (std::size_t y = y0; y < std::min(y0 + 4, h); ++y)
+          for (std::size_t x = x0; x < std::min(x0 + 4, w); ++x) slot[count++] = y * w + x;
+      } else {
+        for (std::size_t i = q * kPacketSize; i < std::min(n, (q + 1) * kPacketSize); ++i) slot[count++] = i;
+      }
+      Ray r[kMaxPacketSize];
+      Hit hh[kMaxPacketSize];
+      for (int k = 0; k < count; ++k) r[k] = rays.get(slot[k]);
+      closest_hit_packet(bvh, r, count, hh, &c);
       for (int k = 0; k < count; ++k) {
-        const std::size_t j = i + static_cast<std::size_t>(k);
-        hits.t[j] = h[k].t;
-        hits.u[j] = h[k].u;
-        hits.v[j] = h[k].v;
-        hits.triangle[j] = h[k].triangle;
+        const std::size_t j = slot[k];
+        hits.t[j] = hh[k].t;
+        hits.u[j] = hh[k].u;
+        hits.v[j] = hh[k].v;
+        hits.triangle[j] = hh[k].triangle;
       }
     }
-    if (counters) per_chunk[b / kRayChunk] = c;
+    if (counters) per_chunk[b / per_chunk_packets] = c;
   });
   if (counters)
     for (const auto& c : per_chunk) counters->add(c);
