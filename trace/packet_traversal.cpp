@@ -30,6 +30,12 @@ struct Packet {
   alignas(32) float ix[kMaxPacketSize], iy[kMaxPacketSize], iz[kMaxPacketSize];
   alignas(32) float tmin[kMaxPacketSize], best_t[kMaxPacketSize];
   RayShear shear[kMaxPacketSize];
+  // When every ray has the same watertight axis permutation (kx, ky, kz), the leaf test
+  // runs across the rays, one triangle at a time: the shear in lanes.
+  bool common_shear = false;
+  int kx = 0, ky = 1, kz = 2;
+  alignas(32) float okx[kMaxPacketSize], oky[kMaxPacketSize], okz[kMaxPacketSize];
+  alignas(32) float sx[kMaxPacketSize], sy[kMaxPacketSize], sz[kMaxPacketSize];
   // Packet bounds for the interval node test.
   __m256 near_o[3], far_o[3], inv_lo[3], inv_hi[3], tmin_lo;
   std::uint32_t near_off[3], far_off[3];  // plane rows of a WideNode picked by the signs
@@ -131,7 +137,14 @@ bool prepare(const Ray* rays, int count, Packet& p) {
     // Lanes past count copy ray 0 but can never be entered (best t below everything).
     p.best_t[r] = r < count ? ray.tmax : -3.0e38f;
     p.shear[r] = RayShear(ray.origin, ray.direction);
+    const RayShear& sh = p.shear[r];
+    p.okx[r] = sh.origin[sh.kx]; p.oky[r] = sh.origin[sh.ky]; p.okz[r] = sh.origin[sh.kz];
+    p.sx[r] = sh.sx; p.sy[r] = sh.sy; p.sz[r] = sh.sz;
   }
+  p.kx = p.shear[0].kx; p.ky = p.shear[0].ky; p.kz = p.shear[0].kz;
+  p.common_shear = true;
+  for (int r = 1; r < count; ++r)
+    if (p.shear[r].kx != p.kx || p.shear[r].ky != p.ky || p.shear[r].kz != p.kz) p.common_shear = false;
   constexpr std::uint32_t row = kWideArity * sizeof(float), hi = 3 * row;
   for (int a = 0; a < 3; ++a) {
     if (std::signbit(ilo[a]) != std::signbit(ihi[a])) return false;  // mixed signs (±0 directions)
@@ -154,15 +167,103 @@ struct Entry {
   float tnear;
 };
 
+// Triangle l of pack pk against the rays of one 8-lane half (bits `lanes` of it): the
+// watertight test of ray_triangle.h with the rays in lanes and the triangle broadcast, the
+// same operations in the same order as intersect_pack and the scalar test, so the same
+// bits. Lanes whose edge function is exactly zero (or whose product underflows) are redone
+// by the scalar test, which owns the double-precision fallback. Updates best[] / best_t[]
+// (closest t, ties to the lower triangle id); true when some ray's best improved.
+[[gnu::always_inline]] inline bool ray_lanes_triangle(const TrianglePack& pk, int l, Packet& p, int half,
+                                                      unsigned lanes, Hit* best) {
+  const int h = 8 * half;
+  const float* va[3] = {&pk.ax[l], &pk.ay[l], &pk.az[l]};
+  const float* vb[3] = {&pk.bx[l], &pk.by[l], &pk.bz[l]};
+  const float* vc[3] = {&pk.cx[l], &pk.cy[l], &pk.cz[l]};
+  const __m256 okx = _mm256_load_ps(p.okx + h), oky = _mm256_load_ps(p.oky + h), okz = _mm256_load_ps(p.okz + h);
+  const __m256 sx = _mm256_load_ps(p.sx + h), sy = _mm256_load_ps(p.sy + h), sz = _mm256_load_ps(p.sz + h);
+  const __m256 Akx = _mm256_sub_ps(_mm256_set1_ps(*va[p.kx]), okx), Aky = _mm256_sub_ps(_mm256_set1_ps(*va[p.ky]), oky),
+               Akz = _mm256_sub_ps(_mm256_set1_ps(*va[p.kz]), okz);
+  const __m256 Bkx = _mm256_sub_ps(_mm256_set1_ps(*vb[p.kx]), okx), Bky = _mm256_sub_ps(_mm256_set1_ps(*vb[p.ky]), oky),
+               Bkz = _mm256_sub_ps(_mm256_set1_ps(*vb[p.kz]), okz);
+  const __m256 Ckx = _mm256_sub_ps(_mm256_set1_ps(*vc[p.kx]), okx), Cky = _mm256_sub_ps(_mm256_set1_ps(*vc[p.ky]), oky),
+               Ckz = _mm256_sub_ps(_mm256_set1_ps(*vc[p.kz]), okz);
+  const __m256 ax = _mm256_sub_ps(Akx, _mm256_mul_ps(sx, Akz)), ay = _mm256_sub_ps(Aky, _mm256_mul_ps(sy, Akz));
+  const __m256 bx = _mm256_sub_ps(Bkx, _mm256_mul_ps(sx, Bkz)), by = _mm256_sub_ps(Bky, _mm256_mul_ps(sy, Bkz));
+  const __m256 cx = _mm256_sub_ps(Ckx, _mm256_mul_ps(sx, Ckz)), cy = _mm256_sub_ps(Cky, _mm256_mul_ps(sy, Ckz));
+  const __m256 U = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
+  const __m256 V = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
+  const __m256 W = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 mn = _mm256_min_ps(_mm256_min_ps(U, V), W), mx = _mm256_max_ps(_mm256_max_ps(U, V), W);
+  const __m256 inside = _mm256_or_ps(_mm256_cmp_ps(mn, zero, _CMP_GE_OQ), _mm256_cmp_ps(mx, zero, _CMP_LE_OQ));
+  unsigned candidates = static_cast<unsigned>(_mm256_movemask_ps(inside)) & lanes;
+  if (!candidates) return false;
+  const unsigned zero_edge =
+      static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(_mm256_mul_ps(U, V), W), zero, _CMP_EQ_OQ))) &
+      candidates;
+  const __m256 det = _mm256_add_ps(_mm256_add_ps(U, V), W);
+  const __m256 T =
+      _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(U, _mm256_mul_ps(sz, Akz)), _mm256_mul_ps(V, _mm256_mul_ps(sz, Bkz))),
+                    _mm256_mul_ps(W, _mm256_mul_ps(sz, Ckz)));
+  const __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+  const __m256 tt = _mm256_mul_ps(T, inv);
+  const __m256 in_range = _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_load_ps(p.tmin + h), _CMP_GE_OQ),
+                                        _mm256_cmp_ps(tt, _mm256_load_ps(p.best_t + h), _CMP_LE_OQ));
+  unsigned ok = static_cast<unsigned>(_mm256_movemask_ps(in_range)) & candidates & ~zero_edge;
+  if (!ok && !zero_edge) return false;
+  alignas(32) float ts[8], us[8], vs[8];
+  _mm256_store_ps(ts, tt);
+  _mm256_store_ps(us, _mm256_mul_ps(V, inv));
+  _mm256_store_ps(vs, _mm256_mul_ps(W, inv));
+  const std::uint32_t id = pk.id[l];
+  bool improved = false;
+  auto offer = [&](int r, float t, float u, float v) {
+    if (t < best[r].t || (t == best[r].t && id < best[r].triangle)) {
+      best[r] = {t, u, v, id};
+      p.best_t[r] = t;
+      improved = true;
+    }
+  };
+  for (; ok; ok &= ok - 1) {
+    const int j = __builtin_ctz(ok);
+    offer(h + j, ts[j], us[j], vs[j]);
+  }
+  for (unsigned z = zero_edge; z; z &= z - 1) {
+    const int r = h + __builtin_ctz(z);
+    TriangleHit th;
+    const glm::vec3 A(pk.ax[l], pk.ay[l], pk.az[l]), B(pk.bx[l], pk.by[l], pk.bz[l]), C(pk.cx[l], pk.cy[l], pk.cz[l]);
+    if (intersect_triangle_watertight(p.shear[r], A, B, C, p.tmin[r], best[r].t, th)) offer(r, th.t, th.u, th.v);
+  }
+  return improved;
+}
+
 // Leaf child k of n: every ray whose own box test passes is tested against the leaf's
-// triangle packs; best[r] (and p.best_t[r]) keep ray r's closest hit, ties to the lower
-// triangle id. True when some ray's best improved.
+// triangles; best[r] (and p.best_t[r]) keep ray r's closest hit, ties to the lower
+// triangle id (so the order of the tests does not matter). With a common shear and several
+// rays in the leaf, the rays go in lanes against one triangle at a time; otherwise each ray
+// goes against 4-triangle packs. True when some ray's best improved.
 [[gnu::always_inline]] inline bool intersect_leaf(const WideNode& n, int k, const TrianglePack* packs,
                                                   Packet& p, Hit* best, TraversalCounters& c) {
   bool improved = false;
   const std::uint32_t ref = n.child[k];
   const std::uint32_t first = (ref & ~kLeafBit) >> 2, npacks = (ref & 3u) + 1;
-  for (unsigned rb = rays_box_hits(n, k, p); rb; rb &= rb - 1) {
+  const unsigned rays_in = rays_box_hits(n, k, p);
+  if (!rays_in) return false;
+  if (p.common_shear && __builtin_popcount(rays_in) >= 3) {
+    c.triangle_tests += 4u * npacks * static_cast<unsigned>(__builtin_popcount(rays_in));
+    for (std::uint32_t q = first; q < first + npacks; ++q) {
+      const TrianglePack& pk = packs[q];
+      for (int l = 0; l < 4; ++l) {
+        if (pk.id[l] == kEmptyChild) continue;
+        for (int half = 0; half < p.halves; ++half) {
+          const unsigned lanes = (rays_in >> (8 * half)) & 0xffu;
+          if (lanes && ray_lanes_triangle(pk, l, p, half, lanes, best)) improved = true;
+        }
+      }
+    }
+    return improved;
+  }
+  for (unsigned rb = rays_in; rb; rb &= rb - 1) {
     const int r = __builtin_ctz(rb);
     const wide::PackRay pr(p.shear[r]);
     for (std::uint32_t q = first; q < first + npacks; ++q) {
