@@ -334,7 +334,14 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
     unsigned leaves = 0;
     for (unsigned b = bits; b; b &= b - 1) {
       const int k = __builtin_ctz(b);
-      if (n.child[k] & kLeafBit) leaves |= 1u << k;
+      if (!(n.child[k] & kLeafBit)) continue;
+      leaves |= 1u << k;
+      // The leaves' triangles are the traversal's cache misses: start them all before the
+      // first is tested (a pack is 160 bytes, three lines).
+      const char* pk = reinterpret_cast<const char*>(&packs[(n.child[k] & ~kLeafBit) >> 2]);
+      _mm_prefetch(pk, _MM_HINT_T0);
+      _mm_prefetch(pk + 64, _MM_HINT_T0);
+      _mm_prefetch(pk + 128, _MM_HINT_T0);
     }
     bits &= ~leaves;
     bool improved = false;
