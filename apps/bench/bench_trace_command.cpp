@@ -431,11 +431,13 @@ void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global) {
   cmd->add_option("--seed", opt->seed, "Seed of the secondary ray directions")->capture_default_str();
   cmd->add_flag("--no-embree", opt->no_embree, "Skip the Embree comparison");
   cmd->add_option("--image-width", opt->image_width,
-                  "The rays are a camera image this wide (one per pixel, row-major): Embree's rtcIntersect16\n"
-                  "gets 4x4 pixel packets. Default: detected (--width x --height rays from one origin)")
+                  "The rays are a camera image this wide (one per pixel, row-major): our packet kernel and\n"
+                  "Embree's rtcIntersect16 get 4x4 pixel packets. Default: detected (--width x --height rays\n"
+                  "from one origin)")
       ->check(CLI::Range(1, 65536));
   cmd->add_option("--kernel", opt->kernel,
-                  "Our closest-hit kernel: packet (8-ray packets, single-ray fallback when incoherent) or single")
+                  "Our closest-hit kernel: packet (4x4-pixel packets of a camera image, else 8 consecutive rays;\n"
+                  "single-ray fallback when incoherent) or single")
       ->capture_default_str();
   cmd->callback([opt, &global] { run_bench_trace(*opt, global); });
 }
