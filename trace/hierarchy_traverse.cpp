@@ -20,27 +20,13 @@ constexpr std::size_t kPairChunk = 4096;
 constexpr std::size_t kTriangleChunk = 4096;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// A triangle's plane as the leaf test reads it: a vertex, the unnormalized normal (b−a)×(c−a),
-// its length, and max(1, |a|'s largest component) for the test's tolerance. Built once per
-// traversal, not per (ray, triangle) pair.
-struct TrianglePlane {
-  glm::vec3 a{0.0f}, normal{0.0f};
-  float normal_length = 0.0f, a_magnitude = 1.0f;
-};
-
-std::vector<TrianglePlane> triangle_planes(par::Executor& ex, const std::vector<glm::vec3>& p,
-                                           const std::vector<std::uint32_t>& idx) {
-  std::vector<TrianglePlane> planes(idx.size() / 3);
-  ex.parallel_for("hierarchy_planes", planes.size(), kTriangleChunk, [&](std::size_t b, std::size_t e) {
-    for (std::size_t t = b; t < e; ++t) {
-      TrianglePlane& q = planes[t];
-      q.a = p[idx[3 * t]];
-      q.normal = glm::cross(p[idx[3 * t + 1]] - q.a, p[idx[3 * t + 2]] - q.a);
-      q.normal_length = glm::length(q.normal);
-      q.a_magnitude = std::max({1.0f, std::fabs(q.a.x), std::fabs(q.a.y), std::fabs(q.a.z)});
-    }
+std::vector<TriangleLeafBounds> triangle_leaf_bounds_all(par::Executor& ex, const std::vector<glm::vec3>& p,
+                                         const std::vector<std::uint32_t>& idx) {
+  std::vector<TriangleLeafBounds> out(idx.size() / 3);
+  ex.parallel_for("hierarchy_leaf_triangles", out.size(), kTriangleChunk, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t) out[t] = triangle_leaf_bounds(p[idx[3 * t]], p[idx[3 * t + 1]], p[idx[3 * t + 2]]);
   });
-  return planes;
+  return out;
 }
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -54,7 +40,7 @@ struct Traversal {
   const RayHierarchy& h;
   const RayStream& rays;
   const std::vector<BoundingSphere>& spheres;
-  const std::vector<TrianglePlane>& planes;
+  const std::vector<TriangleLeafBounds>& leaf_tris;
   std::size_t capacity, block_size;
   HierarchyTraverseStats& stats;
   HitStream& best;  // merged over batches
@@ -97,23 +83,11 @@ struct Traversal {
     return true;
   }
 
-  // A leaf's ray can hit triangle `t` only if it moves towards the triangle's plane from where
-  // it starts: a ray leaving a reflector is on the front side of its own triangle and of
-  // its neighbours and moves away from them, so these pairs are dropped before the exact
-  // test (ROGER §3.3 keeps them as candidates). The test is exact up to a tolerance that
-  // only keeps pairs: an origin within 1e-5 of the scene's scale of the plane is kept,
-  // whatever its side, so rounding can never drop a true hit (the exact watertight test
-  // decides those).
-  bool ray_can_reach_plane(std::size_t leaf, std::uint32_t t) const {
+  // The leaf test beyond the sphere (leaf_may_hit in the header).
+  bool ray_can_reach(std::size_t leaf, std::uint32_t t) const {
     const std::size_t i = (leaf / std::size_t(h.side)) * std::size_t(h.width) + leaf % std::size_t(h.side);
     const glm::vec3 o(rays.ox[i], rays.oy[i], rays.oz[i]), d(rays.dx[i], rays.dy[i], rays.dz[i]);
-    const TrianglePlane& plane = planes[t];
-    const float side = glm::dot(plane.normal, o - plane.a), towards = glm::dot(plane.normal, d);
-    const float scale = std::max({plane.a_magnitude, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
-    const float tolerance = 1e-5f * scale * plane.normal_length;
-    if (side > tolerance) return towards < 0.0f;
-    if (side < -tolerance) return towards > 0.0f;
-    return true;
+    return leaf_may_hit(o, d, rays.tmin[i], rays.tmax[i], leaf_tris[t]);
   }
 
   // Level l -> l+1 of the descent: one kernel tests each (node, triangle) pair's sphere
@@ -136,7 +110,7 @@ struct Traversal {
           const std::size_t c = (2 * y + std::size_t(j >> 1)) * row + 2 * x + std::size_t(j & 1);
           keep[4 * k + j] = !child[c].empty() && cone_sphere_intersects(child[c], sn[c], cs[c], s) &&
                             (!leaves || child[c].r != 0.0f || child[c].alpha != 0.0f ||
-                             ray_can_reach_plane(c, tri[k]));
+                             ray_can_reach(c, tri[k]));
         }
       }
     });
@@ -218,6 +192,21 @@ struct Traversal {
 
 }  // namespace
 
+TriangleLeafBounds triangle_leaf_bounds(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  TriangleLeafBounds q;
+  q.a = a;
+  // In double the edge differences and products of float coordinates are exact or nearly so,
+  // so the rounded normal is accurate to a float ulp per component however thin the triangle.
+  const glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
+  q.normal = glm::vec3(n);
+  q.normal_length = float(glm::length(n));
+  q.lo = glm::min(a, glm::min(b, c));
+  q.hi = glm::max(a, glm::max(b, c));
+  q.magnitude = std::max({1.0f, std::fabs(q.lo.x), std::fabs(q.lo.y), std::fabs(q.lo.z), std::fabs(q.hi.x),
+                          std::fabs(q.hi.y), std::fabs(q.hi.z)});
+  return q;
+}
+
 std::vector<BoundingSphere> triangle_bounding_spheres(par::Executor& ex, const std::vector<glm::vec3>& p,
                                                       const std::vector<std::uint32_t>& idx) {
   std::vector<BoundingSphere> s(idx.size() / 3);
@@ -243,11 +232,11 @@ void traverse(par::Executor& ex, const std::vector<glm::vec3>& positions, const 
   for (const ConeSphere& leaf : hierarchy.nodes[hierarchy.levels]) stats.active_rays += !leaf.empty();
   const auto t_spheres = std::chrono::steady_clock::now();
   const std::vector<BoundingSphere> spheres = triangle_bounding_spheres(ex, positions, indices);
-  const std::vector<TrianglePlane> planes = triangle_planes(ex, positions, indices);
+  const std::vector<TriangleLeafBounds> leaf_tris = triangle_leaf_bounds_all(ex, positions, indices);
   stats.tests_ms += ms_since(t_spheres);
   const std::size_t side = std::size_t(hierarchy.side);
   const std::size_t capacity = std::max(options.pair_capacity, 4 * side * side);
-  Traversal tr{ex, positions, indices, hierarchy, rays, spheres, planes, capacity, std::max<std::size_t>(1, options.block_size),
+  Traversal tr{ex, positions, indices, hierarchy, rays, spheres, leaf_tris, capacity, std::max<std::size_t>(1, options.block_size),
                stats, hits, consume, {}, {}, {}, {}, {}, {}, {}};
   tr.run(0, std::uint32_t(indices.size() / 3));
   for (std::size_t i = 0; i < hits.triangle.size(); ++i) stats.hits += hits.triangle[i] != kNoHit;

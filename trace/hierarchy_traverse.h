@@ -5,11 +5,14 @@
 // the root.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <span>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "parallel/executor.h"
@@ -66,6 +69,58 @@ void hierarchy_candidates(par::Executor& executor, const std::vector<glm::vec3>&
                           const std::vector<std::uint32_t>& indices, const RayHierarchy& hierarchy,
                           const RayStream& rays, const CandidateConsumer& consume,
                           const HierarchyTraverseOptions& options = {}, HierarchyTraverseStats* stats = nullptr);
+
+// What the leaf test reads of a triangle, built once per traversal (kernel
+// "hierarchy_leaf_triangles"): a vertex, the normal (b−a)×(c−a) computed in double and
+// rounded (so its direction is accurate even for slivers), its length, the axis-aligned
+// box, and the largest coordinate magnitude of the vertices (at least 1), which scales the
+// test's tolerances.
+struct TriangleLeafBounds {
+  glm::vec3 a{0.0f}, normal{0.0f};
+  float normal_length = 0.0f, magnitude = 1.0f;
+  glm::vec3 lo{0.0f}, hi{0.0f};
+};
+TriangleLeafBounds triangle_leaf_bounds(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
+
+// The test a (leaf, triangle) pair passes, after the leaf's eq.3.1 sphere test, to become a
+// candidate of the exact test: the ray o + t d, t in [tmin, tmax], must come within a
+// tolerance of the triangle's plane at some t where it is also inside the triangle's box.
+// Every true hit lies in the plane and in the box, so this keeps every pair the exact
+// (watertight) test accepts: the tolerances (1e-5 of the coordinates' magnitude, in the plane
+// distance and around the box, and 1e-4 of the t range) are far above the rounding of both
+// tests; only pairs are kept by them, never dropped. It removes what ROGER §3.3.3's sphere
+// test keeps although the ray cannot reach the triangle: the triangles whose plane the ray
+// leaves (a reflected ray and its own reflector's triangles), those whose plane lies behind
+// the origin or beyond tmax, and those whose bounding sphere the ray passes but whose
+// plane it crosses outside the box. ROGER §3.4 counts the triangles that remain after
+// traversal as the polygons the ray intersects; this test brings the count close to that.
+inline bool leaf_may_hit(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax, const TriangleLeafBounds& tri) {
+  const float scale = std::max({tri.magnitude, std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
+  // The t interval in which the ray is within `tolerance` of the plane.
+  const float side = glm::dot(tri.normal, o - tri.a), towards = glm::dot(tri.normal, d);
+  const float tolerance = 1e-5f * scale * tri.normal_length;
+  float lo = tmin - 1e-4f * std::fabs(tmin), hi = tmax + 1e-4f * std::fabs(tmax);
+  if (towards != 0.0f) {
+    const float t1 = (-side - tolerance) / towards, t2 = (-side + tolerance) / towards;
+    lo = std::max(lo, std::min(t1, t2));
+    hi = std::min(hi, std::max(t1, t2));
+  } else if (std::fabs(side) > tolerance) {
+    return false;  // parallel to the plane and off it
+  }
+  // Slab test against the box grown by the margin, over that interval.
+  const float margin = 1e-5f * scale;
+  for (int k = 0; k < 3; ++k) {
+    const float bl = tri.lo[k] - margin, bh = tri.hi[k] + margin;
+    if (d[k] == 0.0f) {
+      if (o[k] < bl || o[k] > bh) return false;
+      continue;
+    }
+    const float t1 = (bl - o[k]) / d[k], t2 = (bh - o[k]) / d[k];
+    lo = std::max(lo, std::min(t1, t2));
+    hi = std::min(hi, std::max(t1, t2));
+  }
+  return lo <= hi;
+}
 
 // The bounding sphere of every triangle (kernel "hierarchy_spheres").
 std::vector<BoundingSphere> triangle_bounding_spheres(par::Executor& executor,

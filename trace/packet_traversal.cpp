@@ -1,4 +1,4 @@
-// 8-ray packet traversal of the 8-wide BVH (see packet_traversal.h). Culling is
+// 8- and 16-ray packet traversal of the 8-wide BVH (see packet_traversal.h). Culling is
 // conservative by monotonicity: every float operation of the single-ray slab test is
 // monotone in its operands, so the same operations applied to the packet's extreme
 // origins and reciprocals bound every ray's computed entry (from below) and exit (from
@@ -24,11 +24,18 @@ constexpr float kMaxDirectionSpread = 0.05f;  // per component of the normalized
 
 struct Packet {
   int count = 0;
+  int halves = 1;  // 8-lane halves in use: 1 for up to 8 rays, 2 for up to 16
   // Per ray (lanes), for the per-ray leaf box test.
-  alignas(32) float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
-  alignas(32) float ix[kPacketSize], iy[kPacketSize], iz[kPacketSize];
-  alignas(32) float tmin[kPacketSize], best_t[kPacketSize];
-  RayShear shear[kPacketSize];
+  alignas(32) float ox[kMaxPacketSize], oy[kMaxPacketSize], oz[kMaxPacketSize];
+  alignas(32) float ix[kMaxPacketSize], iy[kMaxPacketSize], iz[kMaxPacketSize];
+  alignas(32) float tmin[kMaxPacketSize], best_t[kMaxPacketSize];
+  RayShear shear[kMaxPacketSize];
+  // When every ray has the same watertight axis permutation (kx, ky, kz), the leaf test
+  // runs across the rays, one triangle at a time: the shear in lanes.
+  bool common_shear = false;
+  int kx = 0, ky = 1, kz = 2;
+  alignas(32) float okx[kMaxPacketSize], oky[kMaxPacketSize], okz[kMaxPacketSize];
+  alignas(32) float sx[kMaxPacketSize], sy[kMaxPacketSize], sz[kMaxPacketSize];
   // Packet bounds for the interval node test.
   __m256 near_o[3], far_o[3], inv_lo[3], inv_hi[3], tmin_lo;
   std::uint32_t near_off[3], far_off[3];  // plane rows of a WideNode picked by the signs
@@ -60,13 +67,14 @@ struct Packet {
 
 // Child k's box against each ray (lanes) with its own best t: the single-ray box test of
 // wide_kernels.h, transposed. Bit r when ray r enters the box.
-[[gnu::always_inline]] inline unsigned rays_box_hits(const WideNode& n, int k, const Packet& p) {
+[[gnu::always_inline]] inline unsigned rays_box_hits_half(const WideNode& n, int k, const Packet& p, int half) {
   const float* rows = n.lo_x;
   auto bcast = [&](std::uint32_t off) {
     return _mm256_set1_ps(*reinterpret_cast<const float*>(reinterpret_cast<const char*>(rows) + off + 4u * k));
   };
-  const __m256 o[3] = {_mm256_load_ps(p.ox), _mm256_load_ps(p.oy), _mm256_load_ps(p.oz)};
-  const __m256 inv[3] = {_mm256_load_ps(p.ix), _mm256_load_ps(p.iy), _mm256_load_ps(p.iz)};
+  const int h = 8 * half;
+  const __m256 o[3] = {_mm256_load_ps(p.ox + h), _mm256_load_ps(p.oy + h), _mm256_load_ps(p.oz + h)};
+  const __m256 inv[3] = {_mm256_load_ps(p.ix + h), _mm256_load_ps(p.iy + h), _mm256_load_ps(p.iz + h)};
   __m256 entry = _mm256_set1_ps(-3.0e38f), exit = _mm256_set1_ps(3.0e38f);
   for (int a = 0; a < 3; ++a) {
     entry = _mm256_max_ps(entry, _mm256_mul_ps(_mm256_sub_ps(bcast(p.near_off[a]), o[a]), inv[a]));
@@ -77,15 +85,21 @@ struct Packet {
   entry = _mm256_min_ps(entry, big);
   exit = _mm256_max_ps(exit, _mm256_sub_ps(_mm256_setzero_ps(), big));
   const __m256 near = _mm256_max_ps(_mm256_sub_ps(entry, _mm256_mul_ps(_mm256_and_ps(entry, abs_mask), eps)),
-                                    _mm256_load_ps(p.tmin));
+                                    _mm256_load_ps(p.tmin + h));
   const __m256 far = _mm256_min_ps(_mm256_add_ps(exit, _mm256_mul_ps(_mm256_and_ps(exit, abs_mask), eps)),
-                                   _mm256_load_ps(p.best_t));
+                                   _mm256_load_ps(p.best_t + h));
   return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ)));
 }
 
-inline float lane_max(const float (&v)[kPacketSize]) {
-  float m = v[0];
-  for (int i = 1; i < kPacketSize; ++i) m = v[i] > m ? v[i] : m;
+[[gnu::always_inline]] inline unsigned rays_box_hits(const WideNode& n, int k, const Packet& p) {
+  unsigned bits = rays_box_hits_half(n, k, p, 0);
+  if (p.halves == 2) bits |= rays_box_hits_half(n, k, p, 1) << 8;
+  return bits;
+}
+
+inline float lane_max(const Packet& p) {
+  float m = p.best_t[0];
+  for (int i = 1; i < 8 * p.halves; ++i) m = p.best_t[i] > m ? p.best_t[i] : m;
   return m;
 }
 
@@ -108,7 +122,8 @@ bool prepare(const Ray* rays, int count, Packet& p) {
     if (dhi[a] - dlo[a] > kMaxDirectionSpread || (dlo[a] < 0.0f) != (dhi[a] < 0.0f)) return false;
   glm::vec3 olo(3.0e38f), ohi(-3.0e38f), ilo(3.0e38f), ihi(-3.0e38f);
   float tmin_lo = 3.0e38f;
-  for (int r = 0; r < kPacketSize; ++r) {
+  p.halves = count > 8 ? 2 : 1;
+  for (int r = 0; r < 8 * p.halves; ++r) {
     const Ray& ray = rays[r < count ? r : 0];
     const glm::vec3 inv = wide::safe_inverse(ray.direction);
     olo = glm::min(olo, ray.origin);
@@ -122,7 +137,14 @@ bool prepare(const Ray* rays, int count, Packet& p) {
     // Lanes past count copy ray 0 but can never be entered (best t below everything).
     p.best_t[r] = r < count ? ray.tmax : -3.0e38f;
     p.shear[r] = RayShear(ray.origin, ray.direction);
+    const RayShear& sh = p.shear[r];
+    p.okx[r] = sh.origin[sh.kx]; p.oky[r] = sh.origin[sh.ky]; p.okz[r] = sh.origin[sh.kz];
+    p.sx[r] = sh.sx; p.sy[r] = sh.sy; p.sz[r] = sh.sz;
   }
+  p.kx = p.shear[0].kx; p.ky = p.shear[0].ky; p.kz = p.shear[0].kz;
+  p.common_shear = true;
+  for (int r = 1; r < count; ++r)
+    if (p.shear[r].kx != p.kx || p.shear[r].ky != p.ky || p.shear[r].kz != p.kz) p.common_shear = false;
   constexpr std::uint32_t row = kWideArity * sizeof(float), hi = 3 * row;
   for (int a = 0; a < 3; ++a) {
     if (std::signbit(ilo[a]) != std::signbit(ihi[a])) return false;  // mixed signs (±0 directions)
@@ -145,15 +167,103 @@ struct Entry {
   float tnear;
 };
 
+// Triangle l of pack pk against the rays of one 8-lane half (bits `lanes` of it): the
+// watertight test of ray_triangle.h with the rays in lanes and the triangle broadcast, the
+// same operations in the same order as intersect_pack and the scalar test, so the same
+// bits. Lanes whose edge function is exactly zero (or whose product underflows) are redone
+// by the scalar test, which owns the double-precision fallback. Updates best[] / best_t[]
+// (closest t, ties to the lower triangle id); true when some ray's best improved.
+[[gnu::always_inline]] inline bool ray_lanes_triangle(const TrianglePack& pk, int l, Packet& p, int half,
+                                                      unsigned lanes, Hit* best) {
+  const int h = 8 * half;
+  const float* va[3] = {&pk.ax[l], &pk.ay[l], &pk.az[l]};
+  const float* vb[3] = {&pk.bx[l], &pk.by[l], &pk.bz[l]};
+  const float* vc[3] = {&pk.cx[l], &pk.cy[l], &pk.cz[l]};
+  const __m256 okx = _mm256_load_ps(p.okx + h), oky = _mm256_load_ps(p.oky + h), okz = _mm256_load_ps(p.okz + h);
+  const __m256 sx = _mm256_load_ps(p.sx + h), sy = _mm256_load_ps(p.sy + h), sz = _mm256_load_ps(p.sz + h);
+  const __m256 Akx = _mm256_sub_ps(_mm256_set1_ps(*va[p.kx]), okx), Aky = _mm256_sub_ps(_mm256_set1_ps(*va[p.ky]), oky),
+               Akz = _mm256_sub_ps(_mm256_set1_ps(*va[p.kz]), okz);
+  const __m256 Bkx = _mm256_sub_ps(_mm256_set1_ps(*vb[p.kx]), okx), Bky = _mm256_sub_ps(_mm256_set1_ps(*vb[p.ky]), oky),
+               Bkz = _mm256_sub_ps(_mm256_set1_ps(*vb[p.kz]), okz);
+  const __m256 Ckx = _mm256_sub_ps(_mm256_set1_ps(*vc[p.kx]), okx), Cky = _mm256_sub_ps(_mm256_set1_ps(*vc[p.ky]), oky),
+               Ckz = _mm256_sub_ps(_mm256_set1_ps(*vc[p.kz]), okz);
+  const __m256 ax = _mm256_sub_ps(Akx, _mm256_mul_ps(sx, Akz)), ay = _mm256_sub_ps(Aky, _mm256_mul_ps(sy, Akz));
+  const __m256 bx = _mm256_sub_ps(Bkx, _mm256_mul_ps(sx, Bkz)), by = _mm256_sub_ps(Bky, _mm256_mul_ps(sy, Bkz));
+  const __m256 cx = _mm256_sub_ps(Ckx, _mm256_mul_ps(sx, Ckz)), cy = _mm256_sub_ps(Cky, _mm256_mul_ps(sy, Ckz));
+  const __m256 U = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
+  const __m256 V = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
+  const __m256 W = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 mn = _mm256_min_ps(_mm256_min_ps(U, V), W), mx = _mm256_max_ps(_mm256_max_ps(U, V), W);
+  const __m256 inside = _mm256_or_ps(_mm256_cmp_ps(mn, zero, _CMP_GE_OQ), _mm256_cmp_ps(mx, zero, _CMP_LE_OQ));
+  unsigned candidates = static_cast<unsigned>(_mm256_movemask_ps(inside)) & lanes;
+  if (!candidates) return false;
+  const unsigned zero_edge =
+      static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(_mm256_mul_ps(U, V), W), zero, _CMP_EQ_OQ))) &
+      candidates;
+  const __m256 det = _mm256_add_ps(_mm256_add_ps(U, V), W);
+  const __m256 T =
+      _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(U, _mm256_mul_ps(sz, Akz)), _mm256_mul_ps(V, _mm256_mul_ps(sz, Bkz))),
+                    _mm256_mul_ps(W, _mm256_mul_ps(sz, Ckz)));
+  const __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+  const __m256 tt = _mm256_mul_ps(T, inv);
+  const __m256 in_range = _mm256_and_ps(_mm256_cmp_ps(tt, _mm256_load_ps(p.tmin + h), _CMP_GE_OQ),
+                                        _mm256_cmp_ps(tt, _mm256_load_ps(p.best_t + h), _CMP_LE_OQ));
+  unsigned ok = static_cast<unsigned>(_mm256_movemask_ps(in_range)) & candidates & ~zero_edge;
+  if (!ok && !zero_edge) return false;
+  alignas(32) float ts[8], us[8], vs[8];
+  _mm256_store_ps(ts, tt);
+  _mm256_store_ps(us, _mm256_mul_ps(V, inv));
+  _mm256_store_ps(vs, _mm256_mul_ps(W, inv));
+  const std::uint32_t id = pk.id[l];
+  bool improved = false;
+  auto offer = [&](int r, float t, float u, float v) {
+    if (t < best[r].t || (t == best[r].t && id < best[r].triangle)) {
+      best[r] = {t, u, v, id};
+      p.best_t[r] = t;
+      improved = true;
+    }
+  };
+  for (; ok; ok &= ok - 1) {
+    const int j = __builtin_ctz(ok);
+    offer(h + j, ts[j], us[j], vs[j]);
+  }
+  for (unsigned z = zero_edge; z; z &= z - 1) {
+    const int r = h + __builtin_ctz(z);
+    TriangleHit th;
+    const glm::vec3 A(pk.ax[l], pk.ay[l], pk.az[l]), B(pk.bx[l], pk.by[l], pk.bz[l]), C(pk.cx[l], pk.cy[l], pk.cz[l]);
+    if (intersect_triangle_watertight(p.shear[r], A, B, C, p.tmin[r], best[r].t, th)) offer(r, th.t, th.u, th.v);
+  }
+  return improved;
+}
+
 // Leaf child k of n: every ray whose own box test passes is tested against the leaf's
-// triangle packs; best[r] (and p.best_t[r]) keep ray r's closest hit, ties to the lower
-// triangle id. True when some ray's best improved.
+// triangles; best[r] (and p.best_t[r]) keep ray r's closest hit, ties to the lower
+// triangle id (so the order of the tests does not matter). With a common shear and several
+// rays in the leaf, the rays go in lanes against one triangle at a time; otherwise each ray
+// goes against 4-triangle packs. True when some ray's best improved.
 [[gnu::always_inline]] inline bool intersect_leaf(const WideNode& n, int k, const TrianglePack* packs,
                                                   Packet& p, Hit* best, TraversalCounters& c) {
   bool improved = false;
   const std::uint32_t ref = n.child[k];
   const std::uint32_t first = (ref & ~kLeafBit) >> 2, npacks = (ref & 3u) + 1;
-  for (unsigned rb = rays_box_hits(n, k, p); rb; rb &= rb - 1) {
+  const unsigned rays_in = rays_box_hits(n, k, p);
+  if (!rays_in) return false;
+  if (p.common_shear && __builtin_popcount(rays_in) >= 3) {
+    c.triangle_tests += 4u * npacks * static_cast<unsigned>(__builtin_popcount(rays_in));
+    for (std::uint32_t q = first; q < first + npacks; ++q) {
+      const TrianglePack& pk = packs[q];
+      for (int l = 0; l < 4; ++l) {
+        if (pk.id[l] == kEmptyChild) continue;
+        for (int half = 0; half < p.halves; ++half) {
+          const unsigned lanes = (rays_in >> (8 * half)) & 0xffu;
+          if (lanes && ray_lanes_triangle(pk, l, p, half, lanes, best)) improved = true;
+        }
+      }
+    }
+    return improved;
+  }
+  for (unsigned rb = rays_in; rb; rb &= rb - 1) {
     const int r = __builtin_ctz(rb);
     const wide::PackRay pr(p.shear[r]);
     for (std::uint32_t q = first; q < first + npacks; ++q) {
@@ -197,7 +307,7 @@ struct Entry {
 }  // namespace
 
 bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, TraversalCounters* counters) {
-  count = std::clamp(count, 0, kPacketSize);
+  count = std::clamp(count, 0, kMaxPacketSize);
   Packet p;
   if (count < 2 || bvh.wide_root() == kEmptyChild || (bvh.wide_root() & kLeafBit) || !prepare(rays, count, p)) {
     for (int r = 0; r < count; ++r) out[r] = closest_hit(bvh, rays[r], counters);
@@ -205,11 +315,11 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
   }
   TraversalCounters c;
   c.rays = static_cast<std::uint64_t>(count);
-  Hit best[kPacketSize];
+  Hit best[kMaxPacketSize];
   for (int r = 0; r < count; ++r) best[r].t = p.best_t[r];
   const WideNode* nodes = bvh.wide_nodes().data();
   const TrianglePack* packs = bvh.triangle_packs().data();
-  float max_t = lane_max(p.best_t);
+  float max_t = lane_max(p);
   Entry stack[kTraversalStackSize];
   int sp = 0;
   std::uint32_t cur = bvh.wide_root();
@@ -224,7 +334,14 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
     unsigned leaves = 0;
     for (unsigned b = bits; b; b &= b - 1) {
       const int k = __builtin_ctz(b);
-      if (n.child[k] & kLeafBit) leaves |= 1u << k;
+      if (!(n.child[k] & kLeafBit)) continue;
+      leaves |= 1u << k;
+      // The leaves' triangles are the traversal's cache misses: start them all before the
+      // first is tested (a pack is 160 bytes, three lines).
+      const char* pk = reinterpret_cast<const char*>(&packs[(n.child[k] & ~kLeafBit) >> 2]);
+      _mm_prefetch(pk, _MM_HINT_T0);
+      _mm_prefetch(pk + 64, _MM_HINT_T0);
+      _mm_prefetch(pk + 128, _MM_HINT_T0);
     }
     bits &= ~leaves;
     bool improved = false;
@@ -233,7 +350,7 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
       leaves &= leaves - 1;
       if (intersect_leaf(n, k, packs, p, best, c)) improved = true;
     }
-    if (improved) max_t = lane_max(p.best_t);
+    if (improved) max_t = lane_max(p);
     // Inner children: descend into the nearest, push the others far-to-near.
     if (bits) {
       Entry hits[kWideArity];
@@ -267,29 +384,45 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
 }
 
 void closest_hit_stream_packets(const Bvh& bvh, const RayStream& rays, HitStream& hits, par::Executor& ex,
-                                TraversalCounters* counters) {
-  static_assert(kRayChunk % kPacketSize == 0, "packets never straddle chunks");
+                                TraversalCounters* counters, int image_width) {
+  static_assert(kRayChunk % kMaxPacketSize == 0, "packets never straddle chunks");
   const std::size_t n = rays.size();
   hits.resize(n);
-  const std::size_t chunks = (n + kRayChunk - 1) / kRayChunk;
+  // The packets: slot[kMaxPacketSize * q + l] is the ray of lane l of packet q (or n for an
+  // unused lane). An image's rays go in 4x4 pixel tiles (16 rays that share most of their
+  // node path), row-major tiles; other streams in runs of kPacketSize consecutive rays.
+  const bool tiles = image_width > 0 && n % static_cast<std::size_t>(image_width) == 0;
+  const std::size_t w = tiles ? static_cast<std::size_t>(image_width) : 0, h = tiles ? n / w : 0;
+  const std::size_t tiles_x = (w + 3) / 4, tiles_y = (h + 3) / 4;
+  const std::size_t packets = tiles ? tiles_x * tiles_y : (n + kPacketSize - 1) / kPacketSize;
+  const std::size_t per_chunk_packets = kRayChunk / (tiles ? kMaxPacketSize : kPacketSize);
+  const std::size_t chunks = (packets + per_chunk_packets - 1) / per_chunk_packets;
   std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
-  ex.parallel_for("trace_closest_packets", n, kRayChunk, [&](std::size_t b, std::size_t e) {
+  ex.parallel_for("trace_closest_packets", packets, per_chunk_packets, [&](std::size_t b, std::size_t e) {
     TraversalCounters c;
-    for (std::size_t i = b; i < e; i += kPacketSize) {
-      const int count = static_cast<int>(std::min<std::size_t>(kPacketSize, e - i));
-      Ray r[kPacketSize];
-      Hit h[kPacketSize];
-      for (int k = 0; k < count; ++k) r[k] = rays.get(i + static_cast<std::size_t>(k));
-      closest_hit_packet(bvh, r, count, h, &c);
+    for (std::size_t q = b; q < e; ++q) {
+      std::size_t slot[kMaxPacketSize];
+      int count = 0;
+      if (tiles) {
+        const std::size_t x0 = (q % tiles_x) * 4, y0 = (q / tiles_x) * 4;
+        for (std::size_t y = y0; y < std::min(y0 + 4, h); ++y)
+          for (std::size_t x = x0; x < std::min(x0 + 4, w); ++x) slot[count++] = y * w + x;
+      } else {
+        for (std::size_t i = q * kPacketSize; i < std::min(n, (q + 1) * kPacketSize); ++i) slot[count++] = i;
+      }
+      Ray r[kMaxPacketSize];
+      Hit hh[kMaxPacketSize];
+      for (int k = 0; k < count; ++k) r[k] = rays.get(slot[k]);
+      closest_hit_packet(bvh, r, count, hh, &c);
       for (int k = 0; k < count; ++k) {
-        const std::size_t j = i + static_cast<std::size_t>(k);
-        hits.t[j] = h[k].t;
-        hits.u[j] = h[k].u;
-        hits.v[j] = h[k].v;
-        hits.triangle[j] = h[k].triangle;
+        const std::size_t j = slot[k];
+        hits.t[j] = hh[k].t;
+        hits.u[j] = hh[k].u;
+        hits.v[j] = hh[k].v;
+        hits.triangle[j] = hh[k].triangle;
       }
     }
-    if (counters) per_chunk[b / kRayChunk] = c;
+    if (counters) per_chunk[b / per_chunk_packets] = c;
   });
   if (counters)
     for (const auto& c : per_chunk) counters->add(c);

@@ -80,7 +80,7 @@ ImageRGBA ShadeHitsPass::operator()(par::NodeContext& c, const SecondaryRays& ra
     add_environment_fallback(c.executor(), *scene, next, specular);
     c.count("fallback_depth_exhausted", next.count);
     if (c.capturing()) {
-      FallbackMask fallbacks(width, height);
+      FallbackMask fallbacks(rays.width, rays.height);
       for (std::size_t i = 0; i < next.active.size(); ++i)
         if (next.active[i]) fallbacks.mark(i, Fallback::depth_exhausted);
       c.publish("fallback", std::move(fallbacks));

@@ -350,10 +350,13 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
   }
   trace::HitStream hits;
   trace::TraversalCounters counters;
+  // Camera rays go to the packet kernel (and to rtcIntersect16) in 4x4 pixel tiles.
+  const int image_width = camera_image_width(o, rays);
   for (int k = 0; k < repeat; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpu_ms();
-    if (o.kernel == "packet") trace::closest_hit_stream_packets(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
+    if (o.kernel == "packet")
+      trace::closest_hit_stream_packets(bvh, rays, hits, ex, k == 0 ? &counters : nullptr, image_width);
     else trace::closest_hit_stream(bvh, rays, hits, ex, k == 0 ? &counters : nullptr);
     trace_ms.push_back(ms_since(t0));
     trace_cpu.push_back(cpu_ms() - c0);
@@ -364,6 +367,7 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
   const double per_ray = 1.0 / std::max<double>(1.0, rays.size());
   OrderedJson j{{"mesh", o.mesh}, {"rays_file", o.rays}, {"triangles", scene.mesh.triangle_count()},
                 {"rays", rays.size()}, {"threads", ex.threads()}, {"repeat", repeat}, {"kernel", o.kernel},
+                {"packets", o.kernel != "packet" ? "none" : image_width > 0 ? "4x4 pixels" : "8 consecutive rays"},
                 {"build_ms", rounded(median(build_ms), 3)}, {"mrays_per_s", rounded(mrays, 3)},
                 {"hits", sum.hits}, {"prim_sum", sum.prim_sum}, {"t_sum", rounded(sum.t_sum, 6)},
                 {"nodes_per_ray", rounded(static_cast<double>(counters.nodes_visited) * per_ray, 2)},
@@ -380,7 +384,6 @@ void run_bench_trace(const BenchTraceOptions& o, const GlobalOptions& global) {
               {"layouts_ms", rounded(st.layouts_ms, 1)}};
 #ifdef SPECULUM_HAVE_EMBREE
   if (!o.no_embree) {
-    const int image_width = camera_image_width(o, rays);
     const EmbreeFigures e = run_embree(scene, rays, image_width, repeat, ex);
     j["embree"] = {{"version", std::to_string(RTC_VERSION_MAJOR) + "." + std::to_string(RTC_VERSION_MINOR) + "." +
                                    std::to_string(RTC_VERSION_PATCH)},
@@ -428,11 +431,13 @@ void add_bench_trace_subcommand(CLI::App& bench, GlobalOptions& global) {
   cmd->add_option("--seed", opt->seed, "Seed of the secondary ray directions")->capture_default_str();
   cmd->add_flag("--no-embree", opt->no_embree, "Skip the Embree comparison");
   cmd->add_option("--image-width", opt->image_width,
-                  "The rays are a camera image this wide (one per pixel, row-major): Embree's rtcIntersect16\n"
-                  "gets 4x4 pixel packets. Default: detected (--width x --height rays from one origin)")
+                  "The rays are a camera image this wide (one per pixel, row-major): our packet kernel and\n"
+                  "Embree's rtcIntersect16 get 4x4 pixel packets. Default: detected (--width x --height rays\n"
+                  "from one origin)")
       ->check(CLI::Range(1, 65536));
   cmd->add_option("--kernel", opt->kernel,
-                  "Our closest-hit kernel: packet (8-ray packets, single-ray fallback when incoherent) or single")
+                  "Our closest-hit kernel: packet (4x4-pixel packets of a camera image, else 8 consecutive rays;\n"
+                  "single-ray fallback when incoherent) or single")
       ->capture_default_str();
   cmd->callback([opt, &global] { run_bench_trace(*opt, global); });
 }

@@ -293,7 +293,8 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
   Drawing d;
   d.drawable = true;
   if (const auto* fallbacks = o.as<FallbackMask>()) {
-    draw_fallbacks(d, *fallbacks);
+    if (fallbacks->empty()) d.drawable = false;
+    else draw_fallbacks(d, *fallbacks);
   } else if (const auto* img = o.as<ImageRGBA>()) {
     d.size = dims(img->width, img->height);
     if (o.resource == pipeline::kDisplay)

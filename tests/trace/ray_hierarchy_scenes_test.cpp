@@ -159,5 +159,30 @@ TEST(RayHierarchyScenesDeterminism, TwoBouncesSameBytesForThreadsAndBatches) {
   EXPECT_GT(sum, 0.0);
 }
 
+// ROGER §3.4 (Fig.3.17) keeps 2.5–4.5 candidates per ray, about the polygons each ray
+// intersects; the leaf test brings sphere-in-room (its default tessellation, one reflected
+// ray per reflector pixel at 64²) to at most that, with every hit still the oracle's.
+TEST(RayHierarchyScenesCandidates, SphereInRoomAtMostFourAndAHalfPerRay) {
+  const Scene scene = load_scene("sphere-in-room", SceneOptions{});
+  par::Executor ex(2);
+  const Bvh bvh = Bvh::build(scene.mesh, ex);
+  const int w = 64, h = 64;
+  const PrimaryPlanes g = primary_planes(scene, bvh, scene.cameras.front(), w, h);
+  const SecondaryRays rays = secondary_rays(ex, g.position, g.normal, g.surface, g.object, scene.cameras.front().eye);
+  const RayHierarchy hi = build_ray_hierarchy(ex, rays.rays, rays.active, w, h);
+  HitStream hits;
+  HierarchyTraverseStats stats;
+  hierarchy_closest_hits(ex, scene.mesh.positions, scene.mesh.indices, hi, rays.rays, hits, {}, &stats);
+  EXPECT_GT(stats.active_rays, 500u);
+  EXPECT_LE(stats.candidates_per_ray(), 4.5);
+  EXPECT_GE(stats.candidates, stats.hits);  // every hit ray keeps at least its hit triangle
+  for (std::size_t i = 0; i < rays.active.size(); ++i) {
+    if (!rays.active[i]) continue;
+    const Hit o = closest_hit_oracle(scene.mesh.positions, scene.mesh.indices, rays.rays.get(i));
+    ASSERT_EQ(hits.triangle[i], o.triangle) << "pixel " << i;
+    if (o.hit()) EXPECT_EQ(std::memcmp(&hits.t[i], &o.t, 4), 0) << "pixel " << i;
+  }
+}
+
 }  // namespace
 }  // namespace speculum::trace

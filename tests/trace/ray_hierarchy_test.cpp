@@ -13,6 +13,7 @@
 #include "tests/trace/test_meshes.h"
 #include "trace/hierarchy_traverse.h"
 #include "trace/ray_hierarchy.h"
+#include "trace/ray_triangle.h"
 
 namespace speculum::trace {
 namespace {
@@ -282,6 +283,96 @@ TEST(RayHierarchy, TiesGoToTheLowerTriangle) {
   const TraceResult b = trace(1, soup, rays, active, 2, 2, 16);  // 4·side² = 16: 32 root pairs split
   EXPECT_GT(b.stats.overflow_batches, 0u);
   for (int i = 0; i < 4; ++i) EXPECT_EQ(b.hits.triangle[i], 0u);
+}
+
+// The leaf test after the sphere test never drops a pair the exact watertight test accepts.
+// Adversarial pairs: rays aimed at vertices, at points on edges and just inside/outside
+// them, grazing rays nearly in the plane, axis-aligned triangles (boxes of zero thickness),
+// slivers, triangles far from the origin (coordinates up to 1e3) and ranges [tmin, tmax]
+// ending right at the hit. Non-vacuous: it rejects the triangles behind the origin, and
+// most of the misses among rays through a triangle's bounding ball.
+TEST(RayHierarchy, LeafTestKeepsEveryExactHit) {
+  int exact_hits = 0, behind = 0, behind_kept = 0;
+  for (std::uint32_t c = 0; c < 200000; ++c) {
+    const float scale = (c % 5 == 0) ? 1000.0f : (c % 5 == 1 ? 0.01f : 1.0f);
+    const glm::vec3 centre = rnd3(c, 81, -1.0f, 1.0f) * scale * 3.0f;
+    glm::vec3 v[3];
+    for (int k = 0; k < 3; ++k) v[k] = centre + rnd3(c, 82 + k, -1.0f, 1.0f) * scale * 0.3f;
+    switch (c % 7) {
+      case 0: v[0].y = v[1].y = v[2].y = centre.y; break;  // axis-aligned: a flat box
+      case 1: v[2] = v[0] + (v[1] - v[0]) * 0.37f + rnd3(c, 85, -1e-4f, 1e-4f) * scale; break;  // sliver
+      case 2: v[1].x = v[0].x, v[2].x = v[0].x; break;
+      default: break;
+    }
+    // The target: a vertex, a point on an edge, or a point in or near the triangle.
+    const float w1 = rnd(c, 0, 86), w2 = rnd(c, 1, 86);
+    glm::vec3 target;
+    switch (c % 4) {
+      case 0: target = v[c % 3]; break;
+      case 1: target = v[0] + w1 * (v[1] - v[0]); break;
+      case 2: target = v[0] + w1 * (v[1] - v[0]) + w2 * (1.0f - w1) * (v[2] - v[0]); break;
+      default: target = v[0] + (w1 * 1.2f - 0.1f) * (v[1] - v[0]) + (w2 * 1.2f - 0.1f) * (v[2] - v[0]); break;
+    }
+    glm::vec3 o;
+    const glm::vec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+    if (c % 9 == 0 && glm::length(n) > 0.0f) {
+      // Grazing: the origin nearly in the plane, far from the target.
+      const glm::vec3 in_plane = glm::normalize(glm::cross(n, rnd3(c, 87, -1.0f, 1.0f)));
+      o = target + in_plane * scale * 2.0f + glm::normalize(n) * scale * 1e-4f * (rnd(c, 2, 86) - 0.5f);
+    } else {
+      o = target + rnd3(c, 88, -1.0f, 1.0f) * scale * (c % 3 == 0 ? 0.01f : 2.0f);
+    }
+    glm::vec3 d = target - o;
+    const bool reversed = c % 11 == 0 && c % 9 != 0;
+    if (reversed) d = -d;  // the triangle behind the origin
+    if (!(glm::length(d) > 0.0f)) continue;
+    d *= 0.5f + 2.0f * rnd(c, 3, 86);  // unnormalized directions, as the rays carry them
+    float tmin = 0.0f, tmax = 1e30f;
+    TriangleHit hit;
+    const RayShear shear(o, d);
+    if (c % 13 == 0 && intersect_triangle_watertight(shear, v[0], v[1], v[2], 0.0f, 1e30f, hit)) {
+      tmax = hit.t;  // a range that ends exactly at the hit (shadow rays)
+      tmin = c % 2 ? hit.t : 0.0f;
+    }
+    const TriangleLeafBounds lt = triangle_leaf_bounds(v[0], v[1], v[2]);
+    const bool kept = leaf_may_hit(o, d, tmin, tmax, lt);
+    if (intersect_triangle_watertight(shear, v[0], v[1], v[2], tmin, tmax, hit)) {
+      ++exact_hits;
+      ASSERT_TRUE(kept) << "case " << c;
+      continue;
+    }
+    if (reversed) {
+      ++behind;
+      behind_kept += kept;
+      continue;
+    }
+  }
+  EXPECT_GT(exact_hits, 60000);
+  EXPECT_GT(behind, 10000);
+  EXPECT_LT(behind_kept, behind / 100);  // only origins within the tolerance of the plane
+  // Typical pairs: rays through random points of the triangle's bounding ball, from random
+  // origins; of those that meet the ball and miss the triangle, the test rejects many
+  // (the rest cross the plane inside the box, outside the triangle).
+  int sphere_misses = 0, sphere_misses_kept = 0;
+  for (std::uint32_t c = 0; c < 20000; ++c) {
+    glm::vec3 v[3];
+    for (int k = 0; k < 3; ++k) v[k] = rnd3(c, 91 + k, -0.5f, 0.5f);
+    const glm::vec3 centroid = (v[0] + v[1] + v[2]) / 3.0f;
+    const float rho = std::max({glm::length(v[0] - centroid), glm::length(v[1] - centroid), glm::length(v[2] - centroid)});
+    const glm::vec3 o = rnd3(c, 94, -3.0f, 3.0f);
+    const glm::vec3 d = centroid + unit_vector(c, 95) * rho * std::cbrt(rnd(c, 0, 96)) - o;
+    TriangleHit hit;
+    const bool exact = intersect_triangle_watertight(RayShear(o, d), v[0], v[1], v[2], 0.0f, 1e30f, hit);
+    const bool kept = leaf_may_hit(o, d, 0.0f, 1e30f, triangle_leaf_bounds(v[0], v[1], v[2]));
+    if (exact) {
+      EXPECT_TRUE(kept) << "typical case " << c;
+    } else {
+      ++sphere_misses;
+      sphere_misses_kept += kept;
+    }
+  }
+  EXPECT_GT(sphere_misses, 5000);
+  EXPECT_LT(sphere_misses_kept, sphere_misses / 4);  // 17 % kept here
 }
 
 }  // namespace
