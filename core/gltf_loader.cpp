@@ -361,10 +361,11 @@ struct Loader {
   // read: each instance of a mesh adds its vertices again, so a small file could otherwise
   // claim any amount (an accessor with no bufferView is count zeros, from no bytes at all).
   void check_counts(const tinygltf::Primitive& prim, int mode) const {
+    // A count past gltf::kMaxAccessorCount is left to checked_accessor, which names it.
     auto count = [&](int accessor) -> std::uint64_t {
-      return accessor >= 0 && static_cast<std::size_t>(accessor) < model.accessors.size()
-                 ? model.accessors[static_cast<std::size_t>(accessor)].count
-                 : 0;
+      if (accessor < 0 || static_cast<std::size_t>(accessor) >= model.accessors.size()) return 0;
+      const std::uint64_t n = model.accessors[static_cast<std::size_t>(accessor)].count;
+      return n > gltf::kMaxAccessorCount ? 0 : n;
     };
     const std::uint64_t nv = count(attribute(prim, "POSITION"));
     const std::uint64_t corners = prim.indices >= 0 ? count(prim.indices) : nv;

@@ -41,6 +41,9 @@ TEST(AbsurdInput, FrameSizesAndSamplesNameTheirLimit) {
   e = refused("inspect --width 16384 --height 16384 -q -o out", dir);
   EXPECT_TRUE(contains(e, "at most 8388608 (2^23)")) << e;
   e = refused("render -t reference --width 1 --height 1 --spp 1000000000 -q -o x.png", dir);
+  EXPECT_TRUE(contains(e, "--spp")) << e;
+  EXPECT_TRUE(contains(e, "65536")) << e;
+  e = refused("render -t reference --width 4096 --height 4096 --spp 65536 -q -o x.png", dir);
   EXPECT_TRUE(contains(e, "reference takes at most 67108864 (2^26)")) << e;
   e = refused("render -t yu-lod --width 1 --height 1 --spp 1000000000 -q -o x.png", dir);
   EXPECT_TRUE(contains(e, "--spp")) << e;
@@ -79,6 +82,12 @@ TEST(AbsurdInput, FileCountsNameTheirLimit) {
                                                          "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]}", 1) +
                               " --width 1 --height 1 -q -o x.png",
                           dir);
+  EXPECT_TRUE(contains(e, "absurd count 2147483648 (more than the limit of 2^28)")) << e;
+  // 2^27 elements (within an accessor's limit) in the same buffer.
+  e = refused("render " + gltf("short.gltf", "{\"bufferView\":0,\"componentType\":5126,\"count\":134217728,"
+                                             "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]}", 1) +
+                  " --width 1 --height 1 -q -o x.png",
+              dir);
   EXPECT_TRUE(contains(e, "more than the limit of 33554432 vertices (2^25)")) << e;
   // 2^28 - 1 zeros from no bytes at all (an accessor without a bufferView).
   e = refused("render " + gltf("zeros.gltf", "{\"componentType\":5126,\"count\":268435455,\"type\":\"VEC3\","

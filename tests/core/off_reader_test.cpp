@@ -113,7 +113,9 @@ TEST(OffReader, BinaryBigEndian) {
   EXPECT_EQ(m.short_faces, 1u);
   // Truncated, absurd counts, a corner count past the data, an index out of range.
   EXPECT_EQ(problem(head + counts + verts + faces.substr(0, 10)),
-            "binary OFF data truncated: the file ends before face 0's corners");
+            "OFF face 0 claims 3 corners but the file holds only 6 more bytes");
+  EXPECT_EQ(problem(head + counts + verts + faces.substr(0, 24)),
+            "binary OFF data truncated: the file ends before face 0's colour");
   EXPECT_EQ(problem(head + big_endian({0x7fffffff, 1, 0}) + verts),
             "header declares 2147483647 vertices but the file has only 69 bytes");
   EXPECT_EQ(problem(head + counts + verts + big_endian({0x40000000, 0, 1, 2})),
@@ -137,10 +139,11 @@ TEST(OffReader, MalformedFilesNameTheProblem) {
   EXPECT_EQ(problem("PLY\n"), "missing OFF header (neither the OFF keyword nor a vertex count comes first)");
   EXPECT_EQ(problem("XOFF\n3 1 0\n"), "OFF header: 'XOFF' is not an OFF keyword ([ST][C][N][4][n]OFF)");
   EXPECT_EQ(problem("OFF\n3 x 0\n"), "OFF header: the face count 'x' is not a whole number below 10^12");
-  EXPECT_EQ(problem("OFF\n3 1\n" + v), "OFF header: the edge count '0' is not a whole number below 10^12");
+  // Free-form white space: a missing edge count takes the first coordinate's place.
+  EXPECT_EQ(problem("OFF\n3 1\n" + v), "OFF data truncated: the file ends before vertex 2");
   // Absurd counts are refused from the header, before anything is reserved.
-  EXPECT_EQ(problem("OFF\n1000000000 1 0\n0 0 0\n"), "header declares 1000000000 vertices but the file has only 31 bytes");
-  EXPECT_EQ(problem("OFF\n3 1000000000 0\n" + v), "header declares 1000000000 faces but the file has only 38 bytes");
+  EXPECT_EQ(problem("OFF\n1000000000 1 0\n0 0 0\n"), "header declares 1000000000 vertices but the file has only 25 bytes");
+  EXPECT_EQ(problem("OFF\n3 1000000000 0\n" + v), "header declares 1000000000 faces but the file has only 37 bytes");
   EXPECT_EQ(problem("OFF\n3 1 0\n" + v + "400000000 0 1 2\n"),
             "OFF face 0 claims 400000000 corners but the file holds only 7 more bytes");
   EXPECT_EQ(problem("OFF\n3 1 0\n" + v + "-50 0 1 2\n"), "OFF face 0 has a negative corner count '-50'");
@@ -153,9 +156,12 @@ TEST(OffReader, MalformedFilesNameTheProblem) {
             "OFF data truncated: the file ends before face 0 (the header declares 1 faces)");
   EXPECT_EQ(problem("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1\n"), "OFF data truncated: the file ends before vertex 2");
   EXPECT_EQ(problem("OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n"), "OFF vertex 1: 'zero' is not a number");
-  // Two faces on one line: the second face's values are read as the first one's colour.
+  // Two faces on one line: the second face's values are read as the first one's colour (at
+  // most 4 numbers), and the second face is missing.
   EXPECT_EQ(problem("OFF\n3 2 0\n" + v + "3 0 1 2 3 2 1 0\n"),
-            "OFF face 0: '0' after its corners is not part of a colour (0 to 4 numbers to the end of the line)");
+            "OFF data truncated: the file ends before face 1 (the header declares 2 faces)");
+  EXPECT_EQ(problem("OFF\n3 2 0\n" + v + "3 0 1 2 4 2 1 0 9\n"),
+            "OFF face 0: '9' after its corners is not part of a colour (0 to 4 numbers to the end of the line)");
   EXPECT_EQ(problem("COFF\n3 1 0\n0 0 0 1 1 1 1 1\n1 0 0\n0 1 0\n3 0 1 2\n"), "OFF vertex 0: more than 4 colour values");
 }
 
