@@ -64,7 +64,8 @@ AccessorView checked_accessor(const tinygltf::Model& model, int index, const std
       component_types.end())
     fail("has the wrong componentType " + std::to_string(acc.componentType) +
          " for this attribute");
-  if (acc.count > kMaxAccessorCount) fail("has an absurd count " + std::to_string(acc.count));
+  if (acc.count > kMaxAccessorCount)
+    fail("has an absurd count " + std::to_string(acc.count) + " (more than the limit of 2^28)");
   if (acc.sparse.isSparse) fail("is sparse (sparse accessors are not supported)");
 
   AccessorView view;

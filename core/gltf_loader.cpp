@@ -30,7 +30,6 @@ namespace speculum {
 namespace {
 
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{2} << 30;  // tinygltf takes 32-bit sizes
-constexpr std::size_t kMaxTriangles = std::size_t{1} << 27;         // 134M: absurd beyond
 
 std::string one_line(std::string s) {
   for (char& c : s)
@@ -161,8 +160,8 @@ struct Loader {
     const std::vector<float> pos = gltf::read_floats(pos_view);
     for (std::size_t i = 0; i < pos.size(); ++i)
       if (!std::isfinite(pos[i]))
-        throw InputError(path, what + " vertex " + std::to_string(i / 3) +
-                                   " has a NaN or infinite position");
+        throw InputError(path, what + ": non-finite vertex " + std::to_string(i / 3) +
+                                   " (NaN or infinite position)");
     std::vector<glm::vec3> p(nv);
     for (std::size_t i = 0; i < nv; ++i) p[i] = {pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
     return p;
@@ -353,6 +352,29 @@ struct Loader {
     }
   }
 
+  [[noreturn]] void too_many(const char* what, std::uint64_t limit, int log2) const {
+    throw InputError(path, "the scene holds more than the limit of " + std::to_string(limit) + " " + what + " (2^" +
+                               std::to_string(log2) + ")");
+  }
+
+  // The scene's totals with this primitive, from its accessors' counts before anything is
+  // read: each instance of a mesh adds its vertices again, so a small file could otherwise
+  // claim any amount (an accessor with no bufferView is count zeros, from no bytes at all).
+  void check_counts(const tinygltf::Primitive& prim, int mode) const {
+    // A count past gltf::kMaxAccessorCount is left to checked_accessor, which names it.
+    auto count = [&](int accessor) -> std::uint64_t {
+      if (accessor < 0 || static_cast<std::size_t>(accessor) >= model.accessors.size()) return 0;
+      const std::uint64_t n = model.accessors[static_cast<std::size_t>(accessor)].count;
+      return n > gltf::kMaxAccessorCount ? 0 : n;
+    };
+    const std::uint64_t nv = count(attribute(prim, "POSITION"));
+    const std::uint64_t corners = prim.indices >= 0 ? count(prim.indices) : nv;
+    // A list makes corners/3 triangles; a strip or fan corners-2.
+    const std::uint64_t tris = mode == TINYGLTF_MODE_TRIANGLES ? corners / 3 : (corners > 2 ? corners - 2 : 0);
+    if (scene.mesh.vertex_count() + nv > kMaxSceneVertices) too_many("vertices", kMaxSceneVertices, 25);
+    if (scene.mesh.triangle_count() + tris > kMaxSceneTriangles) too_many("triangles", kMaxSceneTriangles, 24);
+  }
+
   // Converts one primitive instance into a scene object (skipped, with a warning, when it
   // has no triangles).
   void add_primitive(std::size_t mesh_index, std::size_t prim_index, const glm::mat4& world,
@@ -364,6 +386,7 @@ struct Loader {
                              " primitive " + std::to_string(prim_index);
     const int mode = triangle_mode(prim, what);
     if (mode < 0) return;
+    check_counts(prim, mode);
     PrimitiveGeometry g;
     g.p = read_positions(prim, what);
     const std::size_t nv = g.p.size();
@@ -372,8 +395,7 @@ struct Loader {
       warn(what + ": no triangles");
       return;
     }
-    if (scene.mesh.triangle_count() + g.tris.size() / 3 > kMaxTriangles)
-      throw InputError(path, "more than " + std::to_string(kMaxTriangles) + " triangles");
+    if (scene.mesh.triangle_count() + g.tris.size() / 3 > kMaxSceneTriangles) too_many("triangles", kMaxSceneTriangles, 24);
     g.n = read_normals(prim, g.p, g.tris, what);
     g.uv0 = read_uv(prim, "TEXCOORD_0", nv, what);
     g.uv1 = read_uv(prim, "TEXCOORD_1", nv, what);

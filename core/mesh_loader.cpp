@@ -1,6 +1,7 @@
-// PLY/OFF/STL through OpenMesh, OBJ through core/obj_loader.h (see mesh_loader.h). Headers with element counts are
-// checked against the file size first, so an absurd count cannot make OpenMesh reserve
-// gigabytes; OpenMesh's own stream logging is silenced (the CLI prints one line).
+// PLY/STL through OpenMesh, OFF through our own reader (core/off_reader.h), OBJ through
+// core/obj_loader.h (see mesh_loader.h). PLY and STL headers with element counts are checked
+// against the file size first, so an absurd count cannot make OpenMesh reserve gigabytes;
+// OpenMesh's own stream logging is silenced (the CLI prints one line).
 #include "core/mesh_loader.h"
 
 #include <algorithm>
@@ -8,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <regex>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -23,11 +24,14 @@
 #include "core/error.h"
 #include "core/mesh_normals.h"
 #include "core/obj_loader.h"
+#include "core/off_reader.h"
 
 namespace speculum {
 namespace {
 
 using OmMesh = OpenMesh::TriMesh_ArrayKernelT<>;
+
+constexpr std::uintmax_t kMaxOffFileBytes = std::uintmax_t{2} << 30;
 
 std::string lower_ext(const std::string& path) {
   std::string e = std::filesystem::path(path).extension().string();
@@ -41,9 +45,11 @@ struct PlyProperty {
   int count_bytes = 0;  // list: size of the count's type
   int item_bytes = 0;   // the scalar's size, or each list item's
   bool count_signed = false;
+  bool coordinate = false;  // x, y or z of a vertex
 };
 struct PlyElement {
   unsigned long long count = 0;
+  bool vertex = false;
   std::vector<PlyProperty> properties;
 };
 struct PlyLayout {
@@ -102,20 +108,26 @@ PlyLayout check_ply_header(const std::string& path, std::istream& in, std::uintm
       if (n > size / (binary ? 1 : 2))
         throw InputError(path, "header declares " + w[2] + " " + w[1] + " elements but the file has only " +
                                    std::to_string(size) + " bytes");
+      if ((w[1] == "vertex" && n > kMaxSceneVertices) || (w[1] == "face" && n > kMaxSceneTriangles))
+        throw InputError(path, "header declares " + w[2] + " " + w[1] + " elements: more than the limit of " +
+                                   std::to_string(w[1] == "vertex" ? kMaxSceneVertices : kMaxSceneTriangles) +
+                                   (w[1] == "vertex" ? " (2^25)" : " (2^24)"));
       element = true;
-      layout.elements.push_back({n, {}});
+      layout.elements.push_back({n, w[1] == "vertex", {}});
       vertex = vertex || w[1] == "vertex";
       face = face || w[1] == "face";
     } else if (w[0] == "property") {
       if (!element) bad();
       if (w.size() == 3) {
         if (!kTypes.count(w[1])) bad();
-        layout.elements.back().properties.push_back({false, 0, ply_type_bytes(w[1]), false});
+        layout.elements.back().properties.push_back(
+            {false, 0, ply_type_bytes(w[1]), false,
+             layout.elements.back().vertex && (w[2] == "x" || w[2] == "y" || w[2] == "z")});
       } else if (w.size() == 5 && w[1] == "list") {
         if (!kTypes.count(w[2]) || !kTypes.count(w[3])) bad();
         if (w[2] == "float" || w[2] == "double" || w[2] == "float32" || w[2] == "float64") bad();
         layout.elements.back().properties.push_back(
-            {true, ply_type_bytes(w[2]), ply_type_bytes(w[3]), w[2][0] != 'u'});
+            {true, ply_type_bytes(w[2]), ply_type_bytes(w[3]), w[2][0] != 'u', false});
       } else {
         bad();
       }
@@ -141,6 +153,15 @@ void check_ply_body(const std::string& path, std::istream& in, const PlyLayout& 
       for (unsigned long long i = 0; i < e.count; ++i)
         for (const PlyProperty& p : e.properties) {
           if (!(in >> tok)) truncated("fewer values than the header declares");
+          if (p.coordinate) {
+            // OpenMesh's stream read stops at a value past a float's range and the faces go
+            // unread ("no faces"): name the vertex instead.
+            char* stop = nullptr;
+            const double x = std::strtod(tok.c_str(), &stop);
+            if (*stop == '\0' && !(std::fabs(x) < double(std::numeric_limits<float>::max())))
+              throw InputError(path, "non-finite vertex " + std::to_string(i) + " (coordinate '" + tok.substr(0, 20) +
+                                         "' is NaN, infinite or overflows a float)");
+          }
           if (!p.list) continue;
           if (tok.empty() || tok.size() > 9 || tok.find_first_not_of("0123456789") != std::string::npos)
             throw InputError(path, "PLY list count '" + tok.substr(0, 20) + "' is not a whole number below 10^9");
@@ -191,94 +212,7 @@ void check_ply_body(const std::string& path, std::istream& in, const PlyLayout& 
 void check_declared_counts(const std::string& path, const std::string& ext, std::uintmax_t size) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open file");
-  auto too_many = [&](unsigned long long n, const char* what, unsigned long long min_bytes) {
-    if (n > size / min_bytes)
-      throw InputError(path, std::string("header declares ") + std::to_string(n) + " " + what +
-                                 " but the file has only " + std::to_string(size) + " bytes");
-  };
-  if (ext == ".off") {
-    // The first line is the keyword alone, "[ST][C][N][4][n]OFF" (Geomview's OFF), or it and
-    // BINARY: OpenMesh reads the counts from the lines after it, so a keyword line with
-    // anything else on it would leave them unread.
-    std::string first_line;
-    std::getline(in, first_line);
-    std::istringstream fl(first_line);
-    std::string magic, binary_word, extra;
-    fl >> magic >> binary_word >> extra;
-    static const std::regex kKeyword("(ST)?C?N?4?n?OFF");
-    if (!std::regex_match(magic, kKeyword)) {
-      if (magic.find("OFF") == std::string::npos) throw InputError(path, "missing OFF header");
-      throw InputError(path, "OFF header: '" + magic.substr(0, 20) + "' is not an OFF keyword ([ST][C][N][4][n]OFF)");
-    }
-    // Texture coordinates (ST), 4D (4) and n-dimensional (n) vertices are refused: OpenMesh's
-    // reading of them does not follow the values the header implies (a fuzzed STOFF file made
-    // it read a coordinate as a corner count and exhaust memory), so they cannot be checked.
-    if (magic.find("ST") != std::string::npos || magic.find('4') != std::string::npos ||
-        magic.find('n') != std::string::npos)
-      throw InputError(path, "OFF variant '" + magic + "' is not supported (OFF, COFF, NOFF and CNOFF are)");
-    if ((!binary_word.empty() && binary_word != "BINARY") || !extra.empty())
-      throw InputError(path, "OFF header: the first line must hold only the keyword (and BINARY)");
-    if (binary_word.empty()) {
-      // The counts "nv nf ne" follow the keyword ("[ST][C][N][4][n]OFF"; nOFF first gives the
-      // dimension), after any '#' comment lines. Every variant's counts are checked: OpenMesh
-      // reserves what they claim.
-      auto next = [&](std::string& tok) {
-        while (in >> tok) {
-          if (tok[0] != '#') return true;
-          std::string rest;
-          std::getline(in, rest);
-        }
-        return false;
-      };
-      auto whole = [&](const char* what) {
-        std::string tok;
-        if (!next(tok) || tok.size() > 12 || tok.find_first_not_of("0123456789") != std::string::npos)
-          throw InputError(path, std::string("OFF header: the ") + what + " is not a whole number");
-        return std::stoull(tok);
-      };
-      if (magic.find('n') != std::string::npos) (void)whole("dimension");
-      const unsigned long long nv = whole("vertex count");
-      const unsigned long long nf = whole("face count");
-      (void)whole("edge count");  // read by OpenMesh too, so the walk below starts where it does
-      too_many(nv, "vertices", 6);
-      too_many(nf, "faces", 2);
-      // OpenMesh reads the vertices and then the faces as a stream of values (a vertex with
-      // colours from its own line), each face a corner count and that many indices, trusting
-      // the count: a face claiming 444400000 corners, or -50, made it append handles until
-      // memory ran out. Each count must be >= 0 and fit in the values left in the file. A
-      // value that is not a whole number means the faces carry colours, which OpenMesh parses
-      // its own way: the walk stops there.
-      const bool colours = magic.find('C') != std::string::npos;
-      const std::size_t per_vertex = (magic.find('n') != std::string::npos ? 0 : magic.find('4') != std::string::npos ? 4 : 3) +
-                                     (magic.find('N') != std::string::npos ? 3 : 0) +
-                                     (magic.starts_with("ST") ? 2 : 0);
-      std::string line;
-      if (colours || per_vertex < 3) {
-        std::getline(in, line);  // the rest of the counts line
-        for (unsigned long long left = nv; left > 0 && std::getline(in, line);) {
-          std::istringstream ls(line);
-          std::string first;
-          if ((ls >> first) && first[0] != '#') --left;
-        }
-      }
-      std::vector<std::string> values;
-      for (std::string t; in >> t;) values.push_back(std::move(t));
-      std::size_t at = 0;
-      if (!(colours || per_vertex < 3)) at = static_cast<std::size_t>(std::min<unsigned long long>(nv * per_vertex, values.size()));
-      for (unsigned long long f = 0; f < nf && at < values.size(); ++f) {
-        const std::string& count = values[at++];
-        if (count.size() > 1 && count[0] == '-' && count.find_first_not_of("0123456789", 1) == std::string::npos)
-          throw InputError(path, "OFF face " + std::to_string(f) + " has a negative corner count " + count.substr(0, 20));
-        if (count.size() > 12 || count.find_first_not_of("0123456789") != std::string::npos) break;
-        const unsigned long long n = std::stoull(count);
-        if (n > values.size() - at)
-          throw InputError(path, "OFF face " + std::to_string(f) + " claims " + count +
-                                     " corners but the file holds only " + std::to_string(values.size() - at) +
-                                     " more values");
-        at += static_cast<std::size_t>(n);
-      }
-    }
-  } else if (ext == ".ply") {
+  if (ext == ".ply") {
     const PlyLayout layout = check_ply_header(path, in, size);
     check_ply_body(path, in, layout);
   } else if (ext == ".stl") {
@@ -289,6 +223,9 @@ void check_declared_counts(const std::string& path, const std::string& ext, std:
       if (in.gcount() < 84) throw InputError(path, "truncated binary STL header");
       std::uint32_t n = 0;
       std::memcpy(&n, head + 80, 4);
+      if (n > kMaxSceneTriangles)
+        throw InputError(path, "binary STL declares " + std::to_string(n) + " triangles: more than the limit of " +
+                                   std::to_string(kMaxSceneTriangles) + " (2^24)");
       if (84 + 50ull * n > size)
         throw InputError(path, "binary STL declares " + std::to_string(n) +
                                    " triangles but the file is truncated");
@@ -341,8 +278,11 @@ void copy_positions_and_triangles(const std::string& path, const OmMesh& om, Tri
   for (auto vh : om.vertices()) {
     const auto& p = om.point(vh);
     const glm::vec3 q(p[0], p[1], p[2]);
-    if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z))
-      throw InputError(path, "vertex " + std::to_string(vh.idx()) + " has a NaN or infinite position");
+    // A stream stores +-FLT_MAX for a value past a float's range: overflow, as infinity is.
+    constexpr float kMax = std::numeric_limits<float>::max();
+    if (!(std::fabs(q.x) < kMax && std::fabs(q.y) < kMax && std::fabs(q.z) < kMax))
+      throw InputError(path, "non-finite vertex " + std::to_string(vh.idx()) +
+                                 " (a coordinate is NaN, infinite or overflows a float)");
     mesh.positions.push_back(q);
   }
   for (auto fh : om.faces()) {
@@ -396,6 +336,48 @@ void copy_uvs(const OmMesh& om, const OpenMesh::IO::Options& opt, TriangleMesh& 
   }
 }
 
+// OFF through core/off_reader.h. OpenMesh's OFF reader trusts the corner count of every face
+// and walks vertex values its own way (a fuzzed file made it append handles until memory ran
+// out), so no guard in front of it could be proven to bound what it allocates; our reader
+// checks every count against the bytes left before reserving anything.
+void load_off_mesh(const std::string& path, std::uintmax_t size, TriangleMesh& mesh, LoadReport* report) {
+  if (size > kMaxOffFileBytes) throw InputError(path, "file is too large (over 2 GiB)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open file");
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(size));
+  bytes.resize(static_cast<std::size_t>(in.gcount()));
+  OffMesh off = read_off(path, bytes);
+  bytes = std::string();
+  if (off.indices.empty())
+    throw InputError(path, off.faces == 0 ? "contains no faces"
+                                          : "contains no triangles (every face has fewer than 3 distinct corners)");
+  if (report && off.short_faces)
+    report->warn(std::to_string(off.short_faces) + " faces with fewer than 3 corners left out");
+  if (report && off.degenerate_triangles)
+    report->warn(std::to_string(off.degenerate_triangles) + " triangles repeating a corner left out");
+  mesh.positions = std::move(off.positions);
+  mesh.indices = std::move(off.indices);
+  bool file_normals = !off.normals.empty();
+  for (glm::vec3& n : off.normals) {
+    const float len = glm::length(n);
+    if (!(len > 1e-6f) || !std::isfinite(len)) {
+      file_normals = false;
+      if (report) report->warn("bad normals in file, recomputed");
+      break;
+    }
+    n /= len;
+  }
+  mesh.normals = file_normals ? std::move(off.normals) : area_weighted_normals(mesh.positions, mesh.indices);
+  if (off.uvs.empty()) {
+    mesh.uvs.assign(mesh.positions.size(), glm::vec2(0.0f));
+  } else {
+    for (glm::vec2& uv : off.uvs)
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
+    mesh.uvs = std::move(off.uvs);
+  }
+}
+
 // These formats carry no materials: the whole mesh is one object (named after the file)
 // with one default material.
 void add_single_object(const std::string& path, Scene& scene) {
@@ -418,8 +400,16 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
     finish_scene(scene);
     return scene;
   }
-  static const SilenceOpenMesh silence;
   const std::uintmax_t size = checked_file_size(path);
+  if (lower_ext(path) == ".off") {
+    Scene scene;
+    scene.name = path;
+    load_off_mesh(path, size, scene.mesh, report);
+    add_single_object(path, scene);
+    finish_scene(scene);
+    return scene;
+  }
+  static const SilenceOpenMesh silence;
   check_declared_counts(path, lower_ext(path), size);
   OmMesh om;
   OpenMesh::IO::Options opt;

@@ -1,4 +1,4 @@
-// PLY / OFF / STL meshes through OpenMesh: one object, one default material, normals from
+// PLY / STL meshes through OpenMesh, OFF through core/off_reader.h: one object, one default material, normals from
 // the file or computed (area-weighted). OBJ, which carries materials, goes to load_obj
 // (core/obj_loader.h).
 #pragma once

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -260,9 +261,10 @@ void check_vertex_lines(const std::string& path, const std::string& text) {
       for (int k = 0; k < 3 && ls >> token; ++k) {
         char* stop = nullptr;
         const double x = std::strtod(token.c_str(), &stop);
-        if (stop == token.c_str() || !std::isfinite(x))
-          throw InputError(path, "vertex " + std::to_string(vertex) +
-                                     " has a NaN, infinite or unreadable coordinate '" + token.substr(0, 20) + "'");
+        // A value past a float's range overflows to infinity when tinyobjloader reads it.
+        if (stop == token.c_str() || !(std::fabs(x) < double(std::numeric_limits<float>::max())))
+          throw InputError(path, "non-finite vertex " + std::to_string(vertex) + ": coordinate '" + token.substr(0, 20) +
+                                     "' is NaN, infinite, past a float's range or unreadable");
       }
     }
     at = end + 1;
@@ -329,7 +331,7 @@ Scene load_obj(const std::string& path, LoadReport& report) {
                     nt = attrib.texcoords.size() / 2;
   for (std::size_t i = 0; i < attrib.vertices.size(); ++i)
     if (!std::isfinite(attrib.vertices[i]))
-      throw InputError(path, "vertex " + std::to_string(i / 3 + 1) + " has a NaN or infinite position");
+      throw InputError(path, "non-finite vertex " + std::to_string(i / 3 + 1) + " (NaN or infinite position)");
 
   // Scene materials for the .mtl materials in use, in .mtl order; -1 and unknown: default.
   MtlConverter converter(path, dir, reader, scene, report);

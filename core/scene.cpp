@@ -77,7 +77,7 @@ void Scene::validate() const {
   for (std::size_t i = 0; i < nv; ++i) {
     const glm::vec3& p = m.positions[i];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw InputError(name, "vertex " + std::to_string(i) + " has a NaN or infinite position");
+      throw InputError(name, "non-finite vertex " + std::to_string(i) + " (NaN or infinite position)");
     const glm::vec3& n = m.normals[i];
     if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
       throw InputError(name, "vertex " + std::to_string(i) + " has a NaN or infinite normal");

@@ -133,6 +133,12 @@ bool is_builtin_scene_name(const std::string& file_or_name) {
 }
 
 void finish_scene(Scene& scene) {
+  if (scene.mesh.triangle_count() > kMaxSceneTriangles)
+    throw InputError(scene.name, std::to_string(scene.mesh.triangle_count()) + " triangles: more than the limit of " +
+                                     std::to_string(kMaxSceneTriangles) + " (2^24)");
+  if (scene.mesh.vertex_count() > kMaxSceneVertices)
+    throw InputError(scene.name, std::to_string(scene.mesh.vertex_count()) + " vertices: more than the limit of " +
+                                     std::to_string(kMaxSceneVertices) + " (2^25)");
   if (scene.materials.empty()) scene.materials.push_back(default_material());
   if (scene.cameras.empty()) scene.cameras.push_back(framing_camera(scene.bounds()));
   for (const Camera& c : scene.cameras) validate_camera(c, scene.name);

@@ -18,8 +18,9 @@
 namespace speculum::pipeline {
 
 void add_frame_options(CLI::App& cmd, FrameOptions& o) {
-  cmd.add_option("scene", o.scene, "glTF/OBJ/PLY file or built-in scene name (default: the "
-                                   "default built-in scene)");
+  cmd.add_option("scene", o.scene, "glTF/OBJ/PLY/OFF/STL file or built-in scene NAME[:size=N] (size at most 10M; "
+                                   "default: the default built-in scene). Any scene holds at most 2^24 triangles "
+                                   "and 2^25 vertices, which bounds memory (a few GB)");
   cmd.add_option("--technique,-t", o.technique, "Technique (see `speculum techniques`)")
       ->capture_default_str();
   o.width_option =

@@ -2,9 +2,11 @@
 // stdout and stderr, and a scratch directory per test.
 #pragma once
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +20,7 @@ namespace speculum::test {
 struct CommandResult {
   int status = -1;
   std::string out, err;
+  long peak_rss_kb = -1;  // the largest resident set of the command's processes (wait4's ru_maxrss)
 };
 
 inline std::string slurp(const std::filesystem::path& p) {
@@ -48,8 +51,21 @@ inline std::string sh_quote(const std::string& s) {
 inline CommandResult run_shell(const std::string& command, const std::filesystem::path& dir) {
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
   const std::string cmd = command + " >" + sh_quote(out.string()) + " 2>" + sh_quote(err.string());
-  const int raw = std::system(cmd.c_str());
+  // fork + wait4 rather than std::system: the child's rusage gives its peak memory (the
+  // shell's, or the largest of the processes it waited for).
   CommandResult r;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int raw = -1;
+  struct rusage usage {};
+  if (pid > 0) {
+    while (::wait4(pid, &raw, 0, &usage) < 0 && errno == EINTR) {
+    }
+    r.peak_rss_kb = usage.ru_maxrss;
+  }
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   r.out = slurp(out);
   r.err = slurp(err);

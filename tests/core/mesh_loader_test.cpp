@@ -88,7 +88,7 @@ TEST(MeshLoader, FaceCornerCountsMustFitInTheFile) {
   EXPECT_EQ(problem(binary_ply("char", std::string(1, '\xff'))), "PLY list count is negative");
   const fs::path off = dir / "tri.off";
   std::ofstream(off) << "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n400000000 0 1\n";
-  EXPECT_EQ(problem(off.string()), "OFF face 1 claims 400000000 corners but the file holds only 2 more values");
+  EXPECT_EQ(problem(off.string()), "OFF face 1 claims 400000000 corners but the file holds only 5 more bytes");
   std::ofstream(off) << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   EXPECT_EQ(load_scene(off.string()).mesh.triangle_count(), 1u);
   fs::remove_all(dir);
