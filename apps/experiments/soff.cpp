@@ -38,6 +38,9 @@ struct SoffExperimentOptions {
   bool sweeps = false;
   bool quick = false;
   bool json = false;
+  std::string images;
+  std::vector<std::string> params;  // soff's --param name=value (the path rows)
+  std::map<std::string, double> soff_params;  // parsed               // write each frame's soff / exact / difference images here
 };
 
 // SOFF's scenes (§4): the living room with 25 reflectors at ~290K triangles and the bathroom at ~90K.
@@ -116,8 +119,9 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
     // Frames spread evenly over the path (the first and the last key included).
     const int index = frames == 1 ? 0 : int(std::lround(double(k) * double(path.frames - 1) / double(frames - 1)));
     const Camera cam = path.at(index);
-    const pipeline::FrameSettings f =
-        settings_for(cam, o.width, o.supersample, {{"glossy_rays", o.glossy_rays}}, "soff");
+    std::map<std::string, double> soff_params = o.soff_params;
+    soff_params["glossy_rays"] = o.glossy_rays;
+    const pipeline::FrameSettings f = settings_for(cam, o.width, o.supersample, soff_params, "soff");
     const pipeline::FrameResult soff = run(scene, "soff", f, ex);
     const par::RunReport& r = soff.report;
     ms.push_back(double(r.duration_ns) * 1e-6);
@@ -146,6 +150,20 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
         run(scene, "specular-reference",
             settings_for(cam, o.width, o.supersample, {{"glossy_samples", o.glossy_samples}}, "specular-reference"), ex);
     const SpecularError e = specular_mae8(scene, cam, soff.display, exact.display, ex);
+    if (!o.images.empty()) {
+      // SOFF Fig. 8: the two images and their absolute 8-bit difference, scaled by 8.
+      std::string stem = o.images + "/" + scene_name.substr(0, scene_name.find(':')) + "_" + path.name + "_" +
+                         std::to_string(index);
+      ImageRGBA diff(soff.display.width, soff.display.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+      for (std::size_t i = 0; i < diff.pixels.size(); ++i)
+        for (int ch = 0; ch < 3; ++ch) {
+          const int d = std::abs(display_to_8bit(soff.display.pixels[i][ch]) - display_to_8bit(exact.display.pixels[i][ch]));
+          diff.pixels[i][ch] = srgb_to_linear(std::min(1.0f, 8.0f * float(d) / 255.0f));
+        }
+      write_image(stem + "_soff.png", soff.display);
+      write_image(stem + "_exact.png", exact.display);
+      write_image(stem + "_diff8.png", diff);
+    }
     mae.push_back(e.all), mae_mirror.push_back(e.mirror), mae_glossy.push_back(e.glossy);
     if (k == 0 && o.reference_spp > 0) {
       pipeline::FrameSettings rf = settings_for(cam, o.width, 1, {}, "reference");
@@ -226,6 +244,18 @@ void run_soff_experiment(SoffExperimentOptions o, const GlobalOptions& global) {
     o.width = std::min(o.width, 256);
     o.glossy_samples = std::min(o.glossy_samples, 16);
   }
+  for (const std::string& item : o.params) {
+    const auto eq = item.find('=');
+    char* end = nullptr;
+    const std::string text = eq == std::string::npos ? "" : item.substr(eq + 1);
+    const double v = std::strtod(text.c_str(), &end);
+    if (eq == std::string::npos || eq == 0 || text.empty() || *end != '\0' || !std::isfinite(v))
+      throw InputError("--param", "expected name=number, got '" + item + "'");
+    if (item.substr(0, eq) == "glossy_rays")
+      throw InputError("--param glossy_rays", "use --glossy-rays (the trace columns use the same count)");
+    o.soff_params[item.substr(0, eq)] = v;
+  }
+  pipeline::check_technique_params(pipeline::find_technique("soff"), o.soff_params);
   const std::vector<std::string>& scenes = o.scenes.empty() ? kScenes : o.scenes;
   // Resolve every scene's paths before rendering anything: a bad name fails at once.
   std::vector<std::pair<std::string, std::vector<CameraPath>>> work;
@@ -300,6 +330,11 @@ void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global)
   cmd->add_option("--reference-spp", o->reference_spp,
                   "Path-traced reference samples for mae8_frame (first frame of each path; 0: skip)")
       ->check(CLI::Range(0, 4096))->capture_default_str();
+  cmd->add_option("--param", o->params, "soff parameter name=value for the path rows, repeatable (see `speculum techniques`)");
+  cmd->add_option("--images", o->images,
+                  "Write each frame's soff and exact-specular images and their 8-bit difference ×8 "
+                  "(SOFF Fig. 8) into this existing directory")
+      ->check(CLI::ExistingDirectory);
   cmd->add_flag("--sweeps", o->sweeps, "Add the Table 3/4/5/8 sweeps on the first frame of the first path");
   cmd->add_flag("--quick", o->quick, "One scene (bathroom), one path, 4 frames, 256² (tests and smoke checks)");
   cmd->add_flag("--json", o->json, "One JSON object per row instead of the text table");
