@@ -324,11 +324,12 @@ SoffCameras soff_cameras(par::Executor& executor, const GBuffer& g, const SoffCl
         reflected[k] = reflect(-g.view_direction(i), nrm);
         const SurfaceParams& s = g.surface.pixels[i];
         if (s.is_glossy_lobe()) {
-          // The GGX lobe's reflected directions: P(tan θ_h > kα) = 1/(1 + k²), so 99% of the
-          // half vectors lie within tan θ_h = 10α, and the reflected direction turns by 2θ_h.
-          // (At 3α, 90%, the lobe's tail rays left the frame and took the environment.)
+          // The GGX lobe's reflected directions: P(tan θ_h > kα) = 1/(1 + k²), so 96% of the
+          // half vectors lie within tan θ_h = 5α, and the reflected direction turns by 2θ_h.
+          // (At 3α, 90%, more tail rays leave the frame and take the environment; at 10α the
+          // wider frame spreads the depth image's pixels too thin on small glossy objects.)
           const float alpha = s.roughness * s.roughness;
-          cone = std::max(cone, 2.0f * std::atan(10.0f * alpha));
+          cone = std::max(cone, 2.0f * std::atan(5.0f * alpha));
         }
         // Step 5's pairs: the right and lower neighbours that belong to the same cluster.
         const std::uint32_t x = i % std::uint32_t(g.width), y = i / std::uint32_t(g.width);
@@ -614,7 +615,7 @@ std::uint32_t soff_self_walk(const GBuffer& g, const glm::mat4& vp, const glm::v
   if (steps < 2) return kNoId;
   const glm::vec3 eye = g.eye;
   // The depth (along the view axis) of the segment and of the surface at step k.
-  float prev_gap = 0.0f;
+  float prev_gap = 0.0f, prev_surface = 0.0f, prev_ray = 0.0f;
   bool prev_valid = false;
   std::uint32_t taken = 0;
   for (int k = 2; k <= steps; ++k) {  // steps 0 and 1: the start's own sample and its neighbour
@@ -630,16 +631,15 @@ std::uint32_t soff_self_walk(const GBuffer& g, const glm::mat4& vp, const glm::v
     const float ray_depth = 1.0f / (ia + (ib - ia) * s);  // = clip w = view depth
     const float surface_depth = glm::dot(g.position.pixels[q] - eye, forward);
     const float gap = surface_depth - ray_depth;  // > 0: the segment is in front
-    if (prev_valid && prev_gap > 0.0f && gap <= 0.0f) {
-      // A crossing, unless the segment dived behind the surface by more than one step's
-      // depth change (it passed behind a silhouette of the reflector).
-      const float step_depth = std::abs(1.0f / (ia + (ib - ia) * (float(k - 1) / float(steps))) - ray_depth);
-      if (-gap <= 2.0f * step_depth + 1e-3f * ray_depth) {
-        if (steps_out) *steps_out = taken;
-        return std::uint32_t(q);
-      }
+    // A crossing from in front to behind, unless the segment dived behind the surface by
+    // more than the step's depth changes allow (it passed behind a silhouette of the
+    // reflector, where the surface jumps).
+    if (prev_valid && prev_gap > 0.0f && gap <= 0.0f &&
+        -gap <= 2.0f * (std::abs(ray_depth - prev_ray) + std::abs(surface_depth - prev_surface)) + 1e-3f * ray_depth) {
+      if (steps_out) *steps_out = taken;
+      return std::uint32_t(q);
     }
-    prev_gap = gap;
+    prev_gap = gap, prev_surface = surface_depth, prev_ray = ray_depth;
     prev_valid = true;
   }
   if (steps_out) *steps_out = taken;

@@ -190,7 +190,7 @@ struct SoffIntersectSettings {
   // is intersected with the reflector's own samples in the frame (the cluster and its
   // sibling clusters), walking the output image one sample at a time; a second
   // intersection takes the diffuse shading of the sample hit.
-  bool concave_self = true;
+  bool concave_self = false;
   Camera camera;  // the output camera (the G-buffer's projection), for concave_self
 };
 

@@ -19,6 +19,8 @@
 #include "core/image_metrics.h"
 #include "core/procedural_scenes.h"
 #include "core/scene_loader.h"
+#include "core/shading.h"
+#include "raster/soff.h"
 #include "raster/gbuffer.h"
 #include "raster/visibility.h"
 #include "trace/bvh.h"
@@ -87,6 +89,59 @@ SpecularError specular_mae8(const Scene& scene, const Camera& camera, const Imag
   return {mean(0), mean(1), mean(2)};
 }
 
+// The scene with every triangle of its reflectors (mirror and glossy materials) split into
+// four at its edge midpoints, attributes interpolated: the same shapes and shading with 4×
+// the reflector triangles (SOFF §4.2.1: the cost does not depend on the non-diffuse
+// triangles, which only reach the G-buffer).
+Scene with_reflectors_split(const Scene& in) {
+  Scene out = in;
+  const TriangleMesh& m = in.mesh;
+  TriangleMesh& o = out.mesh;
+  o.indices.clear(), o.triangle_material.clear(), o.triangle_object.clear();
+  const auto mid = [&](std::uint32_t a, std::uint32_t b) {
+    const auto index = static_cast<std::uint32_t>(o.positions.size());
+    o.positions.push_back(0.5f * (m.positions[a] + m.positions[b]));
+    const glm::vec3 n = m.normals[a] + m.normals[b];
+    o.normals.push_back(glm::length(n) > 0.0f ? glm::normalize(n) : m.normals[a]);
+    if (!m.tangents.empty()) {
+      const glm::vec3 t = glm::vec3(m.tangents[a]) + glm::vec3(m.tangents[b]);
+      o.tangents.push_back(glm::vec4(glm::length(t) > 0.0f ? glm::normalize(t) : glm::vec3(m.tangents[a]),
+                                     m.tangents[a].w));
+    }
+    o.uvs.push_back(0.5f * (m.uvs[a] + m.uvs[b]));
+    if (!m.uvs1.empty()) o.uvs1.push_back(0.5f * (m.uvs1[a] + m.uvs1[b]));
+    return index;
+  };
+  for (Object& obj : out.objects) {
+    const std::uint32_t first = obj.first_triangle, count = obj.triangle_count;
+    obj.first_triangle = static_cast<std::uint32_t>(o.triangle_count());
+    for (std::uint32_t t = first; t < first + count; ++t) {
+      const std::uint32_t a = m.indices[3 * t], b = m.indices[3 * t + 1], c = m.indices[3 * t + 2];
+      const std::uint32_t material = m.triangle_material[t], object = m.triangle_object[t];
+      const auto add = [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+        o.indices.insert(o.indices.end(), {x, y, z});
+        o.triangle_material.push_back(material);
+        o.triangle_object.push_back(object);
+      };
+      if (!raster::soff_reflects(surface_params(in.materials[material]))) {
+        add(a, b, c);
+        continue;
+      }
+      const std::uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      add(a, ab, ca), add(ab, b, bc), add(ca, bc, c), add(ab, bc, ca);
+    }
+    obj.triangle_count = static_cast<std::uint32_t>(o.triangle_count()) - obj.first_triangle;
+  }
+  out.validate();
+  return out;
+}
+
+std::size_t reflector_triangles(const Scene& scene) {
+  std::size_t n = 0;
+  for (std::uint32_t mat : scene.mesh.triangle_material) n += raster::soff_reflects(surface_params(scene.materials[mat]));
+  return n;
+}
+
 struct Frame {
   pipeline::FrameResult soff;
   double samples = 0;
@@ -145,10 +200,15 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
     const double build = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ms_rebuild.push_back(rebuild);
     ms_prebuilt.push_back(std::max(0.0, rebuild - build));
-    // The error against the exact specular layer with converged glossy lobes.
+    // The error against the exact specular layer: with as many lobe samples as soff's rays
+    // it is the frame just traced (the same rays: the depth images' error alone), with more
+    // the glossy lobes converge (soff's sampling noise included).
     const pipeline::FrameResult exact =
-        run(scene, "specular-reference",
-            settings_for(cam, o.width, o.supersample, {{"glossy_samples", o.glossy_samples}}, "specular-reference"), ex);
+        o.glossy_samples == o.glossy_rays
+            ? traced
+            : run(scene, "specular-reference",
+                  settings_for(cam, o.width, o.supersample, {{"glossy_samples", o.glossy_samples}}, "specular-reference"),
+                  ex);
     const SpecularError e = specular_mae8(scene, cam, soff.display, exact.display, ex);
     if (!o.images.empty()) {
       // SOFF Fig. 8: the two images and their absolute 8-bit difference, scaled by 8.
@@ -225,6 +285,8 @@ void sweep_row(const Scene& scene, const std::string& scene_name, const Camera& 
       .cell("sweep", sweep)
       .cell("value", value, 3)
       .cell("width", width)
+      .cell("triangles", std::int64_t(scene.mesh.triangle_count()))
+      .cell("reflector_triangles", std::int64_t(reflector_triangles(scene)))
       .cell("clusters", counter_of(r, "soff_clusters", "clusters"), 0)
       .cell("disocclusion_pct", 100.0 * counter_of(r, "soff_intersect", "disoccluded_samples") / samples, 3)
       .cell("depth_image_pixels", counter_of(r, "soff_cameras", "depth_image_pixels"), 0)
@@ -277,7 +339,7 @@ void run_soff_experiment(SoffExperimentOptions o, const GlobalOptions& global) {
     steps += paths.size() * std::size_t(o.frames);
     work.emplace_back(name, std::move(paths));
   }
-  if (o.sweeps) steps += 12;
+  if (o.sweeps) steps += 14;
   par::Executor ex(global.threads, global.lanes);
   ResultTable table(o.json);
   Progress progress("soff", steps, global.quiet);
@@ -301,6 +363,9 @@ void run_soff_experiment(SoffExperimentOptions o, const GlobalOptions& global) {
     sweep_row(scene, name, cam, "image_scale", s, o.width, {{"image_scale", s}}, o, ex, table, progress);
   for (int rays : {8, 49})  // Table 8: glossy rays per pixel
     sweep_row(scene, name, cam, "glossy_rays", rays, o.width, {{"glossy_rays", rays}}, o, ex, table, progress);
+  // Table 6 / §4.2.1: the reflectors' triangles × 4 (same shapes) change little.
+  sweep_row(scene, name, cam, "reflector_triangles", 1, o.width, {}, o, ex, table, progress);
+  sweep_row(with_reflectors_split(scene), name, cam, "reflector_triangles", 4, o.width, {}, o, ex, table, progress);
 }
 
 }  // namespace
@@ -312,7 +377,7 @@ void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global)
       "SOFF §4: per scene and camera path the specular error against the exact specular "
       "reference, the disocclusion pixels, clusters, the stage split and the speed against "
       "tracing the same rays with a BVH rebuilt per frame and prebuilt; --sweeps adds the "
-      "bins / output size / depth-image scale / glossy rays trends (Tables 3, 4, 5, 8).\n"
+      "bins / output size / depth-image scale / glossy rays / reflector triangles trends (Tables 3, 4, 5, 8, 6).\n"
       "Example: speculum experiment soff --quick --json");
   cmd->add_option("--scenes", o->scenes,
                   "Scenes with camera paths (default: living-room:size=240000:reflectors=25, bathroom)")

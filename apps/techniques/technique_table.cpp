@@ -115,7 +115,8 @@ const std::vector<Technique>& techniques() {
         {"glossy_far", 1, 0.05, 1, false, "glossy clusters' far plane at this × the scene diameter (§3.5)"},
         {"fill", 0, 0, 1, true, "disoccluded rays: 0 the environment (SOFF), 1 the depth image beside the silhouette"},
         {"reshade", 1, 0, 1, true, "1: a hit's view-dependent shading is re-evaluated for the ray; 0: the depth image's colour"},
-        {"concave", 1, 0, 1, true, "1: concave clusters' rays are first intersected with their own reflector (SOFF §4.4)"}}},
+        {"concave", 0, 0, 1, true,
+         "concave clusters (SOFF §4.4): 0 like convex ones, 1 rays first intersected with their own reflector"}}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",
