@@ -168,7 +168,7 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
               const SoffExperimentOptions& o, par::Executor& ex, ResultTable& table, Progress& progress) {
   const int frames = std::max(1, std::min(o.frames, path.frames));
   std::vector<double> ms, ms_cl, ms_cam, ms_di, ms_is, ms_rebuild, ms_prebuilt, mae, mae_mirror, mae_glossy, dis,
-      clusters;
+      clusters, mae_trace, mae_trace_glossy;
   double mae_frame = -1.0;
   for (int k = 0; k < frames; ++k) {
     // Frames spread evenly over the path (the first and the last key included).
@@ -225,6 +225,10 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
       write_image(stem + "_diff8.png", diff);
     }
     mae.push_back(e.all), mae_mirror.push_back(e.mirror), mae_glossy.push_back(e.glossy);
+    // The traced frame with soff's rays against the same reference: the sampling noise of
+    // N lobe rays that any method tracing them has (0 when the reference uses those rays).
+    const SpecularError et = specular_mae8(scene, cam, traced.display, exact.display, ex);
+    mae_trace.push_back(et.all), mae_trace_glossy.push_back(et.glossy);
     if (k == 0 && o.reference_spp > 0) {
       pipeline::FrameSettings rf = settings_for(cam, o.width, 1, {}, "reference");
       rf.spp = o.reference_spp;
@@ -250,6 +254,8 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
       .cell("mae8_specular", mae_avg, 2)
       .cell("mae8_mirror", mean(mae_mirror), 2)
       .cell("mae8_glossy", mean(mae_glossy), 2)
+      .cell("mae8_trace_specular", mean(mae_trace), 2)
+      .cell("mae8_trace_glossy", mean(mae_trace_glossy), 2)
       .cell("mae8_frame", mae_frame, 2)
       .cell("disocclusion_pct_avg", dis_avg, 3)
       .cell("disocclusion_pct_max", *std::max_element(dis.begin(), dis.end()), 3)
