@@ -7,7 +7,9 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/camera_rays.h"
 #include "core/optics.h"
+#include "core/shading.h"
 #include "core/sampling.h"
 #include "raster/direct_light.h"
 #include "raster/specular_radiance.h"
@@ -45,9 +47,9 @@ void soff_bin(const glm::vec3& n, float scale, const SoffBinSettings& bins, int&
                  bins.phi_bins - 1);
 }
 
-float soff_bin_scale(double percent, int visible) {
+float soff_bin_scale(double percent, int visible, double gain) {
   if (visible < 1) return 1.0f;
-  return static_cast<float>(std::min(1.0, percent / double(visible)));
+  return static_cast<float>(std::min(1.0, gain * percent / double(visible)));
 }
 
 SoffClusters soff_cluster(par::Executor& executor, const GBuffer& g, const SoffBinSettings& bins) {
@@ -73,7 +75,7 @@ SoffClusters soff_cluster(par::Executor& executor, const GBuffer& g, const SoffB
   std::vector<float> scale(visible_object.size());
   for (std::size_t k = 0; k < visible_object.size(); ++k)
     scale[k] = soff_bin_scale(100.0 * double(per_object[visible_object[k]]) / double(n),
-                              out.visible_reflectors);
+                              out.visible_reflectors, bins.share_gain);
   const std::uint32_t per_reflector = std::uint32_t(bins.theta_bins) * std::uint32_t(bins.phi_bins);
   // The fixed bin array: visible reflectors × θ bins × φ bins; each sample's bin is a pure
   // function of its own normal and reflector (SOFF §4.3: no neighbour information).
@@ -322,10 +324,12 @@ SoffCameras soff_cameras(par::Executor& executor, const GBuffer& g, const SoffCl
         reflected[k] = reflect(-g.view_direction(i), nrm);
         const SurfaceParams& s = g.surface.pixels[i];
         if (s.is_glossy_lobe()) {
-          // The GGX lobe's reflected directions: 90% of the half-vector distribution lies
-          // within tan θ_h = 3α, and the reflected direction turns by 2θ_h.
+          // The GGX lobe's reflected directions: P(tan θ_h > kα) = 1/(1 + k²), so 96% of the
+          // half vectors lie within tan θ_h = 5α, and the reflected direction turns by 2θ_h.
+          // (At 3α, 90%, more tail rays leave the frame and take the environment; at 10α the
+          // wider frame spreads the depth image's pixels too thin on small glossy objects.)
           const float alpha = s.roughness * s.roughness;
-          cone = std::max(cone, 2.0f * std::atan(3.0f * alpha));
+          cone = std::max(cone, 2.0f * std::atan(5.0f * alpha));
         }
         // Step 5's pairs: the right and lower neighbours that belong to the same cluster.
         const std::uint32_t x = i % std::uint32_t(g.width), y = i / std::uint32_t(g.width);
@@ -411,6 +415,8 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
   out.pixels = out.offsets.back();
   out.inv_z.assign(out.pixels, 0.0f);
   out.colour.assign(out.pixels, glm::vec3(0.0f));
+  out.surface.assign(out.pixels, SurfaceParams{});
+  out.normal.assign(out.pixels, glm::vec3(0.0f));
 
   SoffDepthStats st;
   std::vector<std::uint32_t> kept, indices, objects;
@@ -468,6 +474,8 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
           out.inv_z[base + i] = 1.0f / vis.depth.pixels[i];
           out.colour[base + i] = shade_surface(scene, gb.surface.pixels[i], gb.position.pixels[i],
                                                gb.normal.pixels[i], gb.view_direction(i), shadows, env);
+          out.surface[base + i] = gb.surface.pixels[i];
+          out.normal[base + i] = gb.normal.pixels[i];
         } else {
           const float sx = float(i % std::size_t(cam.width)) + 0.5f, sy = float(i / std::size_t(cam.width)) + 0.5f;
           out.colour[base + i] = env.radiance(cam.pixel_direction(sx, sy), 1e6f);
@@ -556,15 +564,123 @@ glm::vec3 bilinear(const glm::vec3* colour, int w, int h, float sx, float sy) {
          (at(x0, y0 + 1) * (1.0f - fx) + at(x0 + 1, y0 + 1) * fx) * fy;
 }
 
+// The change of shade_surface's value at (s, p, n) when the viewer moves from direction v0
+// to v1: the terms that depend on the view (each light's BRDF, the coupled diffuse layer's
+// Fresnel factor, the rough specular lobe), with one shadow lookup per light.
+glm::vec3 view_dependent_change(const Scene& scene, const SurfaceParams& s, const glm::vec3& p, const glm::vec3& n,
+                                const glm::vec3& v0, const glm::vec3& v1, const std::vector<ShadowMap>& shadows,
+                                const EnvironmentMap& env) {
+  // shade_surface lights the side the viewer is on.
+  const glm::vec3 n0 = glm::dot(n, v0) < 0.0f ? -n : n, n1 = glm::dot(n, v1) < 0.0f ? -n : n;
+  glm::vec3 change(0.0f);
+  for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+    const LightSample ls = sample_light(scene.lights[k], p);
+    if (ls.irradiance == glm::vec3(0.0f)) continue;
+    const bool lit0 = glm::dot(n0, ls.direction) > 0.0f, lit1 = glm::dot(n1, ls.direction) > 0.0f;
+    if (!lit0 && !lit1) continue;
+    if (k < shadows.size()) {
+      const float vis0 = lit0 ? shadows[k].visibility(p, n0, ls.direction) : 0.0f;
+      const float vis1 = !lit1 ? 0.0f : n1 == n0 ? vis0 : shadows[k].visibility(p, n1, ls.direction);
+      if (vis1 > 0.0f) change += vis1 * shade_light(s, n1, v1, ls);
+      if (vis0 > 0.0f) change -= vis0 * shade_light(s, n0, v0, ls);
+    } else {
+      if (lit1) change += shade_light(s, n1, v1, ls);
+      if (lit0) change -= shade_light(s, n0, v0, ls);
+    }
+  }
+  change += diffuse_albedo_over_pi(s, glm::dot(n1, v1)) * env.irradiance(n1) -
+            diffuse_albedo_over_pi(s, glm::dot(n0, v0)) * env.irradiance(n0);
+  if (s.has_rough_specular_lobe())
+    change += specular_reflectance(s, glm::dot(n1, v1)) * env.radiance(reflect(-v1, n1), s.phong_exponent) -
+              specular_reflectance(s, glm::dot(n0, v0)) * env.radiance(reflect(-v0, n0), s.phong_exponent);
+  return change;
+}
+
 }  // namespace
 
-ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffClusters& clusters,
-                         const SoffCameras& cameras, const SoffDepthImages& images,
-                         const EnvironmentMap& env, const SoffIntersectSettings& settings,
-                         SoffIntersectStats* stats) {
+std::uint32_t soff_self_walk(const GBuffer& g, const glm::mat4& vp, const glm::vec3& forward, std::uint32_t reflector,
+                             const glm::ivec4& box, const glm::vec3& p, const glm::vec3& d, float length,
+                             std::uint32_t* steps_out) {
+  // Clip space is linear along the segment; x/w, y/w and 1/w are linear in screen space.
+  const glm::vec4 ca = vp * glm::vec4(p, 1.0f), cb = vp * glm::vec4(p + d * length, 1.0f);
+  if (steps_out) *steps_out = 0;
+  if (!(ca.w > 0.0f) || !(cb.w > 0.0f)) return kNoId;  // the segment leaves the view backwards
+  const float W = float(g.width), H = float(g.height);
+  if (box.z < box.x || box.w < box.y || box.x < 0 || box.y < 0 || box.z >= g.width || box.w >= g.height) return kNoId;
+  const glm::vec2 a((ca.x / ca.w * 0.5f + 0.5f) * W, (0.5f - ca.y / ca.w * 0.5f) * H);
+  const glm::vec2 b((cb.x / cb.w * 0.5f + 0.5f) * W, (0.5f - cb.y / cb.w * 0.5f) * H);
+  const float ia = 1.0f / ca.w, ib = 1.0f / cb.w;
+  const glm::vec2 delta = b - a;
+  const int steps = std::min(int(std::ceil(std::max(std::abs(delta.x), std::abs(delta.y)))), g.width + g.height);
+  if (steps < 2) return kNoId;
+  const glm::vec3 eye = g.eye;
+  // The depth (along the view axis) of the segment and of the surface at step k.
+  float prev_gap = 0.0f, prev_surface = 0.0f, prev_ray = 0.0f;
+  bool prev_valid = false;
+  std::uint32_t taken = 0;
+  for (int k = 2; k <= steps; ++k) {  // steps 0 and 1: the start's own sample and its neighbour
+    const float s = float(k) / float(steps);
+    const float x = a.x + delta.x * s, y = a.y + delta.y * s;
+    if (x < float(box.x) || y < float(box.y) || x >= float(box.z + 1) || y >= float(box.w + 1)) break;
+    ++taken;
+    const std::size_t q = std::size_t(y) * std::size_t(g.width) + std::size_t(x);
+    if (g.object.pixels[q] != reflector) {
+      prev_valid = false;
+      continue;
+    }
+    const float ray_depth = 1.0f / (ia + (ib - ia) * s);  // = clip w = view depth
+    const float surface_depth = glm::dot(g.position.pixels[q] - eye, forward);
+    const float gap = surface_depth - ray_depth;  // > 0: the segment is in front
+    // A crossing from in front to behind, unless the segment dived behind the surface by
+    // more than the step's depth changes allow (it passed behind a silhouette of the
+    // reflector, where the surface jumps).
+    if (prev_valid && prev_gap > 0.0f && gap <= 0.0f &&
+        -gap <= 2.0f * (std::abs(ray_depth - prev_ray) + std::abs(surface_depth - prev_surface)) + 1e-3f * ray_depth) {
+      if (steps_out) *steps_out = taken;
+      return std::uint32_t(q);
+    }
+    prev_gap = gap, prev_surface = surface_depth, prev_ray = ray_depth;
+    prev_valid = true;
+  }
+  if (steps_out) *steps_out = taken;
+  return kNoId;
+}
+
+ImageRGBA soff_intersect(par::Executor& executor, const Scene& scene, const GBuffer& g,
+                         const SoffClusters& clusters, const SoffCameras& cameras, const SoffDepthImages& images,
+                         const std::vector<ShadowMap>& shadows, const EnvironmentMap& env,
+                         const SoffIntersectSettings& settings, SoffIntersectStats* stats) {
   constexpr std::size_t kChunk = 1024;
   ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   std::vector<SoffIntersectStats> per_chunk(par::Executor::chunk_count(out.size(), kChunk));
+  // Concave clusters: the output camera's projection and each cluster's extent (the longest
+  // segment a second intersection within the reflector can need: twice the largest
+  // distance of a cluster sample from the cluster's mean point, over the reflector's clusters).
+  const glm::mat4 vp = projection_matrix(settings.camera, g.width, g.height) * view_matrix(settings.camera);
+  const glm::vec3 forward = glm::normalize(settings.camera.target - settings.camera.eye);
+  // Per reflector with a concave cluster: the longest segment a second intersection can
+  // need (the diagonal of its samples' box) and its samples' box in the output image, which
+  // bounds the walk.
+  std::vector<float> reach(cameras.size(), 0.0f);
+  std::vector<glm::ivec4> screen_box(cameras.size(), glm::ivec4(0));
+  if (settings.concave_self) {
+    for (std::size_t c = 0; c < cameras.size(); ++c) {
+      if (!cameras[c].valid || !cameras[c].concave) continue;
+      Bounds box;
+      glm::ivec4 sb(g.width, g.height, -1, -1);
+      for (std::size_t o = 0; o < cameras.size(); ++o) {
+        if (clusters.reflector[o] != clusters.reflector[c]) continue;
+        for (std::uint32_t k = clusters.offsets[o]; k < clusters.offsets[o + 1]; ++k) {
+          const std::uint32_t q = clusters.samples[k];
+          box.grow(g.position.pixels[q]);
+          const int x = int(q % std::uint32_t(g.width)), y = int(q / std::uint32_t(g.width));
+          sb = glm::ivec4(std::min(sb.x, x), std::min(sb.y, y), std::max(sb.z, x), std::max(sb.w, y));
+        }
+      }
+      reach[c] = glm::length(box.extent());
+      screen_box[c] = sb;
+    }
+  }
   executor.parallel_for("soff_intersect.walk", out.size(), kChunk, [&](std::size_t begin, std::size_t end) {
     SoffIntersectStats& st = per_chunk[begin / kChunk];
     for (std::size_t i = begin; i < end; ++i) {
@@ -580,20 +696,52 @@ ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffCl
         continue;
       }
       const SoffCamera& cam = cameras[c];
-      const float* inv_z = images.inv_z.data() + images.offsets[c];
-      const glm::vec3* colour = images.colour.data() + images.offsets[c];
+      const std::size_t base = images.offsets[c];
+      const float* inv_z = images.inv_z.data() + base;
+      const glm::vec3* colour = images.colour.data() + base;
+      const glm::vec3 p = g.position.pixels[i];
       int disoccluded = 0, rays = 0;
       const bool fade = cam.glossy && settings.glossy_fade;
+      const bool self = settings.concave_self && cam.concave && reach[c] > 0.0f;
       // The radiance a reflected ray from this sample finds in the depth image, or the
       // environment (a miss, a disocclusion, a direction the camera cannot frame).
       const auto trace = [&](const glm::vec3& d) {
         ++st.rays, ++rays;
-        const SoffWalkResult r = soff_walk(cam, inv_z, g.position.pixels[i], d);
+        if (self) {
+          ++st.concave_rays;
+          std::uint32_t taken = 0;
+          const std::uint32_t q =
+              soff_self_walk(g, vp, forward, clusters.reflector[c], screen_box[c], p, d, reach[c], &taken);
+          st.self_steps += taken;
+          if (q != kNoId) {
+            ++st.self_hits;
+            // First order (SOFF §4.4): the diffuse shading of the reflector's sample hit.
+            return shade_surface(scene, g.surface.pixels[q], g.position.pixels[q], g.normal.pixels[q], -d, shadows,
+                                 env);
+          }
+        }
+        const SoffWalkResult r = soff_walk(cam, inv_z, p, d);
         st.steps += r.steps;
         if (r.steps <= 1) ++st.planar_lookups;
         if (r.kind == SoffWalkResult::Hit) {
           ++st.hits;
-          const glm::vec3 hit = bilinear(colour, cam.width, cam.height, r.sx, r.sy);
+          glm::vec3 hit = bilinear(colour, cam.width, cam.height, r.sx, r.sy);
+          if (settings.reshade) {
+            // The nearest pixel's surface, at the hit on the ray, seen along the ray instead
+            // of from the cluster camera.
+            const int x = std::clamp(int(r.sx), 0, cam.width - 1), y = std::clamp(int(r.sy), 0, cam.height - 1);
+            const std::size_t k = base + std::size_t(y) * std::size_t(cam.width) + std::size_t(x);
+            // Only glossy surfaces' shading changes much with the view (their light
+            // highlights); mirrors reflect no point light and rough surfaces' lobes are broad.
+            if (images.inv_z[k] > 0.0f && images.surface[k].is_glossy_lobe()) {
+              const float dz = glm::dot(d, cam.w);
+              const glm::vec3 at = p + d * ((1.0f / r.inv_z - glm::dot(p - cam.eye, cam.w)) / dz);
+              const glm::vec3 v0 = glm::normalize(cam.eye - at);
+              hit = glm::max(hit + view_dependent_change(scene, images.surface[k], at, images.normal[k], v0, -d,
+                                                         shadows, env),
+                             glm::vec3(0.0f));
+            }
+          }
           if (!fade) return hit;
           // SOFF §3.5: a glossy reflection fades as the reflected surface nears the pulled-in
           // far plane, here over the last quarter of the depth range, towards what a ray
@@ -643,6 +791,9 @@ ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffCl
       stats->disoccluded_samples += c.disoccluded_samples;
       stats->unclustered_samples += c.unclustered_samples;
       stats->planar_lookups += c.planar_lookups;
+      stats->concave_rays += c.concave_rays;
+      stats->self_hits += c.self_hits;
+      stats->self_steps += c.self_steps;
     }
   return out;
 }
@@ -721,9 +872,10 @@ SoffDepthImages SoffDepthImagesPass::operator()(par::NodeContext& c, const SoffC
 
 ImageRGBA SoffIntersectPass::operator()(par::NodeContext& c, const GBuffer& gbuffer, const SoffClusters& clusters,
                                         const SoffCameras& cameras, const SoffDepthImages& images,
-                                        const EnvironmentMap& environment) const {
+                                        const ShadowMaps& shadows, const EnvironmentMap& environment) const {
   SoffIntersectStats st;
-  ImageRGBA specular = soff_intersect(c.executor(), gbuffer, clusters, cameras, images, environment, settings, &st);
+  ImageRGBA specular = soff_intersect(c.executor(), *scene, gbuffer, clusters, cameras, images, shadows, environment,
+                                      settings, &st);
   c.count("rays", double(st.rays));
   c.count("steps", double(st.steps));
   c.count("hits", double(st.hits));
@@ -732,6 +884,9 @@ ImageRGBA SoffIntersectPass::operator()(par::NodeContext& c, const GBuffer& gbuf
   c.count("disoccluded_samples", double(st.disoccluded_samples));
   c.count("unclustered_samples", double(st.unclustered_samples));
   c.count("planar_lookups", double(st.planar_lookups));
+  c.count("concave_rays", double(st.concave_rays));
+  c.count("self_hits", double(st.self_hits));
+  c.count("self_steps", double(st.self_steps));
   return specular;
 }
 

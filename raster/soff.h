@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/image.h"
@@ -29,6 +30,7 @@ namespace speculum::raster {
 struct SoffBinSettings {
   int theta_bins = 13;  // MAXTHETABINS: normal azimuth bins over 360°
   int phi_bins = 8;     // MAXPHIBINS: normal polar bins over 180°
+  float share_gain = 1.0f;  // the screen share a_R (percent) is multiplied by this (calibration)
 };
 
 // The samples SOFF reflects: mirror and glossy lobes (refractors are not SOFF's; the
@@ -59,7 +61,7 @@ void soff_bin(const glm::vec3& n, float scale, const SoffBinSettings& bins, int&
 // with a_R in percent and clamped to 1 it reproduces SOFF Table 7's 100–200 clusters per
 // frame (a calibration of the printed formula, not a correction) and still the ≤ 52 bins of
 // the paper's full-screen sphere example.
-float soff_bin_scale(double percent, int visible);
+float soff_bin_scale(double percent, int visible, double gain = 1.0);
 
 SoffClusters soff_cluster(par::Executor& executor, const GBuffer& g, const SoffBinSettings& bins);
 
@@ -134,6 +136,10 @@ struct SoffDepthImages {
   std::vector<std::size_t> offsets;
   std::vector<float> inv_z;         // 1/z along the camera axis; 0: empty (nothing seen)
   std::vector<glm::vec3> colour;    // direct shading of the surface seen, or the environment
+  // The surface seen (material at the pixel and its shading normal), so that a hit can be
+  // re-shaded for its own ray direction (SoffIntersectSettings::reshade).
+  std::vector<SurfaceParams> surface;
+  std::vector<glm::vec3> normal;
   std::uint64_t pixels = 0;
 };
 
@@ -174,6 +180,18 @@ struct SoffIntersectSettings {
   // sample just before the silhouette it passed behind (the nearest captured surface).
   bool fill_disocclusions = false;
   std::uint32_t seed = 0;
+  // The depth image's colour was shaded for the cluster camera's view; the terms of the
+  // shading that depend on the view (light highlights of glossy surfaces, the Fresnel
+  // coupling of the diffuse layer) are re-evaluated at the hit for the reflected ray itself
+  // (from the nearest depth-image pixel's surface), so a hit is shaded as a ray tracer
+  // shades it. Off: the depth image's colour as it is (SOFF §3.4).
+  bool reshade = true;
+  // Concave clusters (SOFF §4.4's second option): before the depth image, the reflected ray
+  // is intersected with the reflector's own samples in the frame (the cluster and its
+  // sibling clusters), walking the output image one sample at a time; a second
+  // intersection takes the diffuse shading of the sample hit.
+  bool concave_self = false;
+  Camera camera;  // the output camera (the G-buffer's projection), for concave_self
 };
 
 struct SoffIntersectStats {
@@ -185,12 +203,26 @@ struct SoffIntersectStats {
   std::uint64_t disoccluded_samples = 0;  // samples most of whose rays were disoccluded
   std::uint64_t unclustered_samples = 0;  // specular samples without a valid camera
   std::uint64_t planar_lookups = 0;       // rays that projected to a point (one lookup)
+  std::uint64_t concave_rays = 0;         // rays of concave clusters tested against their reflector
+  std::uint64_t self_hits = 0;            // of those, rays that hit the reflector itself
+  std::uint64_t self_steps = 0;           // output-image steps of those walks
 };
 
-ImageRGBA soff_intersect(par::Executor& executor, const GBuffer& g, const SoffClusters& clusters,
-                         const SoffCameras& cameras, const SoffDepthImages& images,
-                         const EnvironmentMap& env, const SoffIntersectSettings& settings,
-                         SoffIntersectStats* stats = nullptr);
+// Walks the segment p → p + d·length through the output image (the G-buffer of `camera`),
+// one sample at a time while inside `box` (x0, y0, x1, y1: the reflector's samples' box,
+// inclusive), against the depth of the samples of object `reflector`: the first
+// sample where the segment passes from in front of that surface to behind it (within the
+// depth change of one step) is a hit; its index, or kNoId. The start's own footprint (the
+// first sample and its neighbours) is skipped. SOFF §4.4: intersecting a concave cluster
+// with itself.
+std::uint32_t soff_self_walk(const GBuffer& g, const glm::mat4& view_projection, const glm::vec3& forward,
+                             std::uint32_t reflector, const glm::ivec4& box, const glm::vec3& p, const glm::vec3& d,
+                             float length, std::uint32_t* steps = nullptr);
+
+ImageRGBA soff_intersect(par::Executor& executor, const Scene& scene, const GBuffer& g,
+                         const SoffClusters& clusters, const SoffCameras& cameras, const SoffDepthImages& images,
+                         const std::vector<ShadowMap>& shadows, const EnvironmentMap& env,
+                         const SoffIntersectSettings& settings, SoffIntersectStats* stats = nullptr);
 
 // The clusters in false colour (grey: diffuse and background), for inspect.
 ImageRGBA soff_cluster_image(const SoffClusters& clusters);
@@ -237,10 +269,13 @@ struct SoffIntersectPass {
       "Walks each reflected ray through its cluster's depth image one pixel at a time, hit where "
       "the 1/z segments cross, bilinear colour; glossy samples average several lobe rays; misses "
       "and disocclusions take the environment map (SOFF §3.4, §3.5).";
+  const Scene* scene = nullptr;
   SoffIntersectSettings settings;
-  void parameters(par::Params& p) const { p.set("glossy_rays", settings.glossy_rays); }
+  void parameters(par::Params& p) const {
+    p.set("glossy_rays", settings.glossy_rays).set("reshade", settings.reshade).set("concave", settings.concave_self);
+  }
   ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const SoffClusters& clusters,
-                       const SoffCameras& cameras, const SoffDepthImages& images,
+                       const SoffCameras& cameras, const SoffDepthImages& images, const ShadowMaps& shadows,
                        const EnvironmentMap& environment) const;
 };
 

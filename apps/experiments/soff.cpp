@@ -19,6 +19,8 @@
 #include "core/image_metrics.h"
 #include "core/procedural_scenes.h"
 #include "core/scene_loader.h"
+#include "core/shading.h"
+#include "raster/soff.h"
 #include "raster/gbuffer.h"
 #include "raster/visibility.h"
 #include "trace/bvh.h"
@@ -38,6 +40,9 @@ struct SoffExperimentOptions {
   bool sweeps = false;
   bool quick = false;
   bool json = false;
+  std::string images;
+  std::vector<std::string> params;  // soff's --param name=value (the path rows)
+  std::map<std::string, double> soff_params;  // parsed               // write each frame's soff / exact / difference images here
 };
 
 // SOFF's scenes (§4): the living room with 25 reflectors at ~290K triangles and the bathroom at ~90K.
@@ -84,6 +89,59 @@ SpecularError specular_mae8(const Scene& scene, const Camera& camera, const Imag
   return {mean(0), mean(1), mean(2)};
 }
 
+// The scene with every triangle of its reflectors (mirror and glossy materials) split into
+// four at its edge midpoints, attributes interpolated: the same shapes and shading with 4×
+// the reflector triangles (SOFF §4.2.1: the cost does not depend on the non-diffuse
+// triangles, which only reach the G-buffer).
+Scene with_reflectors_split(const Scene& in) {
+  Scene out = in;
+  const TriangleMesh& m = in.mesh;
+  TriangleMesh& o = out.mesh;
+  o.indices.clear(), o.triangle_material.clear(), o.triangle_object.clear();
+  const auto mid = [&](std::uint32_t a, std::uint32_t b) {
+    const auto index = static_cast<std::uint32_t>(o.positions.size());
+    o.positions.push_back(0.5f * (m.positions[a] + m.positions[b]));
+    const glm::vec3 n = m.normals[a] + m.normals[b];
+    o.normals.push_back(glm::length(n) > 0.0f ? glm::normalize(n) : m.normals[a]);
+    if (!m.tangents.empty()) {
+      const glm::vec3 t = glm::vec3(m.tangents[a]) + glm::vec3(m.tangents[b]);
+      o.tangents.push_back(glm::vec4(glm::length(t) > 0.0f ? glm::normalize(t) : glm::vec3(m.tangents[a]),
+                                     m.tangents[a].w));
+    }
+    o.uvs.push_back(0.5f * (m.uvs[a] + m.uvs[b]));
+    if (!m.uvs1.empty()) o.uvs1.push_back(0.5f * (m.uvs1[a] + m.uvs1[b]));
+    return index;
+  };
+  for (Object& obj : out.objects) {
+    const std::uint32_t first = obj.first_triangle, count = obj.triangle_count;
+    obj.first_triangle = static_cast<std::uint32_t>(o.triangle_count());
+    for (std::uint32_t t = first; t < first + count; ++t) {
+      const std::uint32_t a = m.indices[3 * t], b = m.indices[3 * t + 1], c = m.indices[3 * t + 2];
+      const std::uint32_t material = m.triangle_material[t], object = m.triangle_object[t];
+      const auto add = [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+        o.indices.insert(o.indices.end(), {x, y, z});
+        o.triangle_material.push_back(material);
+        o.triangle_object.push_back(object);
+      };
+      if (!raster::soff_reflects(surface_params(in.materials[material]))) {
+        add(a, b, c);
+        continue;
+      }
+      const std::uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      add(a, ab, ca), add(ab, b, bc), add(ca, bc, c), add(ab, bc, ca);
+    }
+    obj.triangle_count = static_cast<std::uint32_t>(o.triangle_count()) - obj.first_triangle;
+  }
+  out.validate();
+  return out;
+}
+
+std::size_t reflector_triangles(const Scene& scene) {
+  std::size_t n = 0;
+  for (std::uint32_t mat : scene.mesh.triangle_material) n += raster::soff_reflects(surface_params(scene.materials[mat]));
+  return n;
+}
+
 struct Frame {
   pipeline::FrameResult soff;
   double samples = 0;
@@ -110,14 +168,15 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
               const SoffExperimentOptions& o, par::Executor& ex, ResultTable& table, Progress& progress) {
   const int frames = std::max(1, std::min(o.frames, path.frames));
   std::vector<double> ms, ms_cl, ms_cam, ms_di, ms_is, ms_rebuild, ms_prebuilt, mae, mae_mirror, mae_glossy, dis,
-      clusters;
+      clusters, mae_trace, mae_trace_glossy;
   double mae_frame = -1.0;
   for (int k = 0; k < frames; ++k) {
     // Frames spread evenly over the path (the first and the last key included).
     const int index = frames == 1 ? 0 : int(std::lround(double(k) * double(path.frames - 1) / double(frames - 1)));
     const Camera cam = path.at(index);
-    const pipeline::FrameSettings f =
-        settings_for(cam, o.width, o.supersample, {{"glossy_rays", o.glossy_rays}}, "soff");
+    std::map<std::string, double> soff_params = o.soff_params;
+    soff_params["glossy_rays"] = o.glossy_rays;
+    const pipeline::FrameSettings f = settings_for(cam, o.width, o.supersample, soff_params, "soff");
     const pipeline::FrameResult soff = run(scene, "soff", f, ex);
     const par::RunReport& r = soff.report;
     ms.push_back(double(r.duration_ns) * 1e-6);
@@ -141,12 +200,35 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
     const double build = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ms_rebuild.push_back(rebuild);
     ms_prebuilt.push_back(std::max(0.0, rebuild - build));
-    // The error against the exact specular layer with converged glossy lobes.
+    // The error against the exact specular layer: with as many lobe samples as soff's rays
+    // it is the frame just traced (the same rays: the depth images' error alone), with more
+    // the glossy lobes converge (soff's sampling noise included).
     const pipeline::FrameResult exact =
-        run(scene, "specular-reference",
-            settings_for(cam, o.width, o.supersample, {{"glossy_samples", o.glossy_samples}}, "specular-reference"), ex);
+        o.glossy_samples == o.glossy_rays
+            ? traced
+            : run(scene, "specular-reference",
+                  settings_for(cam, o.width, o.supersample, {{"glossy_samples", o.glossy_samples}}, "specular-reference"),
+                  ex);
     const SpecularError e = specular_mae8(scene, cam, soff.display, exact.display, ex);
+    if (!o.images.empty()) {
+      // SOFF Fig. 8: the two images and their absolute 8-bit difference, scaled by 8.
+      std::string stem = o.images + "/" + scene_name.substr(0, scene_name.find(':')) + "_" + path.name + "_" +
+                         std::to_string(index);
+      ImageRGBA diff(soff.display.width, soff.display.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+      for (std::size_t i = 0; i < diff.pixels.size(); ++i)
+        for (int ch = 0; ch < 3; ++ch) {
+          const int d = std::abs(display_to_8bit(soff.display.pixels[i][ch]) - display_to_8bit(exact.display.pixels[i][ch]));
+          diff.pixels[i][ch] = srgb_to_linear(std::min(1.0f, 8.0f * float(d) / 255.0f));
+        }
+      write_image(stem + "_soff.png", soff.display);
+      write_image(stem + "_exact.png", exact.display);
+      write_image(stem + "_diff8.png", diff);
+    }
     mae.push_back(e.all), mae_mirror.push_back(e.mirror), mae_glossy.push_back(e.glossy);
+    // The traced frame with soff's rays against the same reference: the sampling noise of
+    // N lobe rays that any method tracing them has (0 when the reference uses those rays).
+    const SpecularError et = specular_mae8(scene, cam, traced.display, exact.display, ex);
+    mae_trace.push_back(et.all), mae_trace_glossy.push_back(et.glossy);
     if (k == 0 && o.reference_spp > 0) {
       pipeline::FrameSettings rf = settings_for(cam, o.width, 1, {}, "reference");
       rf.spp = o.reference_spp;
@@ -172,6 +254,8 @@ void path_row(const Scene& scene, const std::string& scene_name, const CameraPat
       .cell("mae8_specular", mae_avg, 2)
       .cell("mae8_mirror", mean(mae_mirror), 2)
       .cell("mae8_glossy", mean(mae_glossy), 2)
+      .cell("mae8_trace_specular", mean(mae_trace), 2)
+      .cell("mae8_trace_glossy", mean(mae_trace_glossy), 2)
       .cell("mae8_frame", mae_frame, 2)
       .cell("disocclusion_pct_avg", dis_avg, 3)
       .cell("disocclusion_pct_max", *std::max_element(dis.begin(), dis.end()), 3)
@@ -207,6 +291,8 @@ void sweep_row(const Scene& scene, const std::string& scene_name, const Camera& 
       .cell("sweep", sweep)
       .cell("value", value, 3)
       .cell("width", width)
+      .cell("triangles", std::int64_t(scene.mesh.triangle_count()))
+      .cell("reflector_triangles", std::int64_t(reflector_triangles(scene)))
       .cell("clusters", counter_of(r, "soff_clusters", "clusters"), 0)
       .cell("disocclusion_pct", 100.0 * counter_of(r, "soff_intersect", "disoccluded_samples") / samples, 3)
       .cell("depth_image_pixels", counter_of(r, "soff_cameras", "depth_image_pixels"), 0)
@@ -226,6 +312,18 @@ void run_soff_experiment(SoffExperimentOptions o, const GlobalOptions& global) {
     o.width = std::min(o.width, 256);
     o.glossy_samples = std::min(o.glossy_samples, 16);
   }
+  for (const std::string& item : o.params) {
+    const auto eq = item.find('=');
+    char* end = nullptr;
+    const std::string text = eq == std::string::npos ? "" : item.substr(eq + 1);
+    const double v = std::strtod(text.c_str(), &end);
+    if (eq == std::string::npos || eq == 0 || text.empty() || *end != '\0' || !std::isfinite(v))
+      throw InputError("--param", "expected name=number, got '" + item + "'");
+    if (item.substr(0, eq) == "glossy_rays")
+      throw InputError("--param glossy_rays", "use --glossy-rays (the trace columns use the same count)");
+    o.soff_params[item.substr(0, eq)] = v;
+  }
+  pipeline::check_technique_params(pipeline::find_technique("soff"), o.soff_params);
   const std::vector<std::string>& scenes = o.scenes.empty() ? kScenes : o.scenes;
   // Resolve every scene's paths before rendering anything: a bad name fails at once.
   std::vector<std::pair<std::string, std::vector<CameraPath>>> work;
@@ -247,7 +345,7 @@ void run_soff_experiment(SoffExperimentOptions o, const GlobalOptions& global) {
     steps += paths.size() * std::size_t(o.frames);
     work.emplace_back(name, std::move(paths));
   }
-  if (o.sweeps) steps += 12;
+  if (o.sweeps) steps += 14;
   par::Executor ex(global.threads, global.lanes);
   ResultTable table(o.json);
   Progress progress("soff", steps, global.quiet);
@@ -271,6 +369,9 @@ void run_soff_experiment(SoffExperimentOptions o, const GlobalOptions& global) {
     sweep_row(scene, name, cam, "image_scale", s, o.width, {{"image_scale", s}}, o, ex, table, progress);
   for (int rays : {8, 49})  // Table 8: glossy rays per pixel
     sweep_row(scene, name, cam, "glossy_rays", rays, o.width, {{"glossy_rays", rays}}, o, ex, table, progress);
+  // Table 6 / §4.2.1: the reflectors' triangles × 4 (same shapes) change little.
+  sweep_row(scene, name, cam, "reflector_triangles", 1, o.width, {}, o, ex, table, progress);
+  sweep_row(with_reflectors_split(scene), name, cam, "reflector_triangles", 4, o.width, {}, o, ex, table, progress);
 }
 
 }  // namespace
@@ -282,7 +383,7 @@ void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global)
       "SOFF §4: per scene and camera path the specular error against the exact specular "
       "reference, the disocclusion pixels, clusters, the stage split and the speed against "
       "tracing the same rays with a BVH rebuilt per frame and prebuilt; --sweeps adds the "
-      "bins / output size / depth-image scale / glossy rays trends (Tables 3, 4, 5, 8).\n"
+      "bins / output size / depth-image scale / glossy rays / reflector triangles trends (Tables 3, 4, 5, 8, 6).\n"
       "Example: speculum experiment soff --quick --json");
   cmd->add_option("--scenes", o->scenes,
                   "Scenes with camera paths (default: living-room:size=240000:reflectors=25, bathroom)")
@@ -300,6 +401,11 @@ void add_experiment_soff_subcommand(CLI::App& experiment, GlobalOptions& global)
   cmd->add_option("--reference-spp", o->reference_spp,
                   "Path-traced reference samples for mae8_frame (first frame of each path; 0: skip)")
       ->check(CLI::Range(0, 4096))->capture_default_str();
+  cmd->add_option("--param", o->params, "soff parameter name=value for the path rows, repeatable (see `speculum techniques`)");
+  cmd->add_option("--images", o->images,
+                  "Write each frame's soff and exact-specular images and their 8-bit difference ×8 "
+                  "(SOFF Fig. 8) into this existing directory")
+      ->check(CLI::ExistingDirectory);
   cmd->add_flag("--sweeps", o->sweeps, "Add the Table 3/4/5/8 sweeps on the first frame of the first path");
   cmd->add_flag("--quick", o->quick, "One scene (bathroom), one path, 4 frames, 256² (tests and smoke checks)");
   cmd->add_flag("--json", o->json, "One JSON object per row instead of the text table");

@@ -17,6 +17,7 @@ FrameOutputs add_soff_passes(par::Graph& g, const Scene* scene, const FrameSetti
   SoffBinSettings bins;
   bins.theta_bins = static_cast<int>(f.param("theta_bins"));
   bins.phi_bins = static_cast<int>(f.param("phi_bins"));
+  bins.share_gain = static_cast<float>(f.param("share_gain"));
   auto clusters = g.add("soff_clusters", SoffClustersPass{bins}, s.gbuffer);
   SoffCameraSettings cam;
   cam.image_scale = static_cast<float>(f.param("image_scale"));
@@ -30,8 +31,11 @@ FrameOutputs add_soff_passes(par::Graph& g, const Scene* scene, const FrameSetti
   isect.seed = f.seed;
   isect.glossy_fade = cam.glossy_far < 1.0f;
   isect.fill_disocclusions = f.param("fill") != 0.0;
-  auto specular = g.add("soff_intersect", SoffIntersectPass{isect}, s.gbuffer, clusters, cameras, images,
-                        s.environment);
+  isect.reshade = f.param("reshade") != 0.0;
+  isect.concave_self = f.param("concave") != 0.0;
+  isect.camera = f.camera;
+  auto specular = g.add("soff_intersect", SoffIntersectPass{scene, isect}, s.gbuffer, clusters, cameras, images,
+                        s.shadow_maps, s.environment);
   return add_output_passes(g, f, s.direct, specular);
 }
 

@@ -107,11 +107,16 @@ const std::vector<Technique>& techniques() {
        // also bounded by max_image_side. glossy_rays multiplies the walks per glossy sample.
        {{"theta_bins", 13, 1, 64, true, "MAXTHETABINS: normal azimuth bins (clusters grow with it)"},
         {"phi_bins", 8, 1, 32, true, "MAXPHIBINS: normal polar bins (clusters grow with it)"},
+        {"share_gain", 16, 0.01, 100, false,
+         "bins scale with a reflector's screen share in percent × this / visible reflectors, at most 1 (calibration)"},
         {"image_scale", 1, 0.125, 2, false, "depth-image resolution × this (SOFF Table 5; ≤ 16 pixels per sample at 2)"},
         {"max_image_side", 1024, 16, 4096, true, "largest depth-image side (clamped images are counted)"},
         {"glossy_rays", 8, 1, 64, true, "reflected rays per glossy sample (SOFF §3.5: 8 to 49)"},
         {"glossy_far", 1, 0.05, 1, false, "glossy clusters' far plane at this × the scene diameter (§3.5)"},
-        {"fill", 0, 0, 1, true, "disoccluded rays: 0 the environment (SOFF), 1 the depth image beside the silhouette"}}},
+        {"fill", 0, 0, 1, true, "disoccluded rays: 0 the environment (SOFF), 1 the depth image beside the silhouette"},
+        {"reshade", 1, 0, 1, true, "1: a hit's view-dependent shading is re-evaluated for the ray; 0: the depth image's colour"},
+        {"concave", 0, 0, 1, true,
+         "concave clusters (SOFF §4.4): 0 like convex ones, 1 rays first intersected with their own reflector"}}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",

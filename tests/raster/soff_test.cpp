@@ -14,6 +14,7 @@
 
 #include "apps/techniques/render_frame.h"
 #include "apps/techniques/technique_table.h"
+#include "core/camera_rays.h"
 #include "core/image_metrics.h"
 #include "core/optics.h"
 #include "core/procedural_geometry.h"
@@ -124,10 +125,12 @@ TEST(SoffClusters, SameBytesForAnyThreadCount) {
   }
 }
 
-// The bin scale is the calibrated a_R[%] / n_v, clamped to 1.
+// The bin scale is the calibrated gain × a_R[%] / n_v, clamped to 1.
 TEST(SoffClusters, BinScaleCalibration) {
   EXPECT_EQ(soff_bin_scale(100.0, 1), 1.0f);
   EXPECT_FLOAT_EQ(soff_bin_scale(2.0, 4), 0.5f);
+  EXPECT_FLOAT_EQ(soff_bin_scale(2.0, 64, 16.0), 0.5f);
+  EXPECT_EQ(soff_bin_scale(100.0, 1, 16.0), 1.0f) << "a full-screen reflector keeps the paper's ≤ 52 bins";
   int i = -1, j = -1;
   soff_bin(glm::vec3(0, 1, 0), 1.0f, {}, i, j);
   EXPECT_EQ(j, 0);
@@ -367,6 +370,86 @@ TEST(SoffIntersect, GlossyRaysConvergeTowardsTheReference) {
   EXPECT_LT(many, 0.75 * few) << "8 rays " << few << ", 49 rays " << many;
   EXPECT_LT(few, 0.5 * envmap) << "8 rays " << few << ", envmap " << envmap;
   EXPECT_LE(many, 4.0);
+}
+
+// SOFF §4.4's second option: a reflected ray of a concave mirror bowl walked through the
+// output image against the bowl's own samples finds the analytic second intersection with
+// the sphere the bowl is cut from.
+TEST(SoffConcave, SelfWalkFindsTheAnalyticSecondIntersection) {
+  par::Executor ex(2);
+  SceneBuilder b("bowl");
+  const auto m = b.add_material(mirror("concave mirror"));
+  const glm::vec3 centre(0.0f, 2.0f, 0.0f);
+  const float radius = 2.0f;
+  b.add_object("bowl", m, bowl(centre, radius, 75.0f, 160));
+  const Scene s = b.take();
+  const Camera cam = look({0.0f, 5.0f, 1.5f}, {0.0f, 0.6f, 0.0f}, 60.0f);
+  const int w = 256, h = 256;
+  const GBuffer g = gbuffer_of(ex, s, cam, w, h);
+  const glm::mat4 vp = projection_matrix(cam, w, h) * view_matrix(cam);
+  const glm::vec3 forward = glm::normalize(cam.target - cam.eye);
+  const glm::ivec4 box(0, 0, w - 1, h - 1);
+  int tested = 0, found = 0;
+  double worst = 0.0;
+  for (int y = 8; y < h; y += 16)
+    for (int x = 8; x < w; x += 16) {
+      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+      if (!g.covered(i)) continue;
+      const glm::vec3 p = g.position.pixels[i];
+      // A direction towards a point on the bowl's far side, well inside the rim.
+      const glm::vec3 target = centre + radius * glm::normalize(glm::vec3(-p.x, -1.2f, -p.z) * 0.5f +
+                                                                glm::vec3(0.3f, -1.0f, 0.2f));
+      const glm::vec3 d = glm::normalize(target - p);
+      const float t = -2.0f * glm::dot(p - centre, d);  // |p − c| = R: the other root
+      const glm::vec3 hit = p + d * t;
+      if (!(t > 0.3f)) continue;
+      // Only second intersections the output camera sees (the bowl is open towards it).
+      const glm::vec4 clip = vp * glm::vec4(hit, 1.0f);
+      const int hx = int((clip.x / clip.w * 0.5f + 0.5f) * float(w)), hy = int((0.5f - clip.y / clip.w * 0.5f) * float(h));
+      if (hx < 0 || hy < 0 || hx >= w || hy >= h) continue;
+      const std::size_t hq = std::size_t(hy) * std::size_t(w) + std::size_t(hx);
+      if (!g.covered(hq) || glm::length(g.position.pixels[hq] - hit) > 0.05f) continue;
+      ++tested;
+      const std::uint32_t q = soff_self_walk(g, vp, forward, g.object.pixels[i], box, p, d, 2.0f * radius);
+      if (q == kNoId) continue;
+      ++found;
+      worst = std::max(worst, double(glm::length(g.position.pixels[q] - hit)));
+    }
+  ASSERT_GE(tested, 40);
+  EXPECT_GE(found, tested * 95 / 100) << found << " of " << tested;
+  // A sample of the 256² image spans about 4.2/256 of the bowl; the walk lands within a
+  // few of them of the analytic point.
+  EXPECT_LT(worst, 0.08) << "largest distance from the analytic second intersection";
+}
+
+// On the bowl scene the concave mirror's clusters are detected, their rays are intersected
+// with the bowl itself, and the specular error against the exact reference falls below that
+// of treating the clusters as convex (the first option of SOFF §4.4).
+TEST(SoffConcave, SelfIntersectionLowersTheBowlError) {
+  const Scene s = load_scene("bowl");
+  par::Executor ex(2);
+  const pipeline::Technique& t = pipeline::find_technique("soff");
+  const auto run = [&](double concave) {
+    pipeline::FrameSettings f;
+    f.width = 160;
+    f.height = 120;
+    f.camera = s.cameras.front();
+    f.params = {{"concave", concave}};
+    return pipeline::render_frame(s, t, t.with_defaults(f), ex);
+  };
+  const pipeline::FrameResult with = run(1.0), without = run(0.0);
+  const ImageRGBA ref = render_display(s, "specular-reference", 160, 120);
+  const auto counter = [](const pipeline::FrameResult& r, const char* node, const char* name) {
+    const par::NodeRecord* n = r.report.find(node);
+    const auto it = n ? n->counters.find(name) : decltype(n->counters.end()){};
+    return n && it != n->counters.end() ? it->second : -1.0;
+  };
+  EXPECT_GT(counter(with, "soff_cameras", "concave_clusters"), 0.0);
+  EXPECT_GT(counter(with, "soff_intersect", "self_hits"), 100.0);
+  EXPECT_EQ(counter(without, "soff_intersect", "self_hits"), 0.0);
+  const double e_with = specular_mae8(s, with.display, ref), e_without = specular_mae8(s, without.display, ref);
+  std::printf("bowl: specular mae8 with self-intersection %.2f, as convex %.2f\n", e_with, e_without);
+  EXPECT_LT(e_with, 0.8 * e_without);
 }
 
 }  // namespace
