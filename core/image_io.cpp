@@ -100,6 +100,16 @@ ImageRGBA read_image(const std::string& path, bool to_linear) {
       static_cast<long long>(spec.width) * spec.height > kMaxPixels)
     throw InputError(path, "absurd image size " + std::to_string(spec.width) + "x" +
                                std::to_string(spec.height));
+  // No format this reads packs more than about a thousand samples into a byte (deflate's
+  // limit is 1032:1; run-length codes stay far below), so a header that declares more than
+  // kMaxSamplesPerByte samples per byte of the file is refused before its buffer is reserved.
+  constexpr double kMaxSamplesPerByte = 2048.0;
+  const double samples = double(spec.width) * double(spec.height) * double(spec.nchannels);
+  const double file_bytes = double(std::filesystem::file_size(path));
+  if (samples > kMaxSamplesPerByte * file_bytes)
+    throw InputError(path, "header declares " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                               " pixels, more than " + std::to_string(static_cast<long long>(file_bytes)) +
+                               " bytes can hold");
   const int nc = spec.nchannels;
   std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * nc);
   if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data())) {

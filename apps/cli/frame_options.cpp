@@ -114,7 +114,7 @@ void check_sample_count(const Technique& technique, int width, int height, int s
 
 std::map<std::string, double> check_frame_options(const FrameOptions& o) {
   const Technique& technique = find_technique(o.technique);
-  check_sample_count(technique, o.width, o.height, o.spp);
+  check_sample_count(technique, o.width, o.height, technique.resolve_spp(o.spp, o.width, o.height));
   std::map<std::string, double> params;
   for (const std::string& item : o.params) {
     const auto eq = item.find('=');
@@ -152,9 +152,9 @@ FrameSettings make_frame_settings(const FrameOptions& o, const Scene& scene) {
     f.camera = resolve_camera(scene, o.camera, float(f.width) / float(f.height));
   }
   // The side a camera's aspect ratio derived counts against the same limit.
-  check_sample_count(find_technique(o.technique), f.width, f.height, o.spp);
-  f.supersample = k;
   f.spp = find_technique(o.technique).resolve_spp(o.spp, f.width, f.height);
+  check_sample_count(find_technique(o.technique), f.width, f.height, f.spp);
+  f.supersample = k;
   f.seed = o.seed;
   const Exposure exposure = parse_exposure(o.exposure);
   f.exposure = exposure.value;

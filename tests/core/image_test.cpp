@@ -80,6 +80,23 @@ TEST(ImageIo, MissingFileNamesTheFile) {
   }
 }
 
+// A 55-byte Radiance file whose header declares 999999 × 99 pixels is refused from its
+// header, before ~1.6 GB of floats are reserved for it (the fuzzer found it taking seconds).
+TEST(ImageIo, HeaderDeclaringMorePixelsThanTheFileCanHoldIsRefused) {
+  const auto path = temp_dir() / "huge_header.hdr";
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 999999 +X 99\n";
+  }
+  try {
+    read_image(path.string());
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bytes can hold"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("huge_header.hdr"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ImageIo, UnsupportedOutputFormatIsRejectedWithoutWriting) {
   ImageRGBA img(2, 2);
   const auto path = temp_dir() / "out.bmpx";
