@@ -256,13 +256,8 @@ LayerGrid layer_grid(const ConeHits& hits) {
 SecondaryRays blend_layers(par::Executor& ex, const Scene& scene, const PixelCones& cones, const ConeHits& hits,
                            HitStream& layer_hits) {
   const LayerGrid grid = layer_grid(hits);
-  SecondaryRays gen;
-  gen.width = grid.width * grid.tx;
-  gen.height = grid.height * grid.ty;
-  const std::size_t n = std::size_t(gen.width) * std::size_t(gen.height);
-  gen.rays.resize(n);
-  gen.active.assign(n, 0);
-  gen.weight.assign(n, glm::vec3(0.0f));
+  SecondaryRays gen = empty_generation(grid.width * grid.tx, grid.height * grid.ty);
+  const std::size_t n = gen.active.size();
   layer_hits.resize(n);
   std::fill(layer_hits.t.begin(), layer_hits.t.end(), kInf);
   std::fill(layer_hits.u.begin(), layer_hits.u.end(), 0.0f);
@@ -305,7 +300,7 @@ SecondaryRays blend_layers(par::Executor& ex, const Scene& scene, const PixelCon
       }
     }
   });
-  gen.count = count_flags(gen.active);
+  count_active(gen);
   return gen;
 }
 
@@ -346,13 +341,8 @@ SecondaryRays first_layer_bounce(par::Executor& ex, const Scene& scene, const Se
                                  const HitStream& layer_hits, const ConeHits& hits, std::uint64_t* dropped) {
   const LayerGrid grid = layer_grid(hits);
   const SecondaryRays all = bounce_rays(ex, scene, layers, layer_hits);
-  SecondaryRays out;
-  out.width = hits.width;
-  out.height = hits.height;
-  const std::size_t npix = std::size_t(hits.width) * std::size_t(hits.height);
-  out.rays.resize(npix);
-  out.active.assign(npix, 0);
-  out.weight.assign(npix, glm::vec3(0.0f));
+  SecondaryRays out = empty_generation(hits.width, hits.height);
+  const std::size_t npix = out.active.size();
   const std::uint32_t layer_count = std::uint32_t(grid.tx * grid.ty);
   ex.parallel_for("cone_first_layer", npix, kPixelChunk, [&](std::size_t b, std::size_t e) {
     for (std::size_t p = b; p < e; ++p) {
@@ -376,7 +366,7 @@ SecondaryRays first_layer_bounce(par::Executor& ex, const Scene& scene, const Se
       out.weight[p] = w;
     }
   });
-  out.count = count_flags(out.active);
+  count_active(out);
   if (dropped) *dropped = all.count - out.count;
   return out;
 }
@@ -384,13 +374,8 @@ SecondaryRays first_layer_bounce(par::Executor& ex, const Scene& scene, const Se
 SecondaryRays first_layer(par::Executor& ex, const SecondaryRays& layers, const HitStream& layer_hits,
                           const ConeHits& hits, HitStream& first_hits) {
   const LayerGrid grid = layer_grid(hits);
-  SecondaryRays out;
-  out.width = hits.width;
-  out.height = hits.height;
-  const std::size_t npix = std::size_t(hits.width) * std::size_t(hits.height);
-  out.rays.resize(npix);
-  out.active.assign(npix, 0);
-  out.weight.assign(npix, glm::vec3(0.0f));
+  SecondaryRays out = empty_generation(hits.width, hits.height);
+  const std::size_t npix = out.active.size();
   first_hits.resize(npix);
   ex.parallel_for("cone_first_layer", npix, kPixelChunk, [&](std::size_t b, std::size_t e) {
     for (std::size_t p = b; p < e; ++p) {
@@ -405,7 +390,7 @@ SecondaryRays first_layer(par::Executor& ex, const SecondaryRays& layers, const 
       out.weight[p] = layers.weight[q];
     }
   });
-  out.count = count_flags(out.active);
+  count_active(out);
   return out;
 }
 

@@ -17,17 +17,6 @@ namespace {
 
 constexpr std::size_t kPixelChunk = 1024;
 
-SecondaryRays empty_generation(int width, int height) {
-  SecondaryRays g;
-  g.width = width;
-  g.height = height;
-  const std::size_t n = std::size_t(width) * std::size_t(height);
-  g.rays.resize(n);
-  g.active.assign(n, 0);
-  g.weight.assign(n, glm::vec3(0.0f));
-  return g;
-}
-
 // The reflected or refracted continuation at a surface seen along unit `dir`: n and ng
 // face the incident side. Returns false for non-specular surfaces.
 bool continuation(const SurfaceParams& s, const glm::vec3& p, const glm::vec3& ng, const glm::vec3& n,
@@ -62,12 +51,23 @@ void store(SecondaryRays& g, std::size_t i, const Ray& r, const glm::vec3& w) {
   g.weight[i] = w;
 }
 
+}  // namespace
+
+SecondaryRays empty_generation(int width, int height) {
+  SecondaryRays g;
+  g.width = width;
+  g.height = height;
+  const std::size_t n = std::size_t(width) * std::size_t(height);
+  g.rays.resize(n);
+  g.active.assign(n, 0);
+  g.weight.assign(n, glm::vec3(0.0f));
+  return g;
+}
+
 void count_active(SecondaryRays& g) {
   g.count = 0;
   for (std::uint8_t a : g.active) g.count += a;
 }
-
-}  // namespace
 
 SecondaryRays secondary_rays(par::Executor& ex, const Buffer2D<glm::vec3>& position,
                              const Buffer2D<glm::vec3>& normal, const Buffer2D<SurfaceParams>& surface,

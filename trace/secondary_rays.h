@@ -30,6 +30,11 @@ struct SecondaryRays {
   std::uint64_t count = 0;  // active rays
 };
 
+// A generation of width × height pixels with no active ray (zero weights, count 0).
+SecondaryRays empty_generation(int width, int height);
+// Sets g.count to the number of active rays.
+void count_active(SecondaryRays& g);
+
 // The surfaces that get a secondary ray: mirror and glossy lobes (roughness <
 // kGlossyRoughness) and refractors (the test raster::is_specular uses).
 inline bool has_secondary_ray(const SurfaceParams& s) {

@@ -32,13 +32,8 @@ namespace {
 // weighted F(V·H) G2/G1 / N — the estimator the reference tracer uses (core/brdf.h).
 trace::SecondaryRays glossy_generation(par::Executor& ex, const raster::GBuffer& g, int sample, int samples,
                                        std::uint32_t seed) {
-  trace::SecondaryRays out;
-  out.width = g.width;
-  out.height = g.height;
-  const std::size_t n = std::size_t(g.width) * std::size_t(g.height);
-  out.rays.resize(n);
-  out.active.assign(n, 0);
-  out.weight.assign(n, glm::vec3(0.0f));
+  trace::SecondaryRays out = trace::empty_generation(g.width, g.height);
+  const std::size_t n = out.active.size();
   ex.parallel_for("glossy_lobe_rays", n, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (!g.covered(i)) continue;
@@ -56,8 +51,7 @@ trace::SecondaryRays glossy_generation(par::Executor& ex, const raster::GBuffer&
       out.weight[i] = lobe.weight / float(samples);
     }
   });
-  out.count = 0;
-  for (std::uint8_t a : out.active) out.count += a;
+  trace::count_active(out);
   return out;
 }
 
