@@ -2,6 +2,7 @@
 #include "trace/hit_radiance.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -60,13 +61,12 @@ constexpr float kBakeV[kBakePoints] = {1.0f / 3.0f, 1.0f / 6.0f, 1.0f / 6.0f, 2.
 struct BakePoint {
   SurfacePoint sp;
   glm::vec3 ng, above;
+  Onb frame;  // about the shading normal, for the sky's cosine samples
 };
 BakePoint bake_point(const Scene& scene, std::uint32_t t, int j) {
-  BakePoint b;
-  b.sp = surface_point(scene, t, kBakeU[j], kBakeV[j]);
-  b.ng = glm::dot(b.sp.ng, b.sp.n) < 0.0f ? -b.sp.ng : b.sp.ng;
-  b.above = offset_ray_origin(b.sp.p, b.ng);
-  return b;
+  const SurfacePoint sp = surface_point(scene, t, kBakeU[j], kBakeV[j]);
+  const glm::vec3 ng = glm::dot(sp.ng, sp.n) < 0.0f ? -sp.ng : sp.ng;
+  return BakePoint{sp, ng, offset_ray_origin(sp.p, ng), Onb(sp.n)};
 }
 
 }  // namespace
@@ -86,9 +86,11 @@ TriangleLighting bake_triangle_lighting(par::Executor& ex, const Scene& scene, c
   ex.parallel_for("radiance_bake", nt, 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t t = b; t < e; ++t) {
       const auto tri = static_cast<std::uint32_t>(t);
+      static_assert(kBakePoints == 4);
+      const std::array<BakePoint, kBakePoints> points{bake_point(scene, tri, 0), bake_point(scene, tri, 1),
+                                                      bake_point(scene, tri, 2), bake_point(scene, tri, 3)};
       glm::vec3 lights_e(0.0f);
-      for (int j = 0; j < kBakePoints; ++j) {
-        const BakePoint bp = bake_point(scene, tri, j);
+      for (const BakePoint& bp : points) {
         for (std::size_t l = 0; l < out.light_count; ++l) {
           const LightSample ls = sample_light(scene.lights[l], bp.sp.p);
           if (ls.irradiance == glm::vec3(0.0f) || glm::dot(bp.ng, ls.direction) <= 0.0f) continue;
@@ -105,10 +107,10 @@ TriangleLighting bake_triangle_lighting(par::Executor& ex, const Scene& scene, c
       if (ks > 0) {
         const glm::vec2 shift = random_float2(tri, 0, 0, opt.seed);
         for (int k = 0; k < ks; ++k) {
-          const BakePoint bp = bake_point(scene, tri, k % kBakePoints);
+          const BakePoint& bp = points[static_cast<std::size_t>(k % kBakePoints)];
           const glm::vec2 u = rotate_unit_square(hamersley(static_cast<std::uint32_t>(k),
                                                            static_cast<std::uint32_t>(ks)), shift);
-          const glm::vec3 wi = Onb(bp.sp.n).to_world(sample_cosine_hemisphere(u));
+          const glm::vec3 wi = bp.frame.to_world(sample_cosine_hemisphere(u));
           if (glm::dot(wi, bp.ng) <= 0.0f) continue;
           Ray r;
           r.origin = bp.above;
@@ -118,7 +120,7 @@ TriangleLighting bake_triangle_lighting(par::Executor& ex, const Scene& scene, c
         env_e *= kPi / static_cast<float>(ks);  // E = π × mean radiance under cosine sampling
       }
       out.environment_irradiance[t] = env_e;
-      const SurfaceParams s = surface_point(scene, tri, 1.0f / 3.0f, 1.0f / 3.0f).s;
+      const SurfaceParams& s = points[0].sp.s;  // the centroid's material
       out.radiance[t] = s.emissive + diffuse_albedo_over_pi(s, 1.0f) * (lights_e + env_e) +
                         specular_f0(s) * (env_e / kPi);
     }
