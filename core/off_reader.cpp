@@ -211,6 +211,30 @@ class Reader {
     return key_.four ? 4 : 3;
   }
 
+  // An empty mesh with room for nv vertices and the attributes the keyword declares.
+  OffMesh vertex_storage(std::uint64_t nv) const {
+    OffMesh m;
+    m.positions.reserve(nv);
+    if (key_.normal) m.normals.reserve(nv);
+    if (key_.st) m.uvs.reserve(nv);
+    return m;
+  }
+
+  // Vertex i's position (pv values, divided by w for 4OFF) and, for NOFF, its normal, read
+  // with the format's number reader `value(label)`.
+  template <class Read>
+  void read_position_and_normal(OffMesh& m, std::uint64_t i, int pv, const std::string& what,
+                                const std::string& normal_what, Read value) {
+    std::array<double, 4> v{};
+    for (int k = 0; k < pv; ++k) v[k] = value(what);
+    m.positions.push_back(finite_position(path_, i, v, key_.four));
+    if (key_.normal) {
+      glm::vec3 n;
+      for (int k = 0; k < 3; ++k) n[k] = static_cast<float>(value(normal_what));
+      m.normals.push_back(n);
+    }
+  }
+
   OffMesh read_ascii() {
     const long long ndim = key_.ndim ? static_cast<long long>(count("dimension")) : 3;
     const int pv = position_values(ndim);
@@ -218,20 +242,10 @@ class Reader {
     (void)count("edge count");  // "not used or checked ... but must be present"
     const std::uint64_t per_vertex = pv + (key_.normal ? 3 : 0) + (key_.st ? 2 : 0);
     check_counts(nv, nf, per_vertex, 2, 2);
-    OffMesh m;
-    m.positions.reserve(nv);
-    if (key_.normal) m.normals.reserve(nv);
-    if (key_.st) m.uvs.reserve(nv);
+    OffMesh m = vertex_storage(nv);
     for (std::uint64_t i = 0; i < nv; ++i) {
       const std::string what = "vertex " + std::to_string(i);
-      std::array<double, 4> v{};
-      for (int k = 0; k < pv; ++k) v[k] = number(what);
-      m.positions.push_back(finite_position(path_, i, v, key_.four));
-      if (key_.normal) {
-        glm::vec3 n;
-        for (int k = 0; k < 3; ++k) n[k] = static_cast<float>(number(what + " normal"));
-        m.normals.push_back(n);
-      }
+      read_position_and_normal(m, i, pv, what, what + " normal", [&](const std::string& w) { return number(w); });
       if (key_.colour) {
         // A colour's length is not fixed (1 index, 3 or 4 components), so it is what is left
         // on the vertex's line, less the texture coordinates that follow it.
@@ -316,20 +330,10 @@ class Reader {
     // that many floats (OFF section, binary form).
     const std::uint64_t per_vertex = pv + (key_.normal ? 3 : 0) + (key_.colour ? 4 : 0) + (key_.st ? 2 : 0);
     check_counts(nv, nf, per_vertex, 4, 8);
-    OffMesh m;
-    m.positions.reserve(nv);
-    if (key_.normal) m.normals.reserve(nv);
-    if (key_.st) m.uvs.reserve(nv);
+    OffMesh m = vertex_storage(nv);
     for (std::uint64_t i = 0; i < nv; ++i) {
       const std::string what = "vertex " + std::to_string(i);
-      std::array<double, 4> v{};
-      for (int k = 0; k < pv; ++k) v[k] = f32(what);
-      m.positions.push_back(finite_position(path_, i, v, key_.four));
-      if (key_.normal) {
-        glm::vec3 n;
-        for (int k = 0; k < 3; ++k) n[k] = f32(what);
-        m.normals.push_back(n);
-      }
+      read_position_and_normal(m, i, pv, what, what, [&](const std::string& w) { return double(f32(w)); });
       if (key_.colour)
         for (int k = 0; k < 4; ++k) (void)f32(what);
       if (key_.st) {
