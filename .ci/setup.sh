@@ -12,5 +12,5 @@ $SUDO apt-get install -y -q --no-install-recommends \
   libopenmesh-dev libtbb-dev libnanoflann-dev \
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev \
   assimp-testmodels graphviz libembree-dev \
-  ccache chromium libexpat1-dev parallel gnuplot-nox \
+  ccache chromium libexpat1-dev parallel gnuplot-nox libosmesa6-dev \
   clang-14 libclang-rt-14-dev

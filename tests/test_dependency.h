@@ -1,4 +1,4 @@
-// Tests that need something outside the project (Chromium, gnuplot, GNU parallel, Debian's
+// Tests that need something outside the project (Chromium, gnuplot, GNU parallel, OSMesa, Debian's
 // assimp-testmodels) say so instead of passing quietly without it: under CI (the CI
 // environment variable set, as .ci/run does) a missing dependency fails the test with what to
 // install; elsewhere the test is skipped, and GoogleTest lists it as skipped.

@@ -13,6 +13,7 @@
 #include "apps/cli/camera_options.h"
 #include "apps/cli/json_output.h"
 #include "core/error.h"
+#include "core/output_file.h"
 #include "core/scene_loader.h"
 #include "raster/gbuffer.h"
 #include "raster/visibility.h"
@@ -27,6 +28,7 @@ struct BenchRasterOptions {
   int repeat = 10;
   bool json = false;
   std::string write_ply;
+  std::string write_ids;
   std::string cull = "none";
   std::string gbuffer_source = "records";
   pipeline::CameraOverrides camera;
@@ -36,6 +38,17 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The visibility buffer as the llvmpipe yardstick's --write-ids writes its primitive ids:
+// width × height little-endian uint32, top row first, triangle index + 1 (0: nothing), so
+// the two rasterizers can be compared pixel by pixel.
+void write_triangle_ids(const std::string& path, const raster::VisibilityBuffer& vis) {
+  std::vector<std::uint32_t> ids(vis.triangle.size());
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    ids[i] = vis.triangle.pixels[i] == kNoId ? 0u : vis.triangle.pixels[i] + 1u;
+  const std::string bytes(reinterpret_cast<const char*>(ids.data()), ids.size() * sizeof(std::uint32_t));
+  write_text_file(path, bytes);  // the host is little-endian (x86-64)
 }
 
 void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) {
@@ -77,6 +90,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
     const auto t1 = executor.now_ns();
     if (run == 0) {
       for (std::size_t i = 0; i < g.object.size(); ++i) covered += g.covered(i);
+      if (!o.write_ids.empty()) write_triangle_ids(o.write_ids, vis);
       continue;
     }
     frame_ms.push_back((t1 - t0) * 1e-6);
@@ -131,6 +145,9 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global) {
                   "built once and timed as gbuffer_prepare_ms) or mesh (index/vertex arrays)")
       ->capture_default_str();
   cmd->add_option("--write-ply", o->write_ply, "Also write the triangles as binary PLY");
+  cmd->add_option("--write-ids", o->write_ids,
+                  "Also write the visible triangle per pixel (raw little-endian uint32, top row "
+                  "first, triangle index + 1, 0 for nothing; as speculum_llvmpipe_bench --write-ids)");
   pipeline::add_camera_options(*cmd, o->camera);
   cmd->callback([o, &global] { run_bench_raster(*o, global); });
 }

@@ -189,6 +189,7 @@ struct Options {
   float fov = 45.0f;
   float znear = 0.0f, zfar = 0.0f;  // 0: derived from the mesh bounds
   std::string attribute_format = "rgba16f";  // the second colour attachment
+  std::string write_ids;  // the visibility attachment after the last frame, if set
   bool json = false;
 };
 
@@ -206,6 +207,9 @@ void usage(FILE* to) {
       "  --attribute-format F   second attachment: rgba16f (default), rgba32f or rgba8\n"
       "  --repeat K             timed frames after one warm-up (default 10)\n"
       "  --json                 print one JSON object\n"
+      "  --write-ids FILE       also write the primitive id + 1 per pixel (0: nothing) as raw\n"
+      "                         little-endian uint32, top row first (as speculum bench raster\n"
+      "                         --write-ids), to compare the two rasterizers pixel by pixel\n"
       "llvmpipe's thread count is set by the environment variable LP_NUM_THREADS (unset: one per\n"
       "CPU), e.g. LP_NUM_THREADS=2 speculum_llvmpipe_bench mesh.ply --json\n"
       "Export a speculum workload and its camera with e.g.\n"
@@ -257,6 +261,7 @@ Options parse_args(int argc, char** argv) {
     else if (a == "--far") o.zfar = float(parse_number(a, value()));
     else if (a == "--attribute-format") o.attribute_format = value();
     else if (a == "--json") o.json = true;
+    else if (a == "--write-ids") o.write_ids = value();
     else if (!a.empty() && a[0] == '-') die("unknown option '" + a + "' (see --help)");
     else if (o.mesh.empty()) o.mesh = a;
     else die("more than one mesh given ('" + o.mesh + "', '" + a + "')");
@@ -466,6 +471,14 @@ int main(int argc, char** argv) {
   glReadPixels(0, 0, o.width, o.height, GL_RED_INTEGER, GL_UNSIGNED_INT, ids.data());
   check_gl("glReadPixels");
   const std::size_t covered = std::size_t(std::count_if(ids.begin(), ids.end(), [](GLuint v) { return v != 0; }));
+  if (!o.write_ids.empty()) {
+    // GL's rows run bottom to top; the file's top to bottom.
+    std::ofstream out(o.write_ids, std::ios::binary | std::ios::trunc);
+    for (int y = o.height - 1; y >= 0; --y)
+      out.write(reinterpret_cast<const char*>(ids.data() + std::size_t(y) * o.width),
+                std::streamsize(std::size_t(o.width) * sizeof(GLuint)));
+    if (!out) die(o.write_ids + ": cannot write");
+  }
 
   // llvmpipe reads LP_NUM_THREADS once; unset, it uses one rasterizer thread per CPU.
   const char* env_threads = std::getenv("LP_NUM_THREADS");
