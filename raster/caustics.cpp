@@ -56,6 +56,12 @@ bool face_pixel(const glm::vec3& d, int face, int size, glm::vec2& out) {
   return true;
 }
 
+// A texel and its share of a caustic triangle.
+struct TexelShare {
+  int x, y;
+  float w;
+};
+
 // A caustic map being built: flux, weight and Σ weight·distance in the cube, Σ weight·wi
 // beside it.
 struct MapTarget {
@@ -97,30 +103,60 @@ void splat(MapTarget& t, const glm::vec3& dir, const glm::vec3& flux, float dist
 
 float edge(glm::vec2 a, glm::vec2 b, glm::vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
 
-// A caustic triangle's flux spread evenly over the texels whose centres it covers (the
-// texel under its centroid when it covers none), so its total is kept exactly.
+// The area of triangle p inside texel [x, x+1] × [y, y+1]: the triangle clipped by the
+// texel's four sides (Sutherland–Hodgman; at most 7 corners), then the shoelace formula.
+float texel_overlap(const glm::vec2 (&p)[3], float x, float y) {
+  glm::vec2 poly[8] = {p[0], p[1], p[2]}, next[8];
+  int n = 3;
+  // Each side as (axis, bound, keep the side above the bound).
+  const struct { int axis; float bound; bool above; } sides[4] = {
+      {0, x, true}, {0, x + 1.0f, false}, {1, y, true}, {1, y + 1.0f, false}};
+  for (const auto& side : sides) {
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const glm::vec2 a = poly[i], b = poly[(i + 1) % n];
+      const float da = side.above ? a[side.axis] - side.bound : side.bound - a[side.axis];
+      const float db = side.above ? b[side.axis] - side.bound : side.bound - b[side.axis];
+      if (da >= 0.0f) next[m++] = a;
+      if ((da >= 0.0f) != (db >= 0.0f)) next[m++] = a + (b - a) * (da / (da - db));
+    }
+    n = m;
+    if (n == 0) return 0.0f;
+    std::copy(next, next + n, poly);
+  }
+  float twice = 0.0f;
+  for (int i = 0; i < n; ++i) twice += poly[i].x * poly[(i + 1) % n].y - poly[(i + 1) % n].x * poly[i].y;
+  return 0.5f * std::fabs(twice);
+}
+
+// A caustic triangle's flux spread over the texels it overlaps in proportion to the area of
+// each overlap (box-filtered rasterization: a triangle smaller than a texel does not alias
+// against the texel grid), normalized over the face's texels so its total is kept exactly;
+// a triangle with no area inside the face goes to the texel under its centroid.
 void raster_triangle(MapTarget& t, int face, const glm::vec2 (&p)[3], const glm::vec3& flux, float dist,
-                     const glm::vec3& wi, std::vector<std::pair<int, int>>& scratch) {
+                     const glm::vec3& wi, std::vector<TexelShare>& scratch) {
   const CubeMap& m = t.m;
   scratch.clear();
-  const float area = edge(p[0], p[1], p[2]);
   const int x0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].x, p[1].x, p[2].x}))));
   const int x1 = std::min(m.size - 1, static_cast<int>(std::floor(std::max({p[0].x, p[1].x, p[2].x}))));
   const int y0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].y, p[1].y, p[2].y}))));
   const int y1 = std::min(m.size - 1, static_cast<int>(std::floor(std::max({p[0].y, p[1].y, p[2].y}))));
-  if (area != 0.0f)
+  float total = 0.0f;
+  if (edge(p[0], p[1], p[2]) != 0.0f)
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
-        const glm::vec2 q(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
-        const float w0 = edge(p[1], p[2], q) / area, w1 = edge(p[2], p[0], q) / area, w2 = edge(p[0], p[1], q) / area;
-        if (w0 >= 0.0f && w1 >= 0.0f && w2 >= 0.0f) scratch.emplace_back(x, y);
+        const float a = texel_overlap(p, static_cast<float>(x), static_cast<float>(y));
+        if (a > 0.0f) {
+          scratch.push_back({x, y, a});
+          total += a;
+        }
       }
-  if (scratch.empty()) {
+  if (!(total > 0.0f)) {
     const glm::vec2 g = (p[0] + p[1] + p[2]) / 3.0f;
-    scratch.emplace_back(std::clamp(static_cast<int>(g.x), 0, m.size - 1), std::clamp(static_cast<int>(g.y), 0, m.size - 1));
+    scratch.assign(1, {std::clamp(static_cast<int>(g.x), 0, m.size - 1), std::clamp(static_cast<int>(g.y), 0, m.size - 1), 1.0f});
+    total = 1.0f;
   }
-  const float share = 1.0f / static_cast<float>(scratch.size());
-  for (const auto& [x, y] : scratch) deposit(t, face, x, y, flux * share, share, dist, wi);
+  for (const TexelShare& e : scratch) deposit(t, face, e.x, e.y, flux * (e.w / total), e.w / total, dist, wi);
 }
 
 // A normalized 3×3 tent blur inside each face: every texel's flux goes to its in-face
@@ -216,6 +252,7 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         img.object = object;
         img.light = li;
         img.res = res;
+        img.surface_reflection = surface_reflection;
         img.centre = maps.centres[static_cast<std::size_t>(map_index)];
         const std::size_t n = static_cast<std::size_t>(res) * res;
         img.hit.assign(n, glm::vec3(0.0f));
@@ -334,7 +371,7 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
   if (opt.size < 1 || opt.size > 4096) throw InputError("caustic_map", "size out of range (1..4096)");
   CausticMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
-  std::vector<std::pair<int, int>> scratch;
+  std::vector<TexelShare> scratch;
   // The photons land in the order of the images and their texels (a serial blend stage:
   // the same sums for any thread count).
   for (const PhotonImage& img : photons.images) {

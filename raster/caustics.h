@@ -63,6 +63,7 @@ struct PhotonImage {
   std::uint32_t object = 0;  // the generator
   std::uint32_t light = 0;
   int res = 0;
+  bool surface_reflection = false;   // a refractor's reflected twin (else its refracted path, or a mirror's)
   glm::vec3 centre{0.0f};            // the generator's map centre o
   std::vector<glm::vec3> hit;        // receiver point (world)
   std::vector<glm::vec3> wi;         // unit, from the receiver point back along the photon

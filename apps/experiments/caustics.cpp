@@ -19,6 +19,7 @@
 #include "apps/cli/commands.h"
 #include "apps/cli/progress.h"
 #include "apps/cli/result_table.h"
+#include "apps/techniques/technique_table.h"
 #include "core/error.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
@@ -35,6 +36,8 @@ namespace {
 struct CausticsOptions {
   std::vector<std::string> scenes;
   std::vector<int> photon_res;
+  std::vector<std::string> filters;   // the technique's filter modes, by name or number
+  std::vector<std::string> storages;  // cube, light
   int width = 160;
   int height = 120;
   int cube_size = 256;
@@ -75,11 +78,26 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
   if (resolutions.empty()) resolutions = o.quick ? std::vector<int>{32, 64} : std::vector<int>{32, 64, 128, 256, 512};
   for (int r : resolutions)
     if (r < 16 || r > 512) throw InputError("--photon-res", std::to_string(r) + " is outside [16, 512]");
+  // The filters as the technique names them (`--param filter=...`): the same names in and out.
+  const pipeline::Technique& technique = pipeline::find_technique("caustics");
+  const pipeline::TechniqueParam* filter_param = nullptr;
+  for (const pipeline::TechniqueParam& p : technique.params)
+    if (p.name == "filter") filter_param = &p;
+  std::vector<int> filters;
+  for (const std::string& f : o.filters) try {
+      filters.push_back(static_cast<int>(pipeline::parse_technique_param(technique, "filter=" + f).second));
+    } catch (const InputError& e) {
+      throw InputError("--filter", e.problem());
+    }
+  if (filters.empty())
+    for (std::size_t k = 0; k < filter_param->choices.size(); ++k) filters.push_back(static_cast<int>(k));
+  std::vector<std::string> storages = o.storages;
+  if (storages.empty()) storages = {"cube", "light"};
   const int width = o.quick ? 64 : o.width, height = o.quick ? 48 : o.height;
   const int reference_photons = o.quick ? 4 : o.reference_photons;
   par::Executor ex(global.threads, global.lanes);
   ResultTable table(o.json);
-  Progress progress("caustics", scenes.size() * resolutions.size() * 4, global.quiet);
+  Progress progress("caustics", scenes.size() * resolutions.size() * storages.size() * filters.size(), global.quiet);
   table.set_progress(&progress);
   for (const std::string& scene_name : scenes) {
     const Scene scene = load_scene(o.quick ? scene_name + ":size=4000" : scene_name);
@@ -114,14 +132,14 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
                          ? img.centre - glm::normalize(l.direction) * (2.0f * glm::length(scene.bounds().extent()))
                          : l.position;
       }
-      for (const char* storage : {"cube", "light"})
-        for (raster::CausticFilter filter : {raster::CausticFilter::Splat, raster::CausticFilter::Triangles}) {
+      for (const std::string& storage : storages)
+        for (int filter : filters) {
           raster::CausticMapOptions mo;
           mo.size = o.caustic_size;
-          mo.filter = filter;
+          mo.filter = static_cast<raster::CausticFilter>(filter);
           const auto t1 = std::chrono::steady_clock::now();
           const raster::CausticMaps cm =
-              raster::build_caustic_maps(ex, scene, std::string(storage) == "cube" ? photons : light_space, mo);
+              raster::build_caustic_maps(ex, scene, storage == "cube" ? photons : light_space, mo);
           const ImageRGBA term = raster::gather_caustics(ex, gbuffer, cm, black, 0.05f);
           const double ms = photons_ms + ms_since(t1);
           double total = 0.0, leaked = 0.0;
@@ -132,7 +150,7 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
           }
           const ImageError err = image_error(display(ex, term), reference_display, "caustic term vs reference");
           table.cell("scene", scene_name)
-              .cell("filter", filter == raster::CausticFilter::Splat ? "splat" : "triangles")
+              .cell("filter", filter_param->value_text(filter))
               .cell("storage", storage)
               .cell("photon_res", res)
               .cell("photons", static_cast<std::int64_t>(photons.photons))
@@ -156,6 +174,10 @@ void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& glo
       "Example: speculum experiment caustics --photon-res 64 --photon-res 256 --json");
   cmd->add_option("--scene", o->scenes, "Scene(s) (repeatable; default: glass-sphere, caustic-ring, water-slab)");
   cmd->add_option("--photon-res", o->photon_res, "Photon image side(s), 16..512 (repeatable; default: 32 64 128 256 512)");
+  cmd->add_option("--filter", o->filters,
+                  "Caustic-map filter(s) by name as in `--param filter=`: splat, triangles (repeatable; default: both)");
+  cmd->add_option("--storage", o->storages, "Caustic-map storage(s): cube, light (repeatable; default: both)")
+      ->check(CLI::IsMember({"cube", "light"}));
   cmd->add_option("--width", o->width, "Image width")->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--height", o->height, "Image height")->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--cube-size", o->cube_size, "Face size of the generators' distance maps")
