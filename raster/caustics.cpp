@@ -260,7 +260,8 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         img.flux.assign(n, glm::vec3(0.0f));
         img.valid.assign(n, 0);
         std::vector<glm::vec3> arriving(n, glm::vec3(0.0f));
-        std::vector<std::uint8_t> state(n, 0);  // 0 none, 1 stored, 2 TIR, 3 no receiver
+        std::vector<std::uint8_t> state(n, 0);  // 0 none, 1 stored, 2 TIR, 3 no receiver, 4 chain bound
+        std::vector<std::uint8_t> chain(n, 0);  // internal reflections followed
         const CubeMap* impostor = impostors ? impostors->for_object(object) : nullptr;
         ex.parallel_for("caustic_photons", n, 256, [&](std::size_t b, std::size_t e) {
           for (std::size_t i = b; i < e; ++i) {
@@ -287,18 +288,32 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               if (glm::dot(n1, v) >= 0.0f) n1 = -n1;
               if (!impostor) continue;
               RefractionPath path = enter_refractor(p1, v, n1, s.ior);
-              glm::vec3 p2, n2;
-              if (!find_impostor_exit(*impostor, p1, path.inside, opt.exit_search, p2, n2)) {
-                state[i] = 3;
-                continue;
+              glm::vec3 start = p1, p2, n2;
+              // Total internal reflections are followed inside, each exit found again in the
+              // impostor, up to `chain` of them (the reference weights each by transmission).
+              glm::vec3 inside_weight(1.0f);
+              bool lost = false;
+              for (;;) {
+                if (!find_impostor_exit(*impostor, start, path.inside, opt.exit_search, p2, n2)) {
+                  state[i] = 3;
+                  lost = true;
+                  break;
+                }
+                leave_refractor(path, p2, n2, s.ior);
+                if (!path.total_internal) break;
+                if (chain[i] == opt.chain) {
+                  state[i] = 2;
+                  lost = true;
+                  break;
+                }
+                ++chain[i];
+                inside_weight *= s.transmission;
+                start = p2;
+                path.inside = glm::normalize(path.internal);
               }
-              leave_refractor(path, p2, n2, s.ior);
-              if (path.total_internal) {
-                state[i] = 2;
-                continue;
-              }
+              if (lost) continue;
               const glm::vec3 t = s.transmission * s.base_color;
-              flux *= t * (1.0f - path.f_entry) * t * (1.0f - path.f_exit);
+              flux *= inside_weight * t * (1.0f - path.f_entry) * t * (1.0f - path.f_exit);
               x = p2;
               r = glm::normalize(path.exit_direction);
             } else if (s.is_refractor()) {
@@ -315,6 +330,36 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               flux *= specular_reflectance(s, -glm::dot(n1, v));
               x = p1;
               r = reflect(v, n1);
+              // A concave mirror (a ring, a bowl) meets itself again: the ray searched in the
+              // mirror's own distance impostor. A crossing is the next reflection when it is
+              // bracketed, lies on the stored surface (within 2 %: a bracket from an empty
+              // direction into one behind the surface is none), beyond a twentieth of the
+              // mirror's radius, and before the receiver the environment search brackets;
+              // up to `chain` of them. A photon still meeting the mirror after those is
+              // dropped (its receiver would be behind the mirror: a light leak).
+              bool lost = false;
+              while (impostor) {
+                const DistanceSearchResult self = search_distance_map(*impostor, x, r, opt.exit_search);
+                if (!self.bracketed || !(self.d > 0.05f * sphere.radius)) break;
+                const glm::vec3 on = x + r * self.d - impostor->centre;
+                const float surface = impostor->distance_towards(on);
+                if (!(std::fabs(glm::length(on) - surface) <= 0.02f * surface)) break;
+                const DistanceSearchResult before = search_distance_map(env, x, r, opt.receiver_search);
+                if (before.bracketed && before.d < self.d) break;
+                if (chain[i] == opt.chain) {
+                  state[i] = 4;
+                  lost = true;
+                  break;
+                }
+                ++chain[i];
+                x += r * self.d;
+                glm::vec3 nm(impostor->colour_towards(self.direction));
+                nm = glm::dot(nm, nm) > 0.0f ? glm::normalize(nm) : glm::normalize(x - impostor->centre);
+                if (glm::dot(nm, r) > 0.0f) nm = -nm;
+                flux *= specular_reflectance(s, -glm::dot(nm, r));
+                r = glm::normalize(reflect(r, nm));
+              }
+              if (lost) continue;
             }
             const DistanceSearchResult found = search_distance_map(env, x, r, opt.receiver_search);
             const float stored = std::isfinite(found.d) ? env.distance_towards(found.direction) : kInf;
@@ -336,6 +381,7 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
             ++out.photons;
             out.generator_flux += glm::dvec3(arriving[i]);
           }
+          out.internal_reflections += chain[i];
           if (state[i] == 1) {
             ++out.stored;
             out.stored_flux += glm::dvec3(img.flux[i]);
@@ -343,6 +389,8 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
             ++out.total_internal;
           } else if (state[i] == 3) {
             ++out.no_receiver;
+          } else if (state[i] == 4) {
+            ++out.chain_limited;
           }
         }
         out.images.push_back(std::move(img));
@@ -555,6 +603,8 @@ CausticPhotons CausticPhotonsPass::operator()(par::NodeContext& c, const Reflect
   c.count("stored", static_cast<double>(p.stored));
   c.count("total_internal", static_cast<double>(p.total_internal));
   c.count("no_receiver", static_cast<double>(p.no_receiver));
+  c.count("internal_reflections", static_cast<double>(p.internal_reflections));
+  c.count("chain_limited", static_cast<double>(p.chain_limited));
   return p;
 }
 

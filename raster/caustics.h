@@ -27,9 +27,12 @@
 //   mean photon direction, shaded with the surface's BRDF, added to the direct light.
 //
 // A refractor's photons take two paths, refracted in and out and reflected off its surface
-// (one photon image each). Limits: one generator per path (a photon leaving one generator
-// does not enter another); internal reflections are not followed (TIR photons are dropped
-// and counted). Reflections and refractions see the caustics through
+// (one photon image each). Internal reflections are followed up to `chain` per photon: a
+// mirror that meets itself again (a ring, a bowl) is found in its own distance impostor
+// (§4.4's search, the mirror alone), a refractor's total internal reflections in its
+// impostor. Limits: one generator per path (a photon leaving one generator does not enter
+// another); a refractor's partial internal reflection (F at the exit) is not followed, nor
+// does a photon leaving a refractor meet it again. Reflections and refractions see the caustics through
 // caustic_reflector_maps, the reflector cube maps rendered again with the caustics gathered
 // on their faces.
 #pragma once
@@ -54,6 +57,9 @@ namespace speculum::raster {
 
 struct CausticPhotonOptions {
   int photon_res = 128;                // photon image side per light × generator
+  // Internal reflections followed per photon inside its generator: a mirror meeting itself
+  // again (found in its own distance impostor), a refractor's total internal reflections.
+  int chain = 4;
   DistanceSearchOptions receiver_search;  // in the generator's environment distance map
   DistanceSearchOptions exit_search;      // in a refractor's distance impostor
 };
@@ -77,6 +83,9 @@ struct CausticPhotons {
                                      // refractor's reflected twin not counted again)
   std::uint64_t stored = 0;          // photons with a receiver
   std::uint64_t total_internal = 0;  // refracted photons dropped by total internal reflection
+                                     // beyond the chain bound
+  std::uint64_t internal_reflections = 0;  // reflections followed inside the generators
+  std::uint64_t chain_limited = 0;   // mirror photons still meeting their mirror after `chain`
   std::uint64_t no_receiver = 0;     // searches that found nothing (the environment)
   glm::dvec3 generator_flux{0.0};    // Σ photon power arriving at the generators
   glm::dvec3 stored_flux{0.0};       // Σ power of the stored photons (after the path's Fresnel)
@@ -129,7 +138,7 @@ struct CausticPhotonsPass {
       "map for its diffuse receiver, with power Φ·Ω_texel/(4π) times Fresnel (SURVEY §6.1.2).";
   const Scene* scene = nullptr;
   CausticPhotonOptions options;
-  void parameters(par::Params& p) const { p.set("photon_res", options.photon_res); }
+  void parameters(par::Params& p) const { p.set("photon_res", options.photon_res).set("chain", options.chain); }
   CausticPhotons operator()(par::NodeContext& c, const ReflectorMaps& maps, const RefractorImpostors* impostors) const;
 };
 

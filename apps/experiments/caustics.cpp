@@ -9,6 +9,7 @@
 // photons' receiver from a point behind it along the light's ray.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -21,6 +22,7 @@
 #include "apps/cli/result_table.h"
 #include "apps/techniques/technique_table.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
 #include "raster/caustics.h"
@@ -43,6 +45,7 @@ struct CausticsOptions {
   int cube_size = 256;
   int caustic_size = 128;
   int reference_photons = 64;  // per pixel, per light and generator
+  std::string images;  // write each row's caustic term, the reference's and their difference here
   bool quick = false;
   bool json = false;
 };
@@ -116,7 +119,7 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
     const raster::GBuffer gbuffer =
         raster::resolve_gbuffer(ex, scene, raster::render_visibility(ex, scene, cam, width, height), cam.eye);
     const raster::ReflectorMaps maps = raster::render_reflector_maps(ex, scene, shadows, env, o.cube_size, &gbuffer);
-    const raster::RefractorImpostors impostors = raster::render_refractor_impostors(ex, scene, 128);
+    const raster::RefractorImpostors impostors = raster::render_refractor_impostors(ex, scene, 128, true);
     const ImageRGBA black(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     for (int res : resolutions) {
       raster::CausticPhotonOptions pho;
@@ -148,7 +151,24 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
             total += e;
             if (!lit[i]) leaked += e;
           }
-          const ImageError err = image_error(display(ex, term), reference_display, "caustic term vs reference");
+          const ImageRGBA term_display = display(ex, term);
+          const ImageError err = image_error(term_display, reference_display, "caustic term vs reference");
+          if (!o.images.empty()) {
+            // The two caustic terms and their absolute 8-bit difference, scaled by 8.
+            const std::string stem = o.images + "/" + scene_name.substr(0, scene_name.find(':')) + "_" +
+                                     std::to_string(res) + "_" + filter_param->value_text(filter) + "_" + storage;
+            ImageRGBA diff(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+            for (std::size_t i = 0; i < diff.pixels.size(); ++i)
+              for (int ch = 0; ch < 3; ++ch) {
+                const int d = std::abs(display_to_8bit(term_display.pixels[i][ch]) -
+                                       display_to_8bit(reference_display.pixels[i][ch]));
+                diff.pixels[i][ch] = srgb_to_linear(std::min(1.0f, 8.0f * float(d) / 255.0f));
+              }
+            write_image(stem + ".png", term_display);
+            write_image(stem + "_diff8.png", diff);
+            write_image(o.images + "/" + scene_name.substr(0, scene_name.find(':')) + "_reference.png",
+                        reference_display);
+          }
           table.cell("scene", scene_name)
               .cell("filter", filter_param->value_text(filter))
               .cell("storage", storage)
@@ -187,6 +207,9 @@ void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& glo
   cmd->add_option("--reference-photons", o->reference_photons,
                   "Light-traced reference photons per pixel, per light and generator")
       ->check(CLI::Range(1, 1024))->capture_default_str();
+  cmd->add_option("--images", o->images,
+                  "Write each row's caustic term, the reference's and their 8-bit difference ×8 into this existing directory")
+      ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quick", o->quick, "Smoke check: 64x48, photon_res 32 and 64, small scenes, 4 reference photons per pixel");
   cmd->add_flag("--json", o->json, "One JSON object per row instead of the text table");
   cmd->callback([o, &global] { run_caustics(*o, global); });

@@ -26,9 +26,13 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
                   .describe("Colour + distance cube map around each specular object, itself left out: "
                             "what reflected rays and the photons leaving a generator search (SURVEY §4.1, §6.1).");
   auto impostors = g.add("refractor_impostors",
-                         RefractorImpostorsPass{scene, static_cast<int>(f.param("impostor_size"))});
+                         RefractorImpostorsPass{scene, static_cast<int>(f.param("impostor_size")), true})
+                       .describe("Each refractor and mirror alone from its centre: normal + distance cube map, "
+                                 "searched for a refracted ray's exit and for a photon meeting its generator "
+                                 "again (distance impostors, SURVEY §4.4).");
   CausticPhotonOptions po;
   po.photon_res = static_cast<int>(f.param("photon_res"));
+  po.chain = static_cast<int>(f.param("chain"));
   po.receiver_search = search;
   po.exit_search = search;
   auto photons = g.add("caustic_photons", CausticPhotonsPass{scene, po}, maps, impostors);

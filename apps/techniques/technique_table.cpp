@@ -160,6 +160,8 @@ const std::vector<Technique>& techniques() {
        // Photon images cost photon_res² texels per light and generator (512: 262k each), the
        // caustic map 6·caustic_size² texels (1024: ~200 MB per generator).
        {{"photon_res", 128, 16, 512, true, "photon image side per light and generator (512: 262k photons)"},
+        {"chain", 4, 0, 16, true,
+         "internal reflections a photon follows in its generator: a mirror meeting itself, a refractor's TIR (each one search)"},
         choice_param("filter", "splat", {"splat", "triangles"},
                      "normalized tent-kernel splats, or caustic triangles (then blurred)"),
         {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (splat; the least with adaptive)"},
@@ -168,7 +170,7 @@ const std::vector<Technique>& techniques() {
         {"tolerance", 0.05, 0.001, 1, false, "relative distance mismatch still taken as the photons' receiver"},
         {"linear_steps", 16, 0, 256, true, "linear search steps (receiver and exit searches; < 2: off)"},
         {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
-        {"impostor_size", 128, 4, 1024, true, "cube face side of the refractors' distance impostors (~150 MB each at 1024)"}}},
+        {"impostor_size", 128, 4, 1024, true, "cube face side of the generators' distance impostors (~150 MB each at 1024)"}}},
       {"yu-lod",
        "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
        "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",
