@@ -45,6 +45,7 @@ struct CausticsOptions {
   int cube_size = 256;
   int caustic_size = 128;
   int reference_photons = 64;  // per pixel, per light and generator
+  int chain = 4;               // internal reflections per photon (the technique's `chain`)
   std::string images;  // write each row's caustic term, the reference's and their difference here
   bool quick = false;
   bool json = false;
@@ -124,6 +125,7 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
     for (int res : resolutions) {
       raster::CausticPhotonOptions pho;
       pho.photon_res = res;
+      pho.chain = o.chain;
       const auto t0 = std::chrono::steady_clock::now();
       const raster::CausticPhotons photons = raster::trace_photon_images(ex, scene, maps, &impostors, pho);
       const double photons_ms = ms_since(t0);
@@ -204,6 +206,8 @@ void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& glo
       ->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--caustic-size", o->caustic_size, "Face size of the caustic maps")
       ->check(CLI::Range(16, 1024))->capture_default_str();
+  cmd->add_option("--chain", o->chain, "Internal reflections a photon follows in its generator (the technique's `chain`)")
+      ->check(CLI::Range(0, 16))->capture_default_str();
   cmd->add_option("--reference-photons", o->reference_photons,
                   "Light-traced reference photons per pixel, per light and generator")
       ->check(CLI::Range(1, 1024))->capture_default_str();
