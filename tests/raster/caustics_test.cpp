@@ -393,8 +393,8 @@ TEST(Caustics, BallLensFocusesParaxialPhotonsAtNuDOver4NuMinus1) {
 }
 
 // Photon chains inside a generator, against the light-traced reference (which follows every
-// specular bounce): the mirror ring of caustic-ring sends a sixth of its light back onto
-// itself (the two-bounce arcs inside the cardioid). With the chain the floor inside and
+// specular bounce): the mirror ring of caustic-ring sends about a seventh of the light it
+// reflects back onto itself (the two-bounce arcs inside the cardioid). With the chain the floor inside and
 // outside the ring gets what the reference's does; with chain=0 those photons are dropped
 // (the inside gets a third too little); without the mirror's impostor they pass through the
 // ring's far wall (its own distance map leaves it out) and land outside: a light leak.
