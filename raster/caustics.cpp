@@ -210,6 +210,51 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
     throw InputError("caustic_photons", "photon_res out of range (1..4096)");
   CausticPhotons out;
   const std::vector<std::uint32_t> gens = caustic_generator_objects(scene);
+  // What a photon needs of a generator it reaches from another: its impostor (to know it is
+  // there, and its normal), its material and its distance map.
+  struct Generator {
+    std::uint32_t object = 0;
+    const CubeMap* impostor = nullptr;
+    const CubeMap* map = nullptr;
+    SurfaceParams surface;
+  };
+  std::vector<Generator> generators;
+  for (std::uint32_t o : gens) {
+    Generator gen;
+    gen.object = o;
+    gen.impostor = impostors ? impostors->for_object(o) : nullptr;
+    if (o < maps.map_of_object.size() && maps.map_of_object[o] >= 0)
+      gen.map = &maps.cubes[static_cast<std::size_t>(maps.map_of_object[o])];
+    gen.surface = surface_params(scene.materials[scene.objects[o].material]);
+    generators.push_back(gen);
+  }
+  // Refracted in at p (unit v towards the surface, n the outward normal facing v) and out
+  // through the exit the impostor finds, total internal reflections followed up to `chain`
+  // in all (each × transmission, as the reference weights them). 0, with the photon's flux
+  // weighted by (1 − F1)(1 − F2) × (transmission × base colour)² and its exit x, r; or why it
+  // was lost: 2 TIR beyond the bound, 3 no exit found.
+  const auto refract_through = [&](const CubeMap& im, const SurfaceParams& s, const glm::vec3& p, const glm::vec3& v,
+                                   const glm::vec3& n, std::uint8_t& chain, glm::vec3& flux, glm::vec3& x,
+                                   glm::vec3& r) -> std::uint8_t {
+    RefractionPath path = enter_refractor(p, v, n, s.ior);
+    glm::vec3 start = p, p2, n2;
+    glm::vec3 inside_weight(1.0f);
+    for (;;) {
+      if (!find_impostor_exit(im, start, path.inside, opt.exit_search, p2, n2)) return 3;
+      leave_refractor(path, p2, n2, s.ior);
+      if (!path.total_internal) break;
+      if (chain == opt.chain) return 2;
+      ++chain;
+      inside_weight *= s.transmission;
+      start = p2;
+      path.inside = glm::normalize(path.internal);
+    }
+    const glm::vec3 t = s.transmission * s.base_color;
+    flux *= inside_weight * t * (1.0f - path.f_entry) * t * (1.0f - path.f_exit);
+    x = p2;
+    r = glm::normalize(path.exit_direction);
+    return 0;
+  };
   for (std::uint32_t li = 0; li < scene.lights.size(); ++li) {
     const Light& light = scene.lights[li];
     for (std::uint32_t object : gens) {
@@ -261,7 +306,8 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         img.valid.assign(n, 0);
         std::vector<glm::vec3> arriving(n, glm::vec3(0.0f));
         std::vector<std::uint8_t> state(n, 0);  // 0 none, 1 stored, 2 TIR, 3 no receiver, 4 chain bound
-        std::vector<std::uint8_t> chain(n, 0);  // internal reflections followed
+        std::vector<std::uint8_t> chain(n, 0);  // internal reflections and hops followed
+        std::vector<std::uint8_t> hops(n, 0);   // of which into other generators
         const CubeMap* impostor = impostors ? impostors->for_object(object) : nullptr;
         ex.parallel_for("caustic_photons", n, 256, [&](std::size_t b, std::size_t e) {
           for (std::size_t i = b; i < e; ++i) {
@@ -287,35 +333,11 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               glm::vec3 n1 = gb.normal.pixels[i];
               if (glm::dot(n1, v) >= 0.0f) n1 = -n1;
               if (!impostor) continue;
-              RefractionPath path = enter_refractor(p1, v, n1, s.ior);
-              glm::vec3 start = p1, p2, n2;
-              // Total internal reflections are followed inside, each exit found again in the
-              // impostor, up to `chain` of them (the reference weights each by transmission).
-              glm::vec3 inside_weight(1.0f);
-              bool lost = false;
-              for (;;) {
-                if (!find_impostor_exit(*impostor, start, path.inside, opt.exit_search, p2, n2)) {
-                  state[i] = 3;
-                  lost = true;
-                  break;
-                }
-                leave_refractor(path, p2, n2, s.ior);
-                if (!path.total_internal) break;
-                if (chain[i] == opt.chain) {
-                  state[i] = 2;
-                  lost = true;
-                  break;
-                }
-                ++chain[i];
-                inside_weight *= s.transmission;
-                start = p2;
-                path.inside = glm::normalize(path.internal);
+              const std::uint8_t lost = refract_through(*impostor, s, p1, v, n1, chain[i], flux, x, r);
+              if (lost) {
+                state[i] = lost;
+                continue;
               }
-              if (lost) continue;
-              const glm::vec3 t = s.transmission * s.base_color;
-              flux *= inside_weight * t * (1.0f - path.f_entry) * t * (1.0f - path.f_exit);
-              x = p2;
-              r = glm::normalize(path.exit_direction);
             } else if (s.is_refractor()) {
               // The refractor's surface reflection, weighted as the reference weights it:
               // transmission × exact Fresnel F.
@@ -361,13 +383,68 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               }
               if (lost) continue;
             }
-            const DistanceSearchResult found = search_distance_map(env, x, r, opt.receiver_search);
-            const float stored = std::isfinite(found.d) ? env.distance_towards(found.direction) : kInf;
-            if (!std::isfinite(stored)) {
-              state[i] = 3;
-              continue;
+            // The receiver, searched in the generator's distance map. Where it lies on another
+            // generator (on that generator's impostor surface, within 3 %), the photon goes on
+            // through it (reflected off a mirror, or refracted in and out of a refractor: its
+            // surface reflection is not followed) and searches that generator's distance map,
+            // each such hop one of the `chain` steps; it is stored in its first generator's map.
+            const CubeMap* search_map = &env;
+            std::uint32_t current = object;
+            glm::vec3 hit(0.0f);
+            bool lost = false;
+            for (;;) {
+              const DistanceSearchResult found = search_distance_map(*search_map, x, r, opt.receiver_search);
+              const float stored = std::isfinite(found.d) ? search_map->distance_towards(found.direction) : kInf;
+              if (!std::isfinite(stored)) {
+                state[i] = 3;
+                lost = true;
+                break;
+              }
+              hit = search_map->centre + glm::normalize(found.direction) * stored;
+              const Generator* next = nullptr;
+              glm::vec3 nn(0.0f);
+              for (const Generator& gen : generators) {
+                if (gen.object == current || !gen.impostor || !gen.map) continue;
+                const glm::vec3 on = hit - gen.impostor->centre;
+                const float surface = gen.impostor->distance_towards(on);
+                if (std::isfinite(surface) && std::fabs(glm::length(on) - surface) <= 0.03f * surface) {
+                  next = &gen;
+                  nn = glm::vec3(gen.impostor->colour_towards(on));
+                  nn = glm::dot(nn, nn) > 0.0f ? glm::normalize(nn) : glm::normalize(on);
+                  break;
+                }
+              }
+              if (!next) break;  // a diffuse receiver
+              if (chain[i] == opt.chain) {
+                state[i] = 4;
+                lost = true;
+                break;
+              }
+              ++chain[i];
+              ++hops[i];
+              const SurfaceParams& sn = next->surface;
+              if (sn.is_refractor()) {
+                if (glm::dot(nn, r) >= 0.0f) nn = -nn;
+                glm::vec3 x2, r2;
+                const std::uint8_t why = refract_through(*next->impostor, sn, hit, r, nn, chain[i], flux, x2, r2);
+                if (why) {
+                  state[i] = why;
+                  lost = true;
+                  break;
+                }
+                x = x2;
+                r = r2;
+              } else {
+                if (glm::dot(nn, r) > 0.0f) nn = -nn;
+                flux *= specular_reflectance(sn, -glm::dot(nn, r));
+                x = hit;
+                r = glm::normalize(reflect(r, nn));
+              }
+              search_map = next->map;
+              current = next->object;
             }
-            img.hit[i] = env.centre + glm::normalize(found.direction) * stored;
+            if (lost) continue;
+            img.hit[i] = hit;
             const glm::vec3 back = x - img.hit[i];
             img.wi[i] = glm::dot(back, back) > 0.0f ? glm::normalize(back) : -r;
             img.flux[i] = flux;
@@ -381,7 +458,8 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
             ++out.photons;
             out.generator_flux += glm::dvec3(arriving[i]);
           }
-          out.internal_reflections += chain[i];
+          out.internal_reflections += chain[i] - hops[i];
+          out.generator_hops += hops[i];
           if (state[i] == 1) {
             ++out.stored;
             out.stored_flux += glm::dvec3(img.flux[i]);
@@ -604,6 +682,7 @@ CausticPhotons CausticPhotonsPass::operator()(par::NodeContext& c, const Reflect
   c.count("total_internal", static_cast<double>(p.total_internal));
   c.count("no_receiver", static_cast<double>(p.no_receiver));
   c.count("internal_reflections", static_cast<double>(p.internal_reflections));
+  c.count("generator_hops", static_cast<double>(p.generator_hops));
   c.count("chain_limited", static_cast<double>(p.chain_limited));
   return p;
 }

@@ -85,6 +85,7 @@ struct CausticPhotons {
   std::uint64_t total_internal = 0;  // refracted photons dropped by total internal reflection
                                      // beyond the chain bound
   std::uint64_t internal_reflections = 0;  // reflections followed inside the generators
+  std::uint64_t generator_hops = 0;  // photons' passages from one generator into another
   std::uint64_t chain_limited = 0;   // mirror photons still meeting their mirror after `chain`
   std::uint64_t no_receiver = 0;     // searches that found nothing (the environment)
   glm::dvec3 generator_flux{0.0};    // Σ photon power arriving at the generators
