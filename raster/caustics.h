@@ -27,12 +27,13 @@
 //   mean photon direction, shaded with the surface's BRDF, added to the direct light.
 //
 // A refractor's photons take two paths, refracted in and out and reflected off its surface
-// (one photon image each). Internal reflections are followed up to `chain` per photon: a
-// mirror that meets itself again (a ring, a bowl) is found in its own distance impostor
-// (§4.4's search, the mirror alone), a refractor's total internal reflections in its
-// impostor. Limits: one generator per path (a photon leaving one generator does not enter
-// another); a refractor's partial internal reflection (F at the exit) is not followed, nor
-// does a photon leaving a refractor meet it again. Reflections and refractions see the caustics through
+// (one photon image each). Up to `chain` steps are followed per photon: a mirror that meets
+// itself again (a ring, a bowl) is found in its own distance impostor (§4.4's search, the
+// mirror alone), a refractor's total internal reflections in its impostor, and a receiver
+// found on another generator's impostor surface sends the photon on through that generator
+// and its distance map. Limits: one path per photon (a refractor's partial reflections are
+// not followed), and a photon leaving a refractor does not meet it again. Reflections and
+// refractions see the caustics through
 // caustic_reflector_maps, the reflector cube maps rendered again with the caustics gathered
 // on their faces.
 #pragma once
@@ -57,8 +58,9 @@ namespace speculum::raster {
 
 struct CausticPhotonOptions {
   int photon_res = 128;                // photon image side per light × generator
-  // Internal reflections followed per photon inside its generator: a mirror meeting itself
-  // again (found in its own distance impostor), a refractor's total internal reflections.
+  // Steps followed per photon beyond its first generator: a mirror meeting itself again
+  // (found in its own distance impostor), a refractor's total internal reflections, a
+  // passage into another generator.
   int chain = 4;
   DistanceSearchOptions receiver_search;  // in the generator's environment distance map
   DistanceSearchOptions exit_search;      // in a refractor's distance impostor
@@ -86,7 +88,7 @@ struct CausticPhotons {
                                      // beyond the chain bound
   std::uint64_t internal_reflections = 0;  // reflections followed inside the generators
   std::uint64_t generator_hops = 0;  // photons' passages from one generator into another
-  std::uint64_t chain_limited = 0;   // mirror photons still meeting their mirror after `chain`
+  std::uint64_t chain_limited = 0;   // photons still meeting a generator after `chain` steps
   std::uint64_t no_receiver = 0;     // searches that found nothing (the environment)
   glm::dvec3 generator_flux{0.0};    // Σ photon power arriving at the generators
   glm::dvec3 stored_flux{0.0};       // Σ power of the stored photons (after the path's Fresnel)

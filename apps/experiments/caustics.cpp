@@ -45,7 +45,7 @@ struct CausticsOptions {
   int cube_size = 256;
   int caustic_size = 128;
   int reference_photons = 64;  // per pixel, per light and generator
-  int chain = 4;               // internal reflections per photon (the technique's `chain`)
+  int chain = 4;               // steps per photon past its first generator (the technique's `chain`)
   std::string images;  // write each row's caustic term, the reference's and their difference here
   bool quick = false;
   bool json = false;
@@ -206,7 +206,7 @@ void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& glo
       ->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--caustic-size", o->caustic_size, "Face size of the caustic maps")
       ->check(CLI::Range(16, 1024))->capture_default_str();
-  cmd->add_option("--chain", o->chain, "Internal reflections a photon follows in its generator (the technique's `chain`)")
+  cmd->add_option("--chain", o->chain, "Steps a photon follows past its first generator: internal reflections, other generators (the technique's `chain`)")
       ->check(CLI::Range(0, 16))->capture_default_str();
   cmd->add_option("--reference-photons", o->reference_photons,
                   "Light-traced reference photons per pixel, per light and generator")

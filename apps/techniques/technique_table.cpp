@@ -161,7 +161,7 @@ const std::vector<Technique>& techniques() {
        // caustic map 6·caustic_size² texels (1024: ~200 MB per generator).
        {{"photon_res", 128, 16, 512, true, "photon image side per light and generator (512: 262k photons)"},
         {"chain", 4, 0, 16, true,
-         "internal reflections a photon follows in its generator: a mirror meeting itself, a refractor's TIR (each one search)"},
+         "steps a photon follows past its first generator: a mirror meeting itself, a refractor's TIR, another generator"},
         choice_param("filter", "splat", {"splat", "triangles"},
                      "normalized tent-kernel splats, or caustic triangles (then blurred)"),
         {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (splat; the least with adaptive)"},
