@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -498,14 +500,26 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
   CausticMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   std::vector<TexelShare> scratch;
+  // One map per generator (cube storage), or per generator and light (light storage).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> map_index;
+  const bool light_space = opt.storage == CausticStorage::Light;
   // The photons land in the order of the images and their texels (a serial blend stage:
   // the same sums for any thread count).
   for (const PhotonImage& img : photons.images) {
-    if (out.map_of_object[img.object] < 0) {
-      out.map_of_object[img.object] = static_cast<int>(out.cubes.size());
+    const std::pair<std::uint32_t, std::uint32_t> key{img.object, light_space ? img.light : 0u};
+    if (!map_index.count(key)) {
+      map_index[key] = out.cubes.size();
+      if (out.map_of_object[img.object] < 0) out.map_of_object[img.object] = static_cast<int>(out.cubes.size());
       CubeMap m;
       m.size = opt.size;
       m.centre = img.centre;
+      if (light_space) {
+        // Centred at the light (a directional light: two scene diameters back along its rays).
+        const Light& l = scene.lights[img.light];
+        m.centre = l.type == LightType::Directional
+                       ? img.centre - glm::normalize(l.direction) * (2.0f * glm::length(scene.bounds().extent()))
+                       : l.position;
+      }
       for (int f = 0; f < kCubeFaces; ++f) {
         m.colour[f] = ImageRGBA(opt.size, opt.size, glm::vec4(0.0f));
         m.distance[f] = ImageF(opt.size, opt.size, 0.0f);
@@ -516,7 +530,7 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
       for (int f = 0; f < kCubeFaces; ++f) inc[f] = Buffer2D<glm::vec3>(opt.size, opt.size, glm::vec3(0.0f));
       out.incident.push_back(std::move(inc));
     }
-    const std::size_t mi = static_cast<std::size_t>(out.map_of_object[img.object]);
+    const std::size_t mi = map_index[key];
     CubeMap& m = out.cubes[mi];
     MapTarget target{m, out.incident[mi]};
     const int res = img.res;

@@ -102,18 +102,26 @@ CausticPhotons trace_photon_images(par::Executor& executor, const Scene& scene, 
 
 enum class CausticFilter : std::uint8_t { Splat = 0, Triangles = 1 };
 
+// Where the photon hits are stored: a cube map centred at the generator (SURVEY §6.2), or
+// the same map centred at the light (shadow-map space, the variant §6.2 argues against: its
+// distance check cannot tell the photons' receiver from a point behind it along the
+// light's ray).
+enum class CausticStorage : std::uint8_t { Cube = 0, Light = 1 };
+
 struct CausticMapOptions {
   int size = 128;                // cube face side
   CausticFilter filter = CausticFilter::Splat;
+  CausticStorage storage = CausticStorage::Cube;
   int splat_radius = 1;          // texels (0: the nearest texel only)
   bool adaptive = true;          // splat: radius raised to the spacing of neighbouring photons
 };
 
-// One cube per generator: colour rgb = flux (W) per texel, distance = flux-weighted mean
-// receiver distance |y − o| (+inf where no flux landed).
+// One cube per generator (per generator and light with light storage): colour rgb = flux
+// (W) per texel, distance = flux-weighted mean receiver distance |y − o| (+inf where no flux
+// landed).
 using CubeDirections = std::array<Buffer2D<glm::vec3>, kCubeFaces>;
 struct CausticMaps {
-  std::vector<int> map_of_object;  // -1: not a generator
+  std::vector<int> map_of_object;  // the generator's (first) map; -1: not a generator
   std::vector<CubeMap> cubes;
   // Per texel the flux-weighted mean direction the photons arrived from (unit): receivers
   // beside the generator are lit from its surface, not from its centre.
@@ -155,6 +163,7 @@ struct CausticMapPass {
   void parameters(par::Params& p) const {
     p.set("size", options.size)
         .set("filter", options.filter == CausticFilter::Splat ? "splat" : "triangles")
+        .set("storage", options.storage == CausticStorage::Cube ? "cube" : "light")
         .set("splat_radius", options.splat_radius)
         .set("adaptive", options.adaptive ? 1 : 0);
   }

@@ -4,9 +4,10 @@
 // term alone against the light-traced reference's (trace/light_tracer.h, caustics seen
 // directly), and the light leak: the share of the technique's caustic energy that lands where
 // the reference has none. Storage "cube" is the survey's cube map centred at the generator;
-// "light" is the same map centred at the light (shadow-map space), the variant SURVEY §6.2
-// argues against: its distance check compares distances from the light, which cannot tell the
-// photons' receiver from a point behind it along the light's ray.
+// "light" is the same map centred at the light (shadow-map space, the technique's
+// `storage=light`), the variant SURVEY §6.2 argues against: its distance check compares
+// distances from the light, which cannot tell the photons' receiver from a point behind it
+// along the light's ray.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -82,21 +83,25 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
   if (resolutions.empty()) resolutions = o.quick ? std::vector<int>{32, 64} : std::vector<int>{32, 64, 128, 256, 512};
   for (int r : resolutions)
     if (r < 16 || r > 512) throw InputError("--photon-res", std::to_string(r) + " is outside [16, 512]");
-  // The filters as the technique names them (`--param filter=...`): the same names in and out.
+  // The filters and storages as the technique names them (`--param filter=...`,
+  // `--param storage=...`): the same names in and out.
   const pipeline::Technique& technique = pipeline::find_technique("caustics");
-  const pipeline::TechniqueParam* filter_param = nullptr;
-  for (const pipeline::TechniqueParam& p : technique.params)
-    if (p.name == "filter") filter_param = &p;
-  std::vector<int> filters;
-  for (const std::string& f : o.filters) try {
-      filters.push_back(static_cast<int>(pipeline::parse_technique_param(technique, "filter=" + f).second));
-    } catch (const InputError& e) {
-      throw InputError("--filter", e.problem());
-    }
-  if (filters.empty())
-    for (std::size_t k = 0; k < filter_param->choices.size(); ++k) filters.push_back(static_cast<int>(k));
-  std::vector<std::string> storages = o.storages;
-  if (storages.empty()) storages = {"cube", "light"};
+  const auto modes = [&](const std::string& option, const std::string& name, const std::vector<std::string>& given) {
+    const pipeline::TechniqueParam* param = nullptr;
+    for (const pipeline::TechniqueParam& p : technique.params)
+      if (p.name == name) param = &p;
+    std::vector<int> out;
+    for (const std::string& text : given) try {
+        out.push_back(static_cast<int>(pipeline::parse_technique_param(technique, name + "=" + text).second));
+      } catch (const InputError& e) {
+        throw InputError(option, e.problem());
+      }
+    if (out.empty())
+      for (std::size_t k = 0; k < param->choices.size(); ++k) out.push_back(static_cast<int>(k));
+    return std::make_pair(param, out);
+  };
+  const auto [filter_param, filters] = modes("--filter", "filter", o.filters);
+  const auto [storage_param, storages] = modes("--storage", "storage", o.storages);
   const int width = o.quick ? 64 : o.width, height = o.quick ? 48 : o.height;
   const int reference_photons = o.quick ? 4 : o.reference_photons;
   par::Executor ex(global.threads, global.lanes);
@@ -129,22 +134,14 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
       const auto t0 = std::chrono::steady_clock::now();
       const raster::CausticPhotons photons = raster::trace_photon_images(ex, scene, maps, &impostors, pho);
       const double photons_ms = ms_since(t0);
-      // The light-space variant: the same photons, their map centred at the light.
-      raster::CausticPhotons light_space = photons;
-      for (raster::PhotonImage& img : light_space.images) {
-        const Light& l = scene.lights[img.light];
-        img.centre = l.type == LightType::Directional
-                         ? img.centre - glm::normalize(l.direction) * (2.0f * glm::length(scene.bounds().extent()))
-                         : l.position;
-      }
-      for (const std::string& storage : storages)
+      for (int storage : storages)
         for (int filter : filters) {
           raster::CausticMapOptions mo;
           mo.size = o.caustic_size;
           mo.filter = static_cast<raster::CausticFilter>(filter);
+          mo.storage = static_cast<raster::CausticStorage>(storage);
           const auto t1 = std::chrono::steady_clock::now();
-          const raster::CausticMaps cm =
-              raster::build_caustic_maps(ex, scene, storage == "cube" ? photons : light_space, mo);
+          const raster::CausticMaps cm = raster::build_caustic_maps(ex, scene, photons, mo);
           const ImageRGBA term = raster::gather_caustics(ex, gbuffer, cm, black, 0.05f);
           const double ms = photons_ms + ms_since(t1);
           double total = 0.0, leaked = 0.0;
@@ -158,7 +155,8 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
           if (!o.images.empty()) {
             // The two caustic terms and their absolute 8-bit difference, scaled by 8.
             const std::string stem = o.images + "/" + scene_name.substr(0, scene_name.find(':')) + "_" +
-                                     std::to_string(res) + "_" + filter_param->value_text(filter) + "_" + storage;
+                                     std::to_string(res) + "_" + filter_param->value_text(filter) + "_" +
+                                     storage_param->value_text(storage);
             ImageRGBA diff(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
             for (std::size_t i = 0; i < diff.pixels.size(); ++i)
               for (int ch = 0; ch < 3; ++ch) {
@@ -173,7 +171,7 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
           }
           table.cell("scene", scene_name)
               .cell("filter", filter_param->value_text(filter))
-              .cell("storage", storage)
+              .cell("storage", storage_param->value_text(storage))
               .cell("photon_res", res)
               .cell("photons", static_cast<std::int64_t>(photons.photons))
               .cell("ms", ms, 1)
@@ -198,8 +196,8 @@ void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& glo
   cmd->add_option("--photon-res", o->photon_res, "Photon image side(s), 16..512 (repeatable; default: 32 64 128 256 512)");
   cmd->add_option("--filter", o->filters,
                   "Caustic-map filter(s) by name as in `--param filter=`: splat, triangles (repeatable; default: both)");
-  cmd->add_option("--storage", o->storages, "Caustic-map storage(s): cube, light (repeatable; default: both)")
-      ->check(CLI::IsMember({"cube", "light"}));
+  cmd->add_option("--storage", o->storages,
+                  "Caustic-map storage(s) by name as in `--param storage=`: cube, light (repeatable; default: both)");
   cmd->add_option("--width", o->width, "Image width")->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--height", o->height, "Image height")->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--cube-size", o->cube_size, "Face size of the generators' distance maps")

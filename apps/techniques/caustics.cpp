@@ -39,6 +39,7 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   CausticMapOptions mo;
   mo.size = static_cast<int>(f.param("caustic_size"));
   mo.filter = static_cast<CausticFilter>(static_cast<int>(f.param("filter")));
+  mo.storage = static_cast<CausticStorage>(static_cast<int>(f.param("storage")));
   mo.splat_radius = static_cast<int>(f.param("splat_radius"));
   mo.adaptive = f.param("adaptive") != 0.0;
   auto caustic_maps = g.add("caustic_map", CausticMapPass{scene, mo}, photons);

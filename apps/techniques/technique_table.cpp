@@ -151,7 +151,7 @@ const std::vector<Technique>& techniques() {
         {"linear_steps", 16, 0, 256, true, "linear search steps (both searches; < 2: off)"},
         {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
         // ≈ 150 MB per refractor at 1024² faces, ≈ 3.6 GB at 4096².
-        {"impostor_size", 128, 4, 1024, true, "cube face side of the distance impostors (method 2; ~150 MB each at 1024)"}}},
+        {"impostor_size", 128, 4, 1024, true, "cube face side of the distance impostors (method=impostors; ~150 MB each at 1024)"}}},
       {"caustics",
        "caustics (SURVEY §6): photons shot from each light through each mirror/refractor, "
        "receivers found in its distance map, stored in a cube map at the generator, splats or "
@@ -164,6 +164,8 @@ const std::vector<Technique>& techniques() {
          "steps a photon follows past its first generator: a mirror meeting itself, a refractor's TIR, another generator"},
         choice_param("filter", "splat", {"splat", "triangles"},
                      "normalized tent-kernel splats, or caustic triangles (then blurred)"),
+        choice_param("storage", "cube", {"cube", "light"},
+                     "caustic map centred at the generator (SURVEY §6.2), or at the light (shadow-map space: leaks)"),
         {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (splat; the least with adaptive)"},
         {"adaptive", 1, 0, 1, true, "1: splat radius grows to the neighbouring photons' spacing (at most 8 texels)"},
         {"caustic_size", 128, 16, 1024, true, "cube face side of the caustic map (1024: ~200 MB per generator)"},

@@ -131,8 +131,8 @@ TEST(TechniqueParams, NamedChoicesAreTheirIndexByNameOrNumber) {
       EXPECT_NE(listed.find(p.name + "=" + p.value_text(p.fallback) + "  " + p.range_text()), std::string::npos)
           << listed;
     }
-  // caustics filter, refraction method, soff fill and concave, cone-tracing fill.
-  EXPECT_EQ(named, 5);
+  // caustics filter and storage, refraction method, soff fill and concave, cone-tracing fill.
+  EXPECT_EQ(named, 6);
   const Technique& caustics = find_technique("caustics");
   EXPECT_EQ(parse_technique_param(caustics, "filter=triangles"), std::make_pair(std::string("filter"), 1.0));
   EXPECT_EQ(find_technique("refraction").describe_params("").find("method=two-face  one of single|two-face|impostors"),

@@ -117,6 +117,28 @@ TEST(Caustics, MapFluxEqualsStoredPhotonFluxForEveryFilterAndRadius) {
   EXPECT_NEAR(caustic_map_flux(build_caustic_maps(ex, s, r.photons, tri).cubes[0]).x, stored, 1e-4 * stored);
 }
 
+// Light storage (the shadow-map-space variant): the same photons in a map centred at the
+// light, one per generator and light, keeping their flux.
+TEST(Caustics, LightStorageCentresTheMapAtTheLight) {
+  Scene s = load_scene("glass-sphere:size=4000");
+  Light second = s.lights.front();
+  second.position += glm::vec3(1.0f, 0.5f, 0.0f);
+  s.lights.push_back(second);
+  par::Executor ex(2);
+  const PhotonRun r = shoot(ex, s, 64);
+  CausticMapOptions o;
+  o.storage = CausticStorage::Light;
+  const CausticMaps m = build_caustic_maps(ex, s, r.photons, o);
+  ASSERT_EQ(m.cubes.size(), 2u);
+  double flux = 0.0;
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(m.cubes[k].centre, s.lights[k].position);
+    flux += caustic_map_flux(m.cubes[k]).x;
+  }
+  EXPECT_NEAR(flux, r.photons.stored_flux.x, 1e-4 * r.photons.stored_flux.x);
+  EXPECT_EQ(build_caustic_maps(ex, s, r.photons, CausticMapOptions{}).cubes.size(), 1u);  // cube: one per generator
+}
+
 // A tilted receiver's irradiance scales with cosθ: the expected value below is shaded with the
 // floor's own normal, so the tilted case asserts E (1 − F0)² cosθ.
 class SlabReceiver : public ::testing::TestWithParam<float> {};
