@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -56,6 +58,12 @@ bool face_pixel(const glm::vec3& d, int face, int size, glm::vec2& out) {
   return true;
 }
 
+// A texel and its share of a caustic triangle.
+struct TexelShare {
+  int x, y;
+  float w;
+};
+
 // A caustic map being built: flux, weight and Σ weight·distance in the cube, Σ weight·wi
 // beside it.
 struct MapTarget {
@@ -97,30 +105,60 @@ void splat(MapTarget& t, const glm::vec3& dir, const glm::vec3& flux, float dist
 
 float edge(glm::vec2 a, glm::vec2 b, glm::vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
 
-// A caustic triangle's flux spread evenly over the texels whose centres it covers (the
-// texel under its centroid when it covers none), so its total is kept exactly.
+// The area of triangle p inside texel [x, x+1] × [y, y+1]: the triangle clipped by the
+// texel's four sides (Sutherland–Hodgman; at most 7 corners), then the shoelace formula.
+float texel_overlap(const glm::vec2 (&p)[3], float x, float y) {
+  glm::vec2 poly[8] = {p[0], p[1], p[2]}, next[8];
+  int n = 3;
+  // Each side as (axis, bound, keep the side above the bound).
+  const struct { int axis; float bound; bool above; } sides[4] = {
+      {0, x, true}, {0, x + 1.0f, false}, {1, y, true}, {1, y + 1.0f, false}};
+  for (const auto& side : sides) {
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const glm::vec2 a = poly[i], b = poly[(i + 1) % n];
+      const float da = side.above ? a[side.axis] - side.bound : side.bound - a[side.axis];
+      const float db = side.above ? b[side.axis] - side.bound : side.bound - b[side.axis];
+      if (da >= 0.0f) next[m++] = a;
+      if ((da >= 0.0f) != (db >= 0.0f)) next[m++] = a + (b - a) * (da / (da - db));
+    }
+    n = m;
+    if (n == 0) return 0.0f;
+    std::copy(next, next + n, poly);
+  }
+  float twice = 0.0f;
+  for (int i = 0; i < n; ++i) twice += poly[i].x * poly[(i + 1) % n].y - poly[(i + 1) % n].x * poly[i].y;
+  return 0.5f * std::fabs(twice);
+}
+
+// A caustic triangle's flux spread over the texels it overlaps in proportion to the area of
+// each overlap (box-filtered rasterization: a triangle smaller than a texel does not alias
+// against the texel grid), normalized over the face's texels so its total is kept exactly;
+// a triangle with no area inside the face goes to the texel under its centroid.
 void raster_triangle(MapTarget& t, int face, const glm::vec2 (&p)[3], const glm::vec3& flux, float dist,
-                     const glm::vec3& wi, std::vector<std::pair<int, int>>& scratch) {
+                     const glm::vec3& wi, std::vector<TexelShare>& scratch) {
   const CubeMap& m = t.m;
   scratch.clear();
-  const float area = edge(p[0], p[1], p[2]);
   const int x0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].x, p[1].x, p[2].x}))));
   const int x1 = std::min(m.size - 1, static_cast<int>(std::floor(std::max({p[0].x, p[1].x, p[2].x}))));
   const int y0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].y, p[1].y, p[2].y}))));
   const int y1 = std::min(m.size - 1, static_cast<int>(std::floor(std::max({p[0].y, p[1].y, p[2].y}))));
-  if (area != 0.0f)
+  float total = 0.0f;
+  if (edge(p[0], p[1], p[2]) != 0.0f)
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
-        const glm::vec2 q(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
-        const float w0 = edge(p[1], p[2], q) / area, w1 = edge(p[2], p[0], q) / area, w2 = edge(p[0], p[1], q) / area;
-        if (w0 >= 0.0f && w1 >= 0.0f && w2 >= 0.0f) scratch.emplace_back(x, y);
+        const float a = texel_overlap(p, static_cast<float>(x), static_cast<float>(y));
+        if (a > 0.0f) {
+          scratch.push_back({x, y, a});
+          total += a;
+        }
       }
-  if (scratch.empty()) {
+  if (!(total > 0.0f)) {
     const glm::vec2 g = (p[0] + p[1] + p[2]) / 3.0f;
-    scratch.emplace_back(std::clamp(static_cast<int>(g.x), 0, m.size - 1), std::clamp(static_cast<int>(g.y), 0, m.size - 1));
+    scratch.assign(1, {std::clamp(static_cast<int>(g.x), 0, m.size - 1), std::clamp(static_cast<int>(g.y), 0, m.size - 1), 1.0f});
+    total = 1.0f;
   }
-  const float share = 1.0f / static_cast<float>(scratch.size());
-  for (const auto& [x, y] : scratch) deposit(t, face, x, y, flux * share, share, dist, wi);
+  for (const TexelShare& e : scratch) deposit(t, face, e.x, e.y, flux * (e.w / total), e.w / total, dist, wi);
 }
 
 // A normalized 3×3 tent blur inside each face: every texel's flux goes to its in-face
@@ -174,6 +212,51 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
     throw InputError("caustic_photons", "photon_res out of range (1..4096)");
   CausticPhotons out;
   const std::vector<std::uint32_t> gens = caustic_generator_objects(scene);
+  // What a photon needs of a generator it reaches from another: its impostor (to know it is
+  // there, and its normal), its material and its distance map.
+  struct Generator {
+    std::uint32_t object = 0;
+    const CubeMap* impostor = nullptr;
+    const CubeMap* map = nullptr;
+    SurfaceParams surface;
+  };
+  std::vector<Generator> generators;
+  for (std::uint32_t o : gens) {
+    Generator gen;
+    gen.object = o;
+    gen.impostor = impostors ? impostors->for_object(o) : nullptr;
+    if (o < maps.map_of_object.size() && maps.map_of_object[o] >= 0)
+      gen.map = &maps.cubes[static_cast<std::size_t>(maps.map_of_object[o])];
+    gen.surface = surface_params(scene.materials[scene.objects[o].material]);
+    generators.push_back(gen);
+  }
+  // Refracted in at p (unit v towards the surface, n the outward normal facing v) and out
+  // through the exit the impostor finds, total internal reflections followed up to `chain`
+  // in all (each × transmission, as the reference weights them). 0, with the photon's flux
+  // weighted by (1 − F1)(1 − F2) × (transmission × base colour)² and its exit x, r; or why it
+  // was lost: 2 TIR beyond the bound, 3 no exit found.
+  const auto refract_through = [&](const CubeMap& im, const SurfaceParams& s, const glm::vec3& p, const glm::vec3& v,
+                                   const glm::vec3& n, std::uint8_t& chain, glm::vec3& flux, glm::vec3& x,
+                                   glm::vec3& r) -> std::uint8_t {
+    RefractionPath path = enter_refractor(p, v, n, s.ior);
+    glm::vec3 start = p, p2, n2;
+    glm::vec3 inside_weight(1.0f);
+    for (;;) {
+      if (!find_impostor_exit(im, start, path.inside, opt.exit_search, p2, n2)) return 3;
+      leave_refractor(path, p2, n2, s.ior);
+      if (!path.total_internal) break;
+      if (chain == opt.chain) return 2;
+      ++chain;
+      inside_weight *= s.transmission;
+      start = p2;
+      path.inside = glm::normalize(path.internal);
+    }
+    const glm::vec3 t = s.transmission * s.base_color;
+    flux *= inside_weight * t * (1.0f - path.f_entry) * t * (1.0f - path.f_exit);
+    x = p2;
+    r = glm::normalize(path.exit_direction);
+    return 0;
+  };
   for (std::uint32_t li = 0; li < scene.lights.size(); ++li) {
     const Light& light = scene.lights[li];
     for (std::uint32_t object : gens) {
@@ -216,6 +299,7 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         img.object = object;
         img.light = li;
         img.res = res;
+        img.surface_reflection = surface_reflection;
         img.centre = maps.centres[static_cast<std::size_t>(map_index)];
         const std::size_t n = static_cast<std::size_t>(res) * res;
         img.hit.assign(n, glm::vec3(0.0f));
@@ -223,7 +307,9 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         img.flux.assign(n, glm::vec3(0.0f));
         img.valid.assign(n, 0);
         std::vector<glm::vec3> arriving(n, glm::vec3(0.0f));
-        std::vector<std::uint8_t> state(n, 0);  // 0 none, 1 stored, 2 TIR, 3 no receiver
+        std::vector<std::uint8_t> state(n, 0);  // 0 none, 1 stored, 2 TIR, 3 no receiver, 4 chain bound
+        std::vector<std::uint8_t> chain(n, 0);  // internal reflections and hops followed
+        std::vector<std::uint8_t> hops(n, 0);   // of which into other generators
         const CubeMap* impostor = impostors ? impostors->for_object(object) : nullptr;
         ex.parallel_for("caustic_photons", n, 256, [&](std::size_t b, std::size_t e) {
           for (std::size_t i = b; i < e; ++i) {
@@ -249,21 +335,11 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               glm::vec3 n1 = gb.normal.pixels[i];
               if (glm::dot(n1, v) >= 0.0f) n1 = -n1;
               if (!impostor) continue;
-              RefractionPath path = enter_refractor(p1, v, n1, s.ior);
-              glm::vec3 p2, n2;
-              if (!find_impostor_exit(*impostor, p1, path.inside, opt.exit_search, p2, n2)) {
-                state[i] = 3;
+              const std::uint8_t lost = refract_through(*impostor, s, p1, v, n1, chain[i], flux, x, r);
+              if (lost) {
+                state[i] = lost;
                 continue;
               }
-              leave_refractor(path, p2, n2, s.ior);
-              if (path.total_internal) {
-                state[i] = 2;
-                continue;
-              }
-              const glm::vec3 t = s.transmission * s.base_color;
-              flux *= t * (1.0f - path.f_entry) * t * (1.0f - path.f_exit);
-              x = p2;
-              r = glm::normalize(path.exit_direction);
             } else if (s.is_refractor()) {
               // The refractor's surface reflection, weighted as the reference weights it:
               // transmission × exact Fresnel F.
@@ -278,14 +354,99 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               flux *= specular_reflectance(s, -glm::dot(n1, v));
               x = p1;
               r = reflect(v, n1);
+              // A concave mirror (a ring, a bowl) meets itself again: the ray searched in the
+              // mirror's own distance impostor. A crossing is the next reflection when it is
+              // bracketed, lies on the stored surface (within 2 %: a bracket from an empty
+              // direction into one behind the surface is none), beyond a twentieth of the
+              // mirror's radius, and before the receiver the environment search brackets;
+              // up to `chain` of them. A photon still meeting the mirror after those is
+              // dropped (its receiver would be behind the mirror: a light leak).
+              bool lost = false;
+              while (impostor) {
+                const DistanceSearchResult self = search_distance_map(*impostor, x, r, opt.exit_search);
+                if (!self.bracketed || !(self.d > 0.05f * sphere.radius)) break;
+                const glm::vec3 on = x + r * self.d - impostor->centre;
+                const float surface = impostor->distance_towards(on);
+                if (!(std::fabs(glm::length(on) - surface) <= 0.02f * surface)) break;
+                const DistanceSearchResult before = search_distance_map(env, x, r, opt.receiver_search);
+                if (before.bracketed && before.d < self.d) break;
+                if (chain[i] == opt.chain) {
+                  state[i] = 4;
+                  lost = true;
+                  break;
+                }
+                ++chain[i];
+                x += r * self.d;
+                glm::vec3 nm(impostor->colour_towards(self.direction));
+                nm = glm::dot(nm, nm) > 0.0f ? glm::normalize(nm) : glm::normalize(x - impostor->centre);
+                if (glm::dot(nm, r) > 0.0f) nm = -nm;
+                flux *= specular_reflectance(s, -glm::dot(nm, r));
+                r = glm::normalize(reflect(r, nm));
+              }
+              if (lost) continue;
             }
-            const DistanceSearchResult found = search_distance_map(env, x, r, opt.receiver_search);
-            const float stored = std::isfinite(found.d) ? env.distance_towards(found.direction) : kInf;
-            if (!std::isfinite(stored)) {
-              state[i] = 3;
-              continue;
+            // The receiver, searched in the generator's distance map. Where it lies on another
+            // generator (on that generator's impostor surface, within 3 %), the photon goes on
+            // through it (reflected off a mirror, or refracted in and out of a refractor: its
+            // surface reflection is not followed) and searches that generator's distance map,
+            // each such hop one of the `chain` steps; it is stored in its first generator's map.
+            const CubeMap* search_map = &env;
+            std::uint32_t current = object;
+            glm::vec3 hit(0.0f);
+            bool lost = false;
+            for (;;) {
+              const DistanceSearchResult found = search_distance_map(*search_map, x, r, opt.receiver_search);
+              const float stored = std::isfinite(found.d) ? search_map->distance_towards(found.direction) : kInf;
+              if (!std::isfinite(stored)) {
+                state[i] = 3;
+                lost = true;
+                break;
+              }
+              hit = search_map->centre + glm::normalize(found.direction) * stored;
+              const Generator* next = nullptr;
+              glm::vec3 nn(0.0f);
+              for (const Generator& gen : generators) {
+                if (gen.object == current || !gen.impostor || !gen.map) continue;
+                const glm::vec3 on = hit - gen.impostor->centre;
+                const float surface = gen.impostor->distance_towards(on);
+                if (std::isfinite(surface) && std::fabs(glm::length(on) - surface) <= 0.03f * surface) {
+                  next = &gen;
+                  nn = glm::vec3(gen.impostor->colour_towards(on));
+                  nn = glm::dot(nn, nn) > 0.0f ? glm::normalize(nn) : glm::normalize(on);
+                  break;
+                }
+              }
+              if (!next) break;  // a diffuse receiver
+              if (chain[i] == opt.chain) {
+                state[i] = 4;
+                lost = true;
+                break;
+              }
+              ++chain[i];
+              ++hops[i];
+              const SurfaceParams& sn = next->surface;
+              if (sn.is_refractor()) {
+                if (glm::dot(nn, r) >= 0.0f) nn = -nn;
+                glm::vec3 x2, r2;
+                const std::uint8_t why = refract_through(*next->impostor, sn, hit, r, nn, chain[i], flux, x2, r2);
+                if (why) {
+                  state[i] = why;
+                  lost = true;
+                  break;
+                }
+                x = x2;
+                r = r2;
+              } else {
+                if (glm::dot(nn, r) > 0.0f) nn = -nn;
+                flux *= specular_reflectance(sn, -glm::dot(nn, r));
+                x = hit;
+                r = glm::normalize(reflect(r, nn));
+              }
+              search_map = next->map;
+              current = next->object;
             }
-            img.hit[i] = env.centre + glm::normalize(found.direction) * stored;
+            if (lost) continue;
+            img.hit[i] = hit;
             const glm::vec3 back = x - img.hit[i];
             img.wi[i] = glm::dot(back, back) > 0.0f ? glm::normalize(back) : -r;
             img.flux[i] = flux;
@@ -299,6 +460,8 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
             ++out.photons;
             out.generator_flux += glm::dvec3(arriving[i]);
           }
+          out.internal_reflections += chain[i] - hops[i];
+          out.generator_hops += hops[i];
           if (state[i] == 1) {
             ++out.stored;
             out.stored_flux += glm::dvec3(img.flux[i]);
@@ -306,6 +469,8 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
             ++out.total_internal;
           } else if (state[i] == 3) {
             ++out.no_receiver;
+          } else if (state[i] == 4) {
+            ++out.chain_limited;
           }
         }
         out.images.push_back(std::move(img));
@@ -334,15 +499,27 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
   if (opt.size < 1 || opt.size > 4096) throw InputError("caustic_map", "size out of range (1..4096)");
   CausticMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
-  std::vector<std::pair<int, int>> scratch;
+  std::vector<TexelShare> scratch;
+  // One map per generator (cube storage), or per generator and light (light storage).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> map_index;
+  const bool light_space = opt.storage == CausticStorage::Light;
   // The photons land in the order of the images and their texels (a serial blend stage:
   // the same sums for any thread count).
   for (const PhotonImage& img : photons.images) {
-    if (out.map_of_object[img.object] < 0) {
-      out.map_of_object[img.object] = static_cast<int>(out.cubes.size());
+    const std::pair<std::uint32_t, std::uint32_t> key{img.object, light_space ? img.light : 0u};
+    if (!map_index.count(key)) {
+      map_index[key] = out.cubes.size();
+      if (out.map_of_object[img.object] < 0) out.map_of_object[img.object] = static_cast<int>(out.cubes.size());
       CubeMap m;
       m.size = opt.size;
       m.centre = img.centre;
+      if (light_space) {
+        // Centred at the light (a directional light: two scene diameters back along its rays).
+        const Light& l = scene.lights[img.light];
+        m.centre = l.type == LightType::Directional
+                       ? img.centre - glm::normalize(l.direction) * (2.0f * glm::length(scene.bounds().extent()))
+                       : l.position;
+      }
       for (int f = 0; f < kCubeFaces; ++f) {
         m.colour[f] = ImageRGBA(opt.size, opt.size, glm::vec4(0.0f));
         m.distance[f] = ImageF(opt.size, opt.size, 0.0f);
@@ -353,7 +530,7 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
       for (int f = 0; f < kCubeFaces; ++f) inc[f] = Buffer2D<glm::vec3>(opt.size, opt.size, glm::vec3(0.0f));
       out.incident.push_back(std::move(inc));
     }
-    const std::size_t mi = static_cast<std::size_t>(out.map_of_object[img.object]);
+    const std::size_t mi = map_index[key];
     CubeMap& m = out.cubes[mi];
     MapTarget target{m, out.incident[mi]};
     const int res = img.res;
@@ -518,6 +695,9 @@ CausticPhotons CausticPhotonsPass::operator()(par::NodeContext& c, const Reflect
   c.count("stored", static_cast<double>(p.stored));
   c.count("total_internal", static_cast<double>(p.total_internal));
   c.count("no_receiver", static_cast<double>(p.no_receiver));
+  c.count("internal_reflections", static_cast<double>(p.internal_reflections));
+  c.count("generator_hops", static_cast<double>(p.generator_hops));
+  c.count("chain_limited", static_cast<double>(p.chain_limited));
   return p;
 }
 

@@ -27,9 +27,13 @@
 //   mean photon direction, shaded with the surface's BRDF, added to the direct light.
 //
 // A refractor's photons take two paths, refracted in and out and reflected off its surface
-// (one photon image each). Limits: one generator per path (a photon leaving one generator
-// does not enter another); internal reflections are not followed (TIR photons are dropped
-// and counted). Reflections and refractions see the caustics through
+// (one photon image each). Up to `chain` steps are followed per photon: a mirror that meets
+// itself again (a ring, a bowl) is found in its own distance impostor (§4.4's search, the
+// mirror alone), a refractor's total internal reflections in its impostor, and a receiver
+// found on another generator's impostor surface sends the photon on through that generator
+// and its distance map. Limits: one path per photon (a refractor's partial reflections are
+// not followed), and a photon leaving a refractor does not meet it again. Reflections and
+// refractions see the caustics through
 // caustic_reflector_maps, the reflector cube maps rendered again with the caustics gathered
 // on their faces.
 #pragma once
@@ -54,6 +58,10 @@ namespace speculum::raster {
 
 struct CausticPhotonOptions {
   int photon_res = 128;                // photon image side per light × generator
+  // Steps followed per photon beyond its first generator: a mirror meeting itself again
+  // (found in its own distance impostor), a refractor's total internal reflections, a
+  // passage into another generator.
+  int chain = 4;
   DistanceSearchOptions receiver_search;  // in the generator's environment distance map
   DistanceSearchOptions exit_search;      // in a refractor's distance impostor
 };
@@ -63,6 +71,7 @@ struct PhotonImage {
   std::uint32_t object = 0;  // the generator
   std::uint32_t light = 0;
   int res = 0;
+  bool surface_reflection = false;   // a refractor's reflected twin (else its refracted path, or a mirror's)
   glm::vec3 centre{0.0f};            // the generator's map centre o
   std::vector<glm::vec3> hit;        // receiver point (world)
   std::vector<glm::vec3> wi;         // unit, from the receiver point back along the photon
@@ -76,6 +85,10 @@ struct CausticPhotons {
                                      // refractor's reflected twin not counted again)
   std::uint64_t stored = 0;          // photons with a receiver
   std::uint64_t total_internal = 0;  // refracted photons dropped by total internal reflection
+                                     // beyond the chain bound
+  std::uint64_t internal_reflections = 0;  // reflections followed inside the generators
+  std::uint64_t generator_hops = 0;  // photons' passages from one generator into another
+  std::uint64_t chain_limited = 0;   // photons still meeting a generator after `chain` steps
   std::uint64_t no_receiver = 0;     // searches that found nothing (the environment)
   glm::dvec3 generator_flux{0.0};    // Σ photon power arriving at the generators
   glm::dvec3 stored_flux{0.0};       // Σ power of the stored photons (after the path's Fresnel)
@@ -89,18 +102,26 @@ CausticPhotons trace_photon_images(par::Executor& executor, const Scene& scene, 
 
 enum class CausticFilter : std::uint8_t { Splat = 0, Triangles = 1 };
 
+// Where the photon hits are stored: a cube map centred at the generator (SURVEY §6.2), or
+// the same map centred at the light (shadow-map space, the variant §6.2 argues against: its
+// distance check cannot tell the photons' receiver from a point behind it along the
+// light's ray).
+enum class CausticStorage : std::uint8_t { Cube = 0, Light = 1 };
+
 struct CausticMapOptions {
   int size = 128;                // cube face side
   CausticFilter filter = CausticFilter::Splat;
+  CausticStorage storage = CausticStorage::Cube;
   int splat_radius = 1;          // texels (0: the nearest texel only)
   bool adaptive = true;          // splat: radius raised to the spacing of neighbouring photons
 };
 
-// One cube per generator: colour rgb = flux (W) per texel, distance = flux-weighted mean
-// receiver distance |y − o| (+inf where no flux landed).
+// One cube per generator (per generator and light with light storage): colour rgb = flux
+// (W) per texel, distance = flux-weighted mean receiver distance |y − o| (+inf where no flux
+// landed).
 using CubeDirections = std::array<Buffer2D<glm::vec3>, kCubeFaces>;
 struct CausticMaps {
-  std::vector<int> map_of_object;  // -1: not a generator
+  std::vector<int> map_of_object;  // the generator's (first) map; -1: not a generator
   std::vector<CubeMap> cubes;
   // Per texel the flux-weighted mean direction the photons arrived from (unit): receivers
   // beside the generator are lit from its surface, not from its centre.
@@ -128,7 +149,7 @@ struct CausticPhotonsPass {
       "map for its diffuse receiver, with power Φ·Ω_texel/(4π) times Fresnel (SURVEY §6.1.2).";
   const Scene* scene = nullptr;
   CausticPhotonOptions options;
-  void parameters(par::Params& p) const { p.set("photon_res", options.photon_res); }
+  void parameters(par::Params& p) const { p.set("photon_res", options.photon_res).set("chain", options.chain); }
   CausticPhotons operator()(par::NodeContext& c, const ReflectorMaps& maps, const RefractorImpostors* impostors) const;
 };
 
@@ -142,6 +163,7 @@ struct CausticMapPass {
   void parameters(par::Params& p) const {
     p.set("size", options.size)
         .set("filter", options.filter == CausticFilter::Splat ? "splat" : "triangles")
+        .set("storage", options.storage == CausticStorage::Cube ? "cube" : "light")
         .set("splat_radius", options.splat_radius)
         .set("adaptive", options.adaptive ? 1 : 0);
   }

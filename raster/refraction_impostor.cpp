@@ -9,12 +9,15 @@
 
 namespace speculum::raster {
 
-RefractorImpostors render_refractor_impostors(par::Executor& executor, const Scene& scene, int size) {
+RefractorImpostors render_refractor_impostors(par::Executor& executor, const Scene& scene, int size, bool mirrors) {
   RefractorImpostors out;
   const std::vector<std::uint8_t> refractors = refractor_objects(scene);
   out.impostor_of_object.assign(scene.objects.size(), -1);
   for (std::uint32_t o = 0; o < scene.objects.size(); ++o) {
-    if (!refractors[o]) continue;
+    const Object& obj = scene.objects[o];
+    const bool mirror = mirrors && obj.material < scene.materials.size() &&
+                        surface_params(scene.materials[obj.material]).is_mirror_lobe();
+    if (!refractors[o] && !mirror) continue;
     Bounds box;
     for (std::size_t t = 0; t < scene.mesh.triangle_count(); ++t)
       if (scene.mesh.triangle_object[t] == o)
@@ -54,7 +57,7 @@ bool find_impostor_exit(const CubeMap& impostor, const glm::vec3& p1, const glm:
 }
 
 RefractorImpostors RefractorImpostorsPass::operator()(par::NodeContext& c) const {
-  RefractorImpostors impostors = render_refractor_impostors(c.executor(), *scene, size);
+  RefractorImpostors impostors = render_refractor_impostors(c.executor(), *scene, size, mirrors);
   c.count("impostors", impostors.cubes.size());
   return impostors;
 }

@@ -28,7 +28,10 @@ struct RefractorImpostors {
 
 // One cube of `size`² per refractor, centred at its bounding-box centre, the refractor
 // alone. The method assumes every surface point is visible from the centre (star-shaped).
-RefractorImpostors render_refractor_impostors(par::Executor& executor, const Scene& scene, int size);
+// `mirrors`: also one per mirror object (a caustic generator's own surface, where a photon
+// leaving it may meet it again).
+RefractorImpostors render_refractor_impostors(par::Executor& executor, const Scene& scene, int size,
+                                              bool mirrors = false);
 
 // The exit of a ray inside the refractor: from world point p1 along unit t1. Returns false
 // when the search finds nothing (the ray start is then kept).
@@ -42,7 +45,8 @@ struct RefractorImpostorsPass {
       "point (distance impostors, SURVEY §4.4).";
   const Scene* scene = nullptr;
   int size = 128;
-  void parameters(par::Params& p) const { p.set("size", size); }
+  bool mirrors = false;  // mirror objects too (render_refractor_impostors)
+  void parameters(par::Params& p) const { p.set("size", size).set("mirrors", mirrors ? 1 : 0); }
   RefractorImpostors operator()(par::NodeContext& c) const;
 };
 

@@ -59,7 +59,7 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
                  "0: the technique's default: 1, reference 8)")
       ->check(CLI::Range(0, 16))->capture_default_str();
   cmd.add_option("--param", o.params,
-                 "Technique parameter name=value, repeatable (see `speculum techniques`)");
+                 "Technique parameter name=value (a number, or a mode by name), repeatable (see `speculum techniques`)");
   // The maxima bound memory: living-room (the built-in scene with most reflectors) peaks
   // near 2.1 GB at --cube-size 1024 (7.8 GB at 2048) and 1.7 GB at --shadow-size 4096 (6.2 GB
   // at 8192).
@@ -75,7 +75,7 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
                "Let the scene's image/buffer URIs and .mtl files point outside the scene\n"
                "file's folder (refused by default: one line, exit 2 for glTF)");
   // The technique parameters, from the technique table (after the command's own footer).
-  std::string params = "\n\nTechnique parameters (--param name=value: default, type and valid range, meaning):";
+  std::string params = "\n\nTechnique parameters (--param name=value: default, valid range or the modes by name, meaning):";
   for (const Technique& t : techniques())
     if (!t.params.empty()) params += "\n  " + t.name + "\n" + t.describe_params("    ");
   cmd.footer(cmd.get_footer() + params);
@@ -117,16 +117,8 @@ std::map<std::string, double> check_frame_options(const FrameOptions& o) {
   check_sample_count(technique, o.width, o.height, technique.resolve_spp(o.spp, o.width, o.height));
   std::map<std::string, double> params;
   for (const std::string& item : o.params) {
-    const auto eq = item.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError("--param", "expected name=number, got '" + item + "'");
-    const std::string name = item.substr(0, eq), text = item.substr(eq + 1);
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0')
-      throw InputError("--param " + name, "expected a number, got '" + item + "'");
-    if (!std::isfinite(v)) throw InputError("--param " + name, "expected a finite number, got '" + item + "'");
-    params[name] = v;
+    const auto [name, value] = parse_technique_param(technique, item);
+    params[name] = value;
   }
   check_technique_params(technique, params);
   return params;

@@ -4,11 +4,13 @@
 // term alone against the light-traced reference's (trace/light_tracer.h, caustics seen
 // directly), and the light leak: the share of the technique's caustic energy that lands where
 // the reference has none. Storage "cube" is the survey's cube map centred at the generator;
-// "light" is the same map centred at the light (shadow-map space), the variant SURVEY §6.2
-// argues against: its distance check compares distances from the light, which cannot tell the
-// photons' receiver from a point behind it along the light's ray.
+// "light" is the same map centred at the light (shadow-map space, the technique's
+// `storage=light`), the variant SURVEY §6.2 argues against: its distance check compares
+// distances from the light, which cannot tell the photons' receiver from a point behind it
+// along the light's ray.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -19,7 +21,9 @@
 #include "apps/cli/commands.h"
 #include "apps/cli/progress.h"
 #include "apps/cli/result_table.h"
+#include "apps/techniques/technique_table.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
 #include "raster/caustics.h"
@@ -35,11 +39,15 @@ namespace {
 struct CausticsOptions {
   std::vector<std::string> scenes;
   std::vector<int> photon_res;
+  std::vector<std::string> filters;   // the technique's filter modes, by name or number
+  std::vector<std::string> storages;  // cube, light
   int width = 160;
   int height = 120;
   int cube_size = 256;
   int caustic_size = 128;
   int reference_photons = 64;  // per pixel, per light and generator
+  int chain = 4;               // steps per photon past its first generator (the technique's `chain`)
+  std::string images;  // write each row's caustic term, the reference's and their difference here
   bool quick = false;
   bool json = false;
 };
@@ -75,11 +83,30 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
   if (resolutions.empty()) resolutions = o.quick ? std::vector<int>{32, 64} : std::vector<int>{32, 64, 128, 256, 512};
   for (int r : resolutions)
     if (r < 16 || r > 512) throw InputError("--photon-res", std::to_string(r) + " is outside [16, 512]");
+  // The filters and storages as the technique names them (`--param filter=...`,
+  // `--param storage=...`): the same names in and out.
+  const pipeline::Technique& technique = pipeline::find_technique("caustics");
+  const auto modes = [&](const std::string& option, const std::string& name, const std::vector<std::string>& given) {
+    const pipeline::TechniqueParam* param = nullptr;
+    for (const pipeline::TechniqueParam& p : technique.params)
+      if (p.name == name) param = &p;
+    std::vector<int> out;
+    for (const std::string& text : given) try {
+        out.push_back(static_cast<int>(pipeline::parse_technique_param(technique, name + "=" + text).second));
+      } catch (const InputError& e) {
+        throw InputError(option, e.problem());
+      }
+    if (out.empty())
+      for (std::size_t k = 0; k < param->choices.size(); ++k) out.push_back(static_cast<int>(k));
+    return std::make_pair(param, out);
+  };
+  const auto [filter_param, filters] = modes("--filter", "filter", o.filters);
+  const auto [storage_param, storages] = modes("--storage", "storage", o.storages);
   const int width = o.quick ? 64 : o.width, height = o.quick ? 48 : o.height;
   const int reference_photons = o.quick ? 4 : o.reference_photons;
   par::Executor ex(global.threads, global.lanes);
   ResultTable table(o.json);
-  Progress progress("caustics", scenes.size() * resolutions.size() * 4, global.quiet);
+  Progress progress("caustics", scenes.size() * resolutions.size() * storages.size() * filters.size(), global.quiet);
   table.set_progress(&progress);
   for (const std::string& scene_name : scenes) {
     const Scene scene = load_scene(o.quick ? scene_name + ":size=4000" : scene_name);
@@ -98,30 +125,23 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
     const raster::GBuffer gbuffer =
         raster::resolve_gbuffer(ex, scene, raster::render_visibility(ex, scene, cam, width, height), cam.eye);
     const raster::ReflectorMaps maps = raster::render_reflector_maps(ex, scene, shadows, env, o.cube_size, &gbuffer);
-    const raster::RefractorImpostors impostors = raster::render_refractor_impostors(ex, scene, 128);
+    const raster::RefractorImpostors impostors = raster::render_refractor_impostors(ex, scene, 128, true);
     const ImageRGBA black(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     for (int res : resolutions) {
       raster::CausticPhotonOptions pho;
       pho.photon_res = res;
+      pho.chain = o.chain;
       const auto t0 = std::chrono::steady_clock::now();
       const raster::CausticPhotons photons = raster::trace_photon_images(ex, scene, maps, &impostors, pho);
       const double photons_ms = ms_since(t0);
-      // The light-space variant: the same photons, their map centred at the light.
-      raster::CausticPhotons light_space = photons;
-      for (raster::PhotonImage& img : light_space.images) {
-        const Light& l = scene.lights[img.light];
-        img.centre = l.type == LightType::Directional
-                         ? img.centre - glm::normalize(l.direction) * (2.0f * glm::length(scene.bounds().extent()))
-                         : l.position;
-      }
-      for (const char* storage : {"cube", "light"})
-        for (raster::CausticFilter filter : {raster::CausticFilter::Splat, raster::CausticFilter::Triangles}) {
+      for (int storage : storages)
+        for (int filter : filters) {
           raster::CausticMapOptions mo;
           mo.size = o.caustic_size;
-          mo.filter = filter;
+          mo.filter = static_cast<raster::CausticFilter>(filter);
+          mo.storage = static_cast<raster::CausticStorage>(storage);
           const auto t1 = std::chrono::steady_clock::now();
-          const raster::CausticMaps cm =
-              raster::build_caustic_maps(ex, scene, std::string(storage) == "cube" ? photons : light_space, mo);
+          const raster::CausticMaps cm = raster::build_caustic_maps(ex, scene, photons, mo);
           const ImageRGBA term = raster::gather_caustics(ex, gbuffer, cm, black, 0.05f);
           const double ms = photons_ms + ms_since(t1);
           double total = 0.0, leaked = 0.0;
@@ -130,10 +150,28 @@ void run_caustics(const CausticsOptions& o, const GlobalOptions& global) {
             total += e;
             if (!lit[i]) leaked += e;
           }
-          const ImageError err = image_error(display(ex, term), reference_display, "caustic term vs reference");
+          const ImageRGBA term_display = display(ex, term);
+          const ImageError err = image_error(term_display, reference_display, "caustic term vs reference");
+          if (!o.images.empty()) {
+            // The two caustic terms and their absolute 8-bit difference, scaled by 8.
+            const std::string stem = o.images + "/" + scene_name.substr(0, scene_name.find(':')) + "_" +
+                                     std::to_string(res) + "_" + filter_param->value_text(filter) + "_" +
+                                     storage_param->value_text(storage);
+            ImageRGBA diff(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+            for (std::size_t i = 0; i < diff.pixels.size(); ++i)
+              for (int ch = 0; ch < 3; ++ch) {
+                const int d = std::abs(display_to_8bit(term_display.pixels[i][ch]) -
+                                       display_to_8bit(reference_display.pixels[i][ch]));
+                diff.pixels[i][ch] = srgb_to_linear(std::min(1.0f, 8.0f * float(d) / 255.0f));
+              }
+            write_image(stem + ".png", term_display);
+            write_image(stem + "_diff8.png", diff);
+            write_image(o.images + "/" + scene_name.substr(0, scene_name.find(':')) + "_reference.png",
+                        reference_display);
+          }
           table.cell("scene", scene_name)
-              .cell("filter", filter == raster::CausticFilter::Splat ? "splat" : "triangles")
-              .cell("storage", storage)
+              .cell("filter", filter_param->value_text(filter))
+              .cell("storage", storage_param->value_text(storage))
               .cell("photon_res", res)
               .cell("photons", static_cast<std::int64_t>(photons.photons))
               .cell("ms", ms, 1)
@@ -156,15 +194,24 @@ void add_experiment_caustics_subcommand(CLI::App& experiment, GlobalOptions& glo
       "Example: speculum experiment caustics --photon-res 64 --photon-res 256 --json");
   cmd->add_option("--scene", o->scenes, "Scene(s) (repeatable; default: glass-sphere, caustic-ring, water-slab)");
   cmd->add_option("--photon-res", o->photon_res, "Photon image side(s), 16..512 (repeatable; default: 32 64 128 256 512)");
+  cmd->add_option("--filter", o->filters,
+                  "Caustic-map filter(s) by name as in `--param filter=`: splat, triangles (repeatable; default: both)");
+  cmd->add_option("--storage", o->storages,
+                  "Caustic-map storage(s) by name as in `--param storage=`: cube, light (repeatable; default: both)");
   cmd->add_option("--width", o->width, "Image width")->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--height", o->height, "Image height")->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--cube-size", o->cube_size, "Face size of the generators' distance maps")
       ->check(CLI::Range(8, 2048))->capture_default_str();
   cmd->add_option("--caustic-size", o->caustic_size, "Face size of the caustic maps")
       ->check(CLI::Range(16, 1024))->capture_default_str();
+  cmd->add_option("--chain", o->chain, "Steps a photon follows past its first generator: internal reflections, other generators (the technique's `chain`)")
+      ->check(CLI::Range(0, 16))->capture_default_str();
   cmd->add_option("--reference-photons", o->reference_photons,
                   "Light-traced reference photons per pixel, per light and generator")
       ->check(CLI::Range(1, 1024))->capture_default_str();
+  cmd->add_option("--images", o->images,
+                  "Write each row's caustic term, the reference's and their 8-bit difference ×8 into this existing directory")
+      ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quick", o->quick, "Smoke check: 64x48, photon_res 32 and 64, small scenes, 4 reference photons per pixel");
   cmd->add_flag("--json", o->json, "One JSON object per row instead of the text table");
   cmd->callback([o, &global] { run_caustics(*o, global); });

@@ -313,15 +313,10 @@ void run_soff_experiment(SoffExperimentOptions o, const GlobalOptions& global) {
     o.glossy_samples = std::min(o.glossy_samples, 16);
   }
   for (const std::string& item : o.params) {
-    const auto eq = item.find('=');
-    char* end = nullptr;
-    const std::string text = eq == std::string::npos ? "" : item.substr(eq + 1);
-    const double v = std::strtod(text.c_str(), &end);
-    if (eq == std::string::npos || eq == 0 || text.empty() || *end != '\0' || !std::isfinite(v))
-      throw InputError("--param", "expected name=number, got '" + item + "'");
-    if (item.substr(0, eq) == "glossy_rays")
+    const auto [name, v] = pipeline::parse_technique_param(pipeline::find_technique("soff"), item);
+    if (name == "glossy_rays")
       throw InputError("--param glossy_rays", "use --glossy-rays (the trace columns use the same count)");
-    o.soff_params[item.substr(0, eq)] = v;
+    o.soff_params[name] = v;
   }
   pipeline::check_technique_params(pipeline::find_technique("soff"), o.soff_params);
   const std::vector<std::string>& scenes = o.scenes.empty() ? kScenes : o.scenes;

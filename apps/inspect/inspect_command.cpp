@@ -83,7 +83,12 @@ fs::path write_inspect_report(const pipeline::FrameOptions& options, const fs::p
                      {"seed", std::to_string(settings.seed)},
                      {"exposure", settings.auto_exposure ? std::string("auto") : std::to_string(settings.exposure)},
                      {"threads", std::to_string(global.threads)}};
-  for (const auto& [k, v] : settings.params) report.settings.emplace_back("param " + k, std::to_string(v));
+  for (const auto& [k, v] : settings.params) {
+    std::string text = std::to_string(v);
+    for (const pipeline::TechniqueParam& p : technique.params)
+      if (p.name == k && !p.choices.empty()) text = p.value_text(v);  // a mode by its name
+    report.settings.emplace_back("param " + k, text);
+  }
 
   // Outputs as they are produced: drawn and written at once (values die with the graph).
   std::map<std::pair<std::string, std::string>, inspect::PortInfo> captured;  // (node, port)

@@ -245,12 +245,9 @@ std::vector<Cell> select_cells(const MatrixOptions& o) {
       throw InputError("--param", "expected technique:name=value for a selected technique, got '" + p + "'");
     // name=value and its range, against the technique table (no scene needed).
     const std::string item = p.substr(colon + 1);
-    const auto eq = item.find('=');
-    char* end = nullptr;
-    const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
-    if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
+    if (item.find('=') == std::string::npos || item.front() == '=')
       throw InputError("--param", "expected technique:name=value, got '" + p + "'");
-    pipeline::check_technique_params(pipeline::find_technique(t), {{item.substr(0, eq), v}});
+    pipeline::parse_technique_param(pipeline::find_technique(t), item);
   }
   std::vector<Cell> cells;
   for (const std::string& t : techniques)

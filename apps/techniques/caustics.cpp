@@ -26,15 +26,20 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
                   .describe("Colour + distance cube map around each specular object, itself left out: "
                             "what reflected rays and the photons leaving a generator search (SURVEY §4.1, §6.1).");
   auto impostors = g.add("refractor_impostors",
-                         RefractorImpostorsPass{scene, static_cast<int>(f.param("impostor_size"))});
+                         RefractorImpostorsPass{scene, static_cast<int>(f.param("impostor_size")), true})
+                       .describe("Each refractor and mirror alone from its centre: normal + distance cube map, "
+                                 "searched for a refracted ray's exit and for a photon meeting its generator "
+                                 "again (distance impostors, SURVEY §4.4).");
   CausticPhotonOptions po;
   po.photon_res = static_cast<int>(f.param("photon_res"));
+  po.chain = static_cast<int>(f.param("chain"));
   po.receiver_search = search;
   po.exit_search = search;
   auto photons = g.add("caustic_photons", CausticPhotonsPass{scene, po}, maps, impostors);
   CausticMapOptions mo;
   mo.size = static_cast<int>(f.param("caustic_size"));
   mo.filter = static_cast<CausticFilter>(static_cast<int>(f.param("filter")));
+  mo.storage = static_cast<CausticStorage>(static_cast<int>(f.param("storage")));
   mo.splat_radius = static_cast<int>(f.param("splat_radius"));
   mo.adaptive = f.param("adaptive") != 0.0;
   auto caustic_maps = g.add("caustic_map", CausticMapPass{scene, mo}, photons);

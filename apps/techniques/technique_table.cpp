@@ -1,7 +1,9 @@
 // The technique table: see technique_table.h.
 #include "apps/techniques/technique_table.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 #include "apps/techniques/recipes.h"
@@ -41,6 +43,28 @@ std::string number(double v) {
 }
 
 }  // namespace
+
+std::string TechniqueParam::value_text(double v) const {
+  if (!choices.empty() && v >= 0 && v < static_cast<double>(choices.size()) && v == std::floor(v))
+    return choices[static_cast<std::size_t>(v)];
+  return number(v);
+}
+
+std::string TechniqueParam::range_text() const {
+  if (choices.empty())
+    return std::string(integer ? "integer" : "number") + " in [" + number(min) + ", " + number(max) + "]";
+  std::string names;
+  for (const std::string& c : choices) names += (names.empty() ? "" : "|") + c;
+  return "one of " + names;
+}
+
+TechniqueParam choice_param(std::string name, const std::string& fallback, std::vector<std::string> names,
+                            std::string doc) {
+  const auto at = std::find(names.begin(), names.end(), fallback);
+  TechniqueParam p{std::move(name), static_cast<double>(at - names.begin()), 0,
+                   static_cast<double>(names.size()) - 1, true, std::move(doc), std::move(names)};
+  return p;
+}
 
 const std::vector<Technique>& techniques() {
   static const std::vector<Technique> table = {
@@ -113,19 +137,21 @@ const std::vector<Technique>& techniques() {
         {"max_image_side", 1024, 16, 4096, true, "largest depth-image side (clamped images are counted)"},
         {"glossy_rays", 8, 1, 64, true, "reflected rays per glossy sample (SOFF §3.5: 8 to 49)"},
         {"glossy_far", 1, 0.05, 1, false, "glossy clusters' far plane at this × the scene diameter (§3.5)"},
-        {"fill", 0, 0, 1, true, "disoccluded rays: 0 the environment (SOFF), 1 the depth image beside the silhouette"},
+        choice_param("fill", "environment", {"environment", "depth-image"},
+                     "disoccluded rays: the environment (SOFF), or the depth image beside the silhouette"),
         {"reshade", 1, 0, 1, true, "1: a hit's view-dependent shading is re-evaluated for the ray; 0: the depth image's colour"},
-        {"concave", 0, 0, 1, true,
-         "concave clusters (SOFF §4.4): 0 like convex ones, 1 rays first intersected with their own reflector"}}},
+        choice_param("concave", "convex", {"convex", "self"},
+                     "concave clusters (SOFF §4.4): like convex ones, or rays first intersected with their own reflector")}},
       {"refraction",
        "refraction (SURVEY §4.4): exit refracted or totally internally reflected, looked up in "
        "the refractor's colour+distance cube",
        add_refraction_passes,
-       {{"method", 1, 0, 2, true, "0 single interface, 1 two-face, 2 distance impostors"},
+       {choice_param("method", "two-face", {"single", "two-face", "impostors"},
+                     "single interface, two-face (back-face normals + thickness), distance impostors"),
         {"linear_steps", 16, 0, 256, true, "linear search steps (both searches; < 2: off)"},
         {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
         // ≈ 150 MB per refractor at 1024² faces, ≈ 3.6 GB at 4096².
-        {"impostor_size", 128, 4, 1024, true, "cube face side of the distance impostors (method 2; ~150 MB each at 1024)"}}},
+        {"impostor_size", 128, 4, 1024, true, "cube face side of the distance impostors (method=impostors; ~150 MB each at 1024)"}}},
       {"caustics",
        "caustics (SURVEY §6): photons shot from each light through each mirror/refractor, "
        "receivers found in its distance map, stored in a cube map at the generator, splats or "
@@ -134,14 +160,19 @@ const std::vector<Technique>& techniques() {
        // Photon images cost photon_res² texels per light and generator (512: 262k each), the
        // caustic map 6·caustic_size² texels (1024: ~200 MB per generator).
        {{"photon_res", 128, 16, 512, true, "photon image side per light and generator (512: 262k photons)"},
-        {"filter", 0, 0, 1, true, "0 splat (normalized tent kernel), 1 caustic triangles (then blurred)"},
-        {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (filter 0; the least with adaptive)"},
+        {"chain", 4, 0, 16, true,
+         "steps a photon follows past its first generator: a mirror meeting itself, a refractor's TIR, another generator"},
+        choice_param("filter", "splat", {"splat", "triangles"},
+                     "normalized tent-kernel splats, or caustic triangles (then blurred)"),
+        choice_param("storage", "cube", {"cube", "light"},
+                     "caustic map centred at the generator (SURVEY §6.2), or at the light (shadow-map space: leaks)"),
+        {"splat_radius", 1, 0, 8, true, "splat kernel radius in caustic-map texels (splat; the least with adaptive)"},
         {"adaptive", 1, 0, 1, true, "1: splat radius grows to the neighbouring photons' spacing (at most 8 texels)"},
         {"caustic_size", 128, 16, 1024, true, "cube face side of the caustic map (1024: ~200 MB per generator)"},
         {"tolerance", 0.05, 0.001, 1, false, "relative distance mismatch still taken as the photons' receiver"},
         {"linear_steps", 16, 0, 256, true, "linear search steps (receiver and exit searches; < 2: off)"},
         {"secant_steps", 4, 0, 16, true, "secant iterations (float precision long before 16)"},
-        {"impostor_size", 128, 4, 1024, true, "cube face side of the refractors' distance impostors (~150 MB each at 1024)"}}},
+        {"impostor_size", 128, 4, 1024, true, "cube face side of the generators' distance impostors (~150 MB each at 1024)"}}},
       {"yu-lod",
        "YU glossy reflections: --spp N Phong-sampled rays per glossy pixel through a threaded "
        "BVH with adaptive LOD (eq.7, --alpha A; 0: LOD off), pre-filtered hit radiance (eq.8-9)",
@@ -174,8 +205,8 @@ const std::vector<Technique>& techniques() {
         {"lobe_energy", 0.5, 0.1, 0.999, false, "fraction of a material's Phong lobe its glossy cone holds"},
         {"far_blur", 0.5, 0, 100, false,
          "far plane where the glossy blur reaches this fraction of the scene radius (0: none)"},
-        {"fill", 1, 0, 1, true,
-         "1: the dropped hits' coverage filled in the kept hits' mean colour before the environment; 0: environment only"},
+        choice_param("fill", "mean", {"environment", "mean"},
+                     "the dropped hits' coverage: the environment only, or the kept hits' mean colour before it"),
         {"pair_capacity", 2048.0 * 2048.0, 1, 1 << 26, true, "pair buffer capacity (pairs; ~10 bytes each)"},
         {"block", 64, 1, 65536, true, "block size s of the hierarchical compaction (ROGER §4.3.2)"}},
        // Each pixel has `kept` slots of kept hits (24 bytes) and of the layer generation
@@ -210,33 +241,59 @@ const Technique& find_technique(const std::string& name) {
                                       " (known: " + known + ")");
 }
 
+namespace {
+
+// The parameter `name` of `technique`; throws InputError listing the known names.
+const TechniqueParam& find_param(const Technique& technique, const std::string& name) {
+  for (const TechniqueParam& p : technique.params)
+    if (p.name == name) return p;
+  std::string list;
+  std::vector<std::string> names;
+  for (const TechniqueParam& p : technique.params) {
+    list += (list.empty() ? "" : ", ") + p.name;
+    names.push_back(p.name);
+  }
+  throw InputError("--param " + name, "unknown parameter '" + name + "' for technique '" + technique.name + "'" +
+                                          did_you_mean(name, names) + " (" +
+                                          (list.empty() ? std::string("it takes no parameters") : "known: " + list) +
+                                          ")");
+}
+
+}  // namespace
+
 void check_technique_params(const Technique& technique, const std::map<std::string, double>& params) {
   for (const auto& [name, value] : params) {
-    const TechniqueParam* spec = nullptr;
-    for (const TechniqueParam& p : technique.params)
-      if (p.name == name) spec = &p;
-    if (!spec) {
-      std::string list;
-      std::vector<std::string> names;
-      for (const TechniqueParam& p : technique.params) {
-        list += (list.empty() ? "" : ", ") + p.name;
-        names.push_back(p.name);
-      }
-      throw InputError("--param " + name,
-                       "unknown parameter '" + name + "' for technique '" + technique.name + "'" +
-                           did_you_mean(name, names) + " (" +
-                           (list.empty() ? std::string("it takes no parameters") : "known: " + list) +
-                           ")");
-    }
-    const std::string range = std::string(spec->integer ? "integer" : "number") + " in [" + number(spec->min) +
-                              ", " + number(spec->max) + "]";
+    const TechniqueParam* spec = &find_param(technique, name);
+    const std::string range = spec->range_text();
     if (!(value >= spec->min && value <= spec->max))
       throw InputError("--param " + name, number(value) + " is outside the valid range of '" + name +
                                               "' for technique '" + technique.name + "': " + range);
     if (spec->integer && value != std::floor(value))
       throw InputError("--param " + name, number(value) + " is not a whole number: '" + name +
-                                              "' for technique '" + technique.name + "' takes an " + range);
+                                              "' for technique '" + technique.name + "' takes " +
+                                              (spec->choices.empty() ? "an " : "") + range);
   }
+}
+
+std::pair<std::string, double> parse_technique_param(const Technique& technique, const std::string& item) {
+  const auto eq = item.find('=');
+  if (eq == std::string::npos || eq == 0) throw InputError("--param", "expected name=value, got '" + item + "'");
+  const std::string name = item.substr(0, eq), text = item.substr(eq + 1);
+  const TechniqueParam& p = find_param(technique, name);
+  for (std::size_t k = 0; k < p.choices.size(); ++k)
+    if (p.choices[k] == text) return {name, static_cast<double>(k)};
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') {
+    if (!p.choices.empty())
+      throw InputError("--param " + name, "unknown value '" + text + "' of '" + name + "' for technique '" +
+                                              technique.name + "'" + did_you_mean(text, p.choices) + ": " +
+                                              p.range_text());
+    throw InputError("--param " + name, "expected a number, got '" + item + "'");
+  }
+  if (!std::isfinite(v)) throw InputError("--param " + name, "expected a finite number, got '" + item + "'");
+  check_technique_params(technique, {{name, v}});
+  return {name, v};
 }
 
 FrameSettings Technique::with_defaults(FrameSettings settings) const {
@@ -255,8 +312,7 @@ int Technique::resolve_spp(int spp, int width, int height) const {
 std::string Technique::describe_params(const std::string& indent) const {
   std::string out;
   for (const TechniqueParam& p : params)
-    out += indent + p.name + "=" + number(p.fallback) + "  " + (p.integer ? "integer" : "number") + " in [" +
-           number(p.min) + ", " + number(p.max) + "]  " + p.doc + "\n";
+    out += indent + p.name + "=" + p.value_text(p.fallback) + "  " + p.range_text() + "  " + p.doc + "\n";
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/techniques/frame_settings.h"
@@ -19,7 +20,19 @@ struct TechniqueParam {
   double min = 0, max = 0;
   bool integer = true;  // only whole numbers are valid
   std::string doc;      // one line
+  // A parameter that picks one of several modes names them: value k is choices[k], so
+  // `--param filter=triangles` and `--param filter=1` are the same (min 0, max size − 1).
+  std::vector<std::string> choices = {};
+
+  // choices[v] for a parameter with named choices, else the number ("1", "0.05").
+  std::string value_text(double v) const;
+  // "integer in [1, 16]", or "one of splat|triangles" for named choices.
+  std::string range_text() const;
 };
+
+// A parameter whose value is one of `names` (its default `fallback`, by name).
+TechniqueParam choice_param(std::string name, const std::string& fallback, std::vector<std::string> names,
+                            std::string doc);
 
 struct Technique {
   std::string name;
@@ -55,5 +68,9 @@ const Technique& find_technique(const std::string& name);
 // Throws InputError naming the first parameter of `params` that `technique` does not take
 // or whose value is outside its range, with the valid names or range.
 void check_technique_params(const Technique& technique, const std::map<std::string, double>& params);
+// One `--param` item, "name=value": the value a number or, for a parameter with named
+// choices, one of the names. Throws InputError (an unknown parameter or name, not a number,
+// out of range) naming the parameter and what it takes.
+std::pair<std::string, double> parse_technique_param(const Technique& technique, const std::string& item);
 
 }  // namespace speculum::pipeline

@@ -61,7 +61,7 @@ TEST(TechniqueParams, OutOfRangeFractionalAndUnknownAreInputErrors) {
       for (double bad : {p.min - 1, p.max + 1, std::nan("")}) {
         const std::string e = input_error(t, p.name, bad);
         EXPECT_NE(e.find("--param " + p.name + ":"), std::string::npos) << e;
-        EXPECT_NE(e.find("[" + text(p.min) + ", " + text(p.max) + "]"), std::string::npos) << e;
+        EXPECT_NE(e.find(p.range_text()), std::string::npos) << e;
       }
       if (p.integer && p.max > p.min)
         EXPECT_NE(input_error(t, p.name, p.min + 0.5), "(accepted)") << t.name << " " << p.name;
@@ -96,9 +96,93 @@ TEST(TechniqueParams, CliRejectsOutOfRangeForEveryTechnique) {
     EXPECT_EQ(r.status, 2) << t.name << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_NE(r.err.find("--param " + p.name), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("[" + text(p.min) + ", " + text(p.max) + "]"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(p.range_text()), std::string::npos) << r.err;
     EXPECT_FALSE(std::ifstream(out).good()) << out;
   }
+}
+
+std::string parse_error(const Technique& t, const std::string& item) {
+  try {
+    parse_technique_param(t, item);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+// The modes a parameter picks between are named: the value is the name's index, given by
+// name or by number, and every enumerated parameter of the table has names.
+TEST(TechniqueParams, NamedChoicesAreTheirIndexByNameOrNumber) {
+  int named = 0;
+  for (const Technique& t : techniques())
+    for (const TechniqueParam& p : t.params) {
+      if (p.choices.empty()) continue;
+      ++named;
+      EXPECT_TRUE(p.integer) << t.name << " " << p.name;
+      EXPECT_EQ(p.min, 0.0) << t.name << " " << p.name;
+      EXPECT_EQ(p.max, double(p.choices.size() - 1)) << t.name << " " << p.name;
+      for (std::size_t k = 0; k < p.choices.size(); ++k) {
+        EXPECT_EQ(parse_technique_param(t, p.name + "=" + p.choices[k]), std::make_pair(p.name, double(k)));
+        EXPECT_EQ(parse_technique_param(t, p.name + "=" + std::to_string(k)), std::make_pair(p.name, double(k)));
+        EXPECT_EQ(p.value_text(double(k)), p.choices[k]);
+      }
+      // The listing names the default and the modes.
+      const std::string listed = t.describe_params("");
+      EXPECT_NE(listed.find(p.name + "=" + p.value_text(p.fallback) + "  " + p.range_text()), std::string::npos)
+          << listed;
+    }
+  // caustics filter and storage, refraction method, soff fill and concave, cone-tracing fill.
+  EXPECT_EQ(named, 6);
+  const Technique& caustics = find_technique("caustics");
+  EXPECT_EQ(parse_technique_param(caustics, "filter=triangles"), std::make_pair(std::string("filter"), 1.0));
+  EXPECT_EQ(find_technique("refraction").describe_params("").find("method=two-face  one of single|two-face|impostors"),
+            0u);
+  // Numbers still work for the others, and names only where a parameter has them.
+  EXPECT_EQ(parse_technique_param(caustics, "photon_res=256"), std::make_pair(std::string("photon_res"), 256.0));
+  EXPECT_NE(parse_error(caustics, "photon_res=splat").find("expected a number"), std::string::npos);
+}
+
+TEST(TechniqueParams, AnUnknownModeNameListsTheValidOnes) {
+  const Technique& caustics = find_technique("caustics");
+  const std::string e = parse_error(caustics, "filter=triangls");
+  EXPECT_EQ(e, "--param filter: unknown value 'triangls' of 'filter' for technique 'caustics' (did you mean "
+               "'triangles'?): one of splat|triangles");
+  EXPECT_NE(parse_error(caustics, "filter=2").find("one of splat|triangles"), std::string::npos);
+  EXPECT_NE(parse_error(caustics, "filter=0.5").find("one of splat|triangles"), std::string::npos);
+  EXPECT_NE(parse_error(caustics, "filter=").find("one of splat|triangles"), std::string::npos);
+  EXPECT_NE(parse_error(caustics, "filtr=splat").find("did you mean 'filter'"), std::string::npos);
+  EXPECT_NE(parse_error(caustics, "=splat").find("expected name=value"), std::string::npos);
+}
+
+// Through the CLI: a mode by name renders the same bytes as by number; a bad name exits 2
+// with one line listing the valid names (render and matrix alike), and the listings show them.
+TEST(TechniqueParams, CliTakesModesByName) {
+  const auto dir = test::scratch_dir();
+  const std::string common = "render glass-sphere:size=1000 -t caustics --width 24 --height 16 --cube-size 16 "
+                             "--shadow-size 64 -q --param photon_res=16 --param caustic_size=16 --param impostor_size=8 ";
+  const auto out = [&](const char* name) { return " -o " + test::sh_quote((dir / name).string()); };
+  const auto a = test::run_speculum(common + "--param filter=triangles" + out("a.png"), dir);
+  const auto b = test::run_speculum(common + "--param filter=1" + out("b.png"), dir);
+  const auto c = test::run_speculum(common + "--param filter=splat" + out("c.png"), dir);
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(test::slurp(dir / "a.png"), test::slurp(dir / "b.png"));
+  EXPECT_NE(test::slurp(dir / "a.png"), test::slurp(dir / "c.png"));  // the name reached the recipe
+  const auto bad = test::run_speculum(common + "--param filter=blur" + out("x.png"), dir);
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_EQ(bad.err, "speculum: --param filter: unknown value 'blur' of 'filter' for technique 'caustics': "
+                     "one of splat|triangles\n");
+  EXPECT_FALSE(std::ifstream((dir / "x.png").string()).good());
+  const auto m = test::run_speculum("matrix --techniques refraction --scenes glass-sphere --param "
+                                    "refraction:method=twoface" + out("m"),
+                                    dir);
+  EXPECT_EQ(m.status, 2);
+  EXPECT_NE(m.err.find("did you mean 'two-face'?): one of single|two-face|impostors"), std::string::npos) << m.err;
+  const auto listing = test::run_speculum("techniques", dir);
+  EXPECT_NE(listing.out.find("--param filter=splat  one of splat|triangles"), std::string::npos) << listing.out;
+  const auto help = test::run_speculum("render --help", dir);
+  EXPECT_NE(help.out.find("method=two-face  one of single|two-face|impostors"), std::string::npos);
 }
 
 }  // namespace
