@@ -85,6 +85,8 @@ struct Binner {
   }
 };
 
+// One set of bins: a second set for the odd refs (two chains of bin updates in flight,
+// merged at the end) measured 4-10% more build CPU time on 1.02M triangles.
 void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
   // Lane 3 of a ref's lo/hi holds the id/pad bits: it is zeroed before the bin index is
   // formed, and ignored in the bin boxes. Lanes 0-2 do exactly Binner::bin's operations.
