@@ -14,6 +14,7 @@
 #include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/bulk_allocator.h"
 #include "core/scene.h"
 #include "parallel/executor.h"
 
@@ -117,13 +118,13 @@ class Bvh {
              par::Executor& executor);
 
   std::size_t triangle_count() const { return triangle_id_.size(); }
-  const std::vector<BinaryNode>& binary_nodes() const { return binary_; }
-  const std::vector<WideNode>& wide_nodes() const { return wide_; }
-  const std::vector<TrianglePack>& triangle_packs() const { return packs_; }
-  const std::vector<ThreadedNode>& threaded_nodes() const { return threaded_; }
-  const std::vector<LeafTriangle>& leaf_triangles() const { return triangles_; }
+  const BulkVector<BinaryNode>& binary_nodes() const { return binary_; }
+  const BulkVector<WideNode>& wide_nodes() const { return wide_; }
+  const BulkVector<TrianglePack>& triangle_packs() const { return packs_; }
+  const BulkVector<ThreadedNode>& threaded_nodes() const { return threaded_; }
+  const BulkVector<LeafTriangle>& leaf_triangles() const { return triangles_; }
   // Original triangle index of each leaf slot.
-  const std::vector<std::uint32_t>& triangle_ids() const { return triangle_id_; }
+  const BulkVector<std::uint32_t>& triangle_ids() const { return triangle_id_; }
   std::uint32_t wide_root() const { return wide_root_; }
   const BvhStats& stats() const { return stats_; }
 
@@ -133,14 +134,14 @@ class Bvh {
 
  private:
   void derive_layouts(par::Executor& executor);
-  void derive_wide(const std::vector<std::uint32_t>& leaf_ref);
 
-  std::vector<BinaryNode> binary_;
-  std::vector<WideNode> wide_;
-  std::vector<TrianglePack> packs_;
-  std::vector<ThreadedNode> threaded_;
-  std::vector<LeafTriangle> triangles_;
-  std::vector<std::uint32_t> triangle_id_;
+  // Bulk vectors (core/bulk_allocator.h): filled in parallel, on huge pages where they are big.
+  BulkVector<BinaryNode> binary_;
+  BulkVector<WideNode> wide_;
+  BulkVector<TrianglePack> packs_;
+  BulkVector<ThreadedNode> threaded_;
+  BulkVector<LeafTriangle> triangles_;
+  BulkVector<std::uint32_t> triangle_id_;
   std::uint32_t wide_root_ = kEmptyChild;
   BvhStats stats_;
 };

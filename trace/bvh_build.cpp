@@ -85,6 +85,8 @@ struct Binner {
   }
 };
 
+// One set of bins: a second set for the odd refs (two chains of bin updates in flight,
+// merged at the end) measured 4-10% more build CPU time on 1.02M triangles.
 void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
   // Lane 3 of a ref's lo/hi holds the id/pad bits: it is zeroed before the bin index is
   // formed, and ignored in the bin boxes. Lanes 0-2 do exactly Binner::bin's operations.
@@ -286,11 +288,11 @@ LeafTriangle leaf_triangle(const std::vector<glm::vec3>& positions, const std::v
 
 // One reference per triangle (its box and id), in triangle order. Throws
 // InputError(source, ...) for an index out of range or a non-finite position.
-std::vector<PrimRef> make_prim_refs(const std::vector<glm::vec3>& positions,
+BulkVector<PrimRef> make_prim_refs(const std::vector<glm::vec3>& positions,
                                     const std::vector<std::uint32_t>& indices, par::Executor& ex,
                                     const std::string& source) {
   const std::size_t tri_count = indices.size() / 3;
-  std::vector<PrimRef> refs(tri_count);
+  BulkVector<PrimRef> refs(tri_count);
   std::vector<std::uint8_t> bad((tri_count + kPrimChunk - 1) / kPrimChunk, 0);
   ex.parallel_for("bvh_prim_refs", tri_count, kPrimChunk, [&](std::size_t b, std::size_t e) {
     for (std::size_t t = b; t < e; ++t) {
@@ -321,7 +323,7 @@ std::vector<PrimRef> make_prim_refs(const std::vector<glm::vec3>& positions,
 
 // The range refs[begin, end) with its box and centroid bounds, reduced over fixed chunks
 // in parallel (min/max: exact in any order).
-Range range_bounds(par::Executor& ex, const std::vector<PrimRef>& refs, std::uint32_t begin, std::uint32_t end) {
+Range range_bounds(par::Executor& ex, const BulkVector<PrimRef>& refs, std::uint32_t begin, std::uint32_t end) {
   const std::size_t n = end - begin;
   const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
   std::vector<Aabb> box(chunks), cbox(chunks);
@@ -345,7 +347,7 @@ Range range_bounds(par::Executor& ex, const std::vector<PrimRef>& refs, std::uin
 
 // The bins of one large range, filled per fixed chunk in parallel and merged in chunk
 // order (min/max/count: exact in any order).
-Bins bin_range_parallel(par::Executor& ex, const std::vector<PrimRef>& refs, const Range& range,
+Bins bin_range_parallel(par::Executor& ex, const BulkVector<PrimRef>& refs, const Range& range,
                         const Binner& binner, int nbins) {
   const std::size_t n = range.end - range.begin;
   const std::size_t chunks = (n + kBinChunk - 1) / kBinChunk;
@@ -378,7 +380,7 @@ struct TopTree {
 // breadth-first): each range is binned in parallel over chunks, then the level's
 // partitions run in parallel, one range per chunk. Nodes and tasks are numbered in FIFO
 // order, as a one-at-a-time loop would number them. Reorders `refs`.
-TopTree split_top_ranges(par::Executor& ex, std::vector<PrimRef>& refs, const BvhBuildOptions& opt) {
+TopTree split_top_ranges(par::Executor& ex, BulkVector<PrimRef>& refs, const BvhBuildOptions& opt) {
   TopTree top;
   if (refs.empty()) return top;
   struct Item {
@@ -436,7 +438,7 @@ TopTree split_top_ranges(par::Executor& ex, std::vector<PrimRef>& refs, const Bv
 }
 
 // Parallel phase: each task builds its subtree alone; chunk = 1 task.
-std::vector<Subtree> build_subtrees(par::Executor& ex, std::vector<PrimRef>& refs,
+std::vector<Subtree> build_subtrees(par::Executor& ex, BulkVector<PrimRef>& refs,
                                     const std::vector<Range>& tasks, const BvhBuildOptions& opt) {
   std::vector<Subtree> sub(tasks.size());
   ex.parallel_for("bvh_subtrees", tasks.size(), 1, [&](std::size_t b, std::size_t e) {
@@ -446,9 +448,9 @@ std::vector<Subtree> build_subtrees(par::Executor& ex, std::vector<PrimRef>& ref
 }
 
 // Leaf triangles and their ids in ref order.
-void gather_leaf_triangles(par::Executor& ex, const std::vector<PrimRef>& refs,
+void gather_leaf_triangles(par::Executor& ex, const BulkVector<PrimRef>& refs,
                            const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
-                           std::vector<LeafTriangle>& triangles, std::vector<std::uint32_t>& triangle_id) {
+                           BulkVector<LeafTriangle>& triangles, BulkVector<std::uint32_t>& triangle_id) {
   triangles.resize(refs.size());
   triangle_id.resize(refs.size());
   ex.parallel_for("bvh_gather_triangles", refs.size(), kPrimChunk, [&](std::size_t b, std::size_t e) {
@@ -465,7 +467,7 @@ void gather_leaf_triangles(par::Executor& ex, const std::vector<PrimRef>& refs,
 // copied (shifting `right`) in parallel, one task per subtree. Fills the depth and leaf
 // counts of `stats`. `top` must hold the root (a non-empty build).
 void splice_depth_first(par::Executor& ex, const TopTree& top, const std::vector<Subtree>& sub,
-                        std::vector<BinaryNode>& binary, BvhStats& stats) {
+                        BulkVector<BinaryNode>& binary, BvhStats& stats) {
   struct Placement {
     std::size_t task;
     std::uint32_t offset, depth;
@@ -535,7 +537,7 @@ Bvh Bvh::build(const std::vector<glm::vec3>& positions, const std::vector<std::u
   };
 
   Bvh bvh;
-  std::vector<PrimRef> refs = make_prim_refs(positions, indices, ex, source);
+  BulkVector<PrimRef> refs = make_prim_refs(positions, indices, ex, source);
   bvh.stats_.refs_ms = lap();
   const TopTree top = split_top_ranges(ex, refs, opt);
   bvh.stats_.top_ms = lap();

@@ -1,9 +1,12 @@
 // Derives the traversal layouts from the binary BVH (bvh.h): the 8-wide collapse (SAH-optimal
 // choice of each wide node's up to 8 slots, Ylitie et al. 2017 §3.1) with triangle packs and the threaded layout of
 // YU §3 / [CHCH06] (depth-first order, hit link = left child, miss link = next subtree).
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "trace/bvh.h"
 
@@ -13,7 +16,7 @@ namespace {
 
 // The threaded layout: parents precede children, so a forward pass hands each child its
 // miss link.
-void derive_threaded(const std::vector<BinaryNode>& binary, std::vector<ThreadedNode>& threaded) {
+void derive_threaded(const BulkVector<BinaryNode>& binary, BulkVector<ThreadedNode>& threaded) {
   threaded.resize(binary.size());
   if (!binary.empty()) threaded[0].miss = kThreadEnd;
   for (std::size_t i = 0; i < binary.size(); ++i) {
@@ -33,7 +36,7 @@ void derive_threaded(const std::vector<BinaryNode>& binary, std::vector<Threaded
 }
 
 // One leaf's triangles as packs of 4 (unused lanes: NaN vertices, id kEmptyChild).
-void fill_packs(const std::vector<LeafTriangle>& tris, const std::vector<std::uint32_t>& ids, const BinaryNode& leaf,
+void fill_packs(const BulkVector<LeafTriangle>& tris, const BulkVector<std::uint32_t>& ids, const BinaryNode& leaf,
                 TrianglePack* out) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const std::uint32_t npacks = (leaf.count + 3) / 4;
@@ -59,19 +62,31 @@ void fill_packs(const std::vector<LeafTriangle>& tris, const std::vector<std::ui
 // node over its children, area(n) + the children in 8 slots), or n dissolved with its
 // children sharing the j slots. Greedy opening by area left many bottom nodes 2-4 full.
 struct CollapsePlan {
-  std::vector<std::uint8_t> choice;      // [n * 8 + j - 1]: 0 = n is one slot, else slots of the left child
-  std::vector<std::uint8_t> node_split;  // n as a wide node: slots of its left child (of 8)
+  BulkVector<std::uint8_t> choice;      // [n * 8 + j - 1]: 0 = n is one slot, else slots of the left child
+  BulkVector<std::uint8_t> node_split;  // n as a wide node: slots of its left child (of 8)
 };
 
-CollapsePlan plan_collapse(const std::vector<BinaryNode>& binary) {
+// A node's plan reads only its two children's costs, and the nodes of a subtree are one
+// index range [i, end) in depth-first order: the subtrees below a size are planned in
+// parallel (one task each, children before parents), then the few nodes above them in
+// decreasing index order. Every cost is computed by the same operations as in one serial
+// sweep, so the plan does not depend on the thread count.
+CollapsePlan plan_collapse(const BulkVector<BinaryNode>& binary, par::Executor& ex) {
   const std::size_t n = binary.size();
   CollapsePlan plan;
-  plan.choice.assign(n * kWideArity, 0);
-  plan.node_split.assign(n, 0);
-  std::vector<float> cost(n * kWideArity, 0.0f);  // leaves cost 0 (the same in every collapse)
-  for (std::size_t i = n; i-- > 0;) {  // children follow their parent in depth-first order
+  plan.choice.resize(n * kWideArity);
+  plan.node_split.resize(n);
+  BulkVector<float> cost(n * kWideArity);  // leaves cost 0 (the same in every collapse)
+  auto plan_node = [&](std::size_t i) {
     const BinaryNode& b = binary[i];
-    if (b.is_leaf()) continue;
+    float* out = &cost[i * kWideArity];
+    std::uint8_t* choice = &plan.choice[i * kWideArity];
+    if (b.is_leaf()) {
+      std::fill_n(out, kWideArity, 0.0f);
+      std::fill_n(choice, kWideArity, std::uint8_t{0});
+      plan.node_split[i] = 0;
+      return;
+    }
     const float* l = &cost[(i + 1) * kWideArity];
     const float* r = &cost[static_cast<std::size_t>(b.right) * kWideArity];
     float split_cost[kWideArity + 1];
@@ -91,17 +106,102 @@ CollapsePlan plan_collapse(const std::vector<BinaryNode>& binary) {
     }
     const float as_node = b.box.half_area() + split_cost[kWideArity];
     plan.node_split[i] = split_left[kWideArity];
-    float* out = &cost[i * kWideArity];
-    std::uint8_t* choice = &plan.choice[i * kWideArity];
     out[0] = as_node;
+    choice[0] = 0;
     for (int j = 2; j <= kWideArity; ++j) {
       const bool dissolve = split_cost[j] < as_node;
       out[j - 1] = dissolve ? split_cost[j] : as_node;
       choice[j - 1] = dissolve ? split_left[j] : 0;
     }
+  };
+  // The end of i's subtree: its last node is reached through right children.
+  auto subtree_end = [&](std::size_t i) {
+    while (!binary[i].is_leaf()) i = binary[i].right;
+    return i + 1;
+  };
+  const std::size_t grain = std::max<std::size_t>(n / 64, 4096);
+  std::vector<std::size_t> top;
+  std::vector<std::pair<std::size_t, std::size_t>> parts;
+  std::vector<std::size_t> stack;
+  if (n > 0) stack.push_back(0);
+  while (!stack.empty()) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    const std::size_t end = subtree_end(i);
+    if (end - i <= grain) {
+      parts.emplace_back(i, end);
+      continue;
+    }
+    top.push_back(i);
+    stack.push_back(binary[i].right);
+    stack.push_back(i + 1);
   }
+  ex.parallel_for("bvh_collapse_plan", parts.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p)
+      for (std::size_t i = parts[p].second; i-- > parts[p].first;) plan_node(i);
+  });
+  std::sort(top.begin(), top.end());
+  for (std::size_t k = top.size(); k-- > 0;) plan_node(top[k]);
   return plan;
 }
+
+// Wide: depth-first allocation, so a child's index is always larger than its parent's.
+void derive_wide(const BulkVector<BinaryNode>& binary, const std::vector<std::uint32_t>& leaf_ref,
+                 const CollapsePlan& plan, BulkVector<WideNode>& wide, std::uint32_t& wide_root) {
+  wide.clear();
+  wide_root = kEmptyChild;
+  if (binary.empty()) return;
+  if (binary[0].is_leaf()) {
+    wide_root = leaf_ref[0];
+    return;
+  }
+  wide.reserve(binary.size() / 2);
+  struct Item {
+    std::uint32_t binary;
+    std::uint32_t parent;  // wide node to patch (kEmptyChild: root)
+    int slot;
+  };
+  std::vector<Item> stack{{0, kEmptyChild, 0}};
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    const auto me = static_cast<std::uint32_t>(wide.size());
+    if (it.parent == kEmptyChild) wide_root = me;
+    else wide[it.parent].child[it.slot] = me;
+    std::uint32_t kids[kWideArity];
+    int count = 0;
+    auto emit = [&](auto&& self, std::uint32_t c, int slots) -> void {
+      const int k = binary[c].is_leaf() ? 0 : plan.choice[c * kWideArity + slots - 1];
+      if (k == 0) {
+        kids[count++] = c;
+        return;
+      }
+      self(self, c + 1, k);
+      self(self, binary[c].right, slots - k);
+    };
+    const int k = plan.node_split[it.binary];
+    emit(emit, it.binary + 1, k);
+    emit(emit, binary[it.binary].right, kWideArity - k);
+    WideNode node;
+    std::memset(&node, 0, sizeof(node));
+    for (int k = 0; k < kWideArity; ++k) {
+      if (k >= count) {
+        node.lo_x[k] = node.lo_y[k] = node.lo_z[k] = 3.0e38f;
+        node.hi_x[k] = node.hi_y[k] = node.hi_z[k] = -3.0e38f;
+        node.child[k] = kEmptyChild;
+        continue;
+      }
+      const BinaryNode& c = binary[kids[k]];
+      node.lo_x[k] = c.box.lo.x; node.lo_y[k] = c.box.lo.y; node.lo_z[k] = c.box.lo.z;
+      node.hi_x[k] = c.box.hi.x; node.hi_y[k] = c.box.hi.y; node.hi_z[k] = c.box.hi.z;
+      node.child[k] = c.is_leaf() ? leaf_ref[kids[k]] : kEmptyChild;  // inner: patched when visited
+    }
+    wide.push_back(node);
+    for (int k = count - 1; k >= 0; --k)
+      if (!binary[kids[k]].is_leaf()) stack.push_back({kids[k], me, k});
+  }
+}
+
 
 }  // namespace
 
@@ -131,67 +231,11 @@ void Bvh::derive_layouts(par::Executor& ex) {
   stats_.triangle_packs = packs_.size();
 
   // The threaded layout and the wide collapse are independent: one task each.
+  const CollapsePlan plan = plan_collapse(binary_, ex);
   ex.parallel_for("bvh_layouts", 2, 1, [&](std::size_t task, std::size_t) {
     if (task == 0) derive_threaded(binary_, threaded_);
-    else derive_wide(leaf_ref);
+    else derive_wide(binary_, leaf_ref, plan, wide_, wide_root_);
   });
-}
-
-// Wide: depth-first allocation, so a child's index is always larger than its parent's.
-void Bvh::derive_wide(const std::vector<std::uint32_t>& leaf_ref) {
-  wide_.clear();
-  wide_root_ = kEmptyChild;
-  if (binary_.empty()) return;
-  if (binary_[0].is_leaf()) {
-    wide_root_ = leaf_ref[0];
-    return;
-  }
-  wide_.reserve(binary_.size() / 2);
-  const CollapsePlan plan = plan_collapse(binary_);
-  struct Item {
-    std::uint32_t binary;
-    std::uint32_t parent;  // wide node to patch (kEmptyChild: root)
-    int slot;
-  };
-  std::vector<Item> stack{{0, kEmptyChild, 0}};
-  while (!stack.empty()) {
-    const Item it = stack.back();
-    stack.pop_back();
-    const auto me = static_cast<std::uint32_t>(wide_.size());
-    if (it.parent == kEmptyChild) wide_root_ = me;
-    else wide_[it.parent].child[it.slot] = me;
-    std::uint32_t kids[kWideArity];
-    int count = 0;
-    auto emit = [&](auto&& self, std::uint32_t c, int slots) -> void {
-      const int k = binary_[c].is_leaf() ? 0 : plan.choice[c * kWideArity + slots - 1];
-      if (k == 0) {
-        kids[count++] = c;
-        return;
-      }
-      self(self, c + 1, k);
-      self(self, binary_[c].right, slots - k);
-    };
-    const int k = plan.node_split[it.binary];
-    emit(emit, it.binary + 1, k);
-    emit(emit, binary_[it.binary].right, kWideArity - k);
-    WideNode node;
-    std::memset(&node, 0, sizeof(node));
-    for (int k = 0; k < kWideArity; ++k) {
-      if (k >= count) {
-        node.lo_x[k] = node.lo_y[k] = node.lo_z[k] = 3.0e38f;
-        node.hi_x[k] = node.hi_y[k] = node.hi_z[k] = -3.0e38f;
-        node.child[k] = kEmptyChild;
-        continue;
-      }
-      const BinaryNode& c = binary_[kids[k]];
-      node.lo_x[k] = c.box.lo.x; node.lo_y[k] = c.box.lo.y; node.lo_z[k] = c.box.lo.z;
-      node.hi_x[k] = c.box.hi.x; node.hi_y[k] = c.box.hi.y; node.hi_z[k] = c.box.hi.z;
-      node.child[k] = c.is_leaf() ? leaf_ref[kids[k]] : kEmptyChild;  // inner: patched when visited
-    }
-    wide_.push_back(node);
-    for (int k = count - 1; k >= 0; --k)
-      if (!binary_[kids[k]].is_leaf()) stack.push_back({kids[k], me, k});
-  }
 }
 
 std::uint64_t Bvh::content_hash() const {

@@ -4,6 +4,14 @@
 // origins and reciprocals bound every ray's computed entry (from below) and exit (from
 // above); a box any ray would enter, the packet enters. Leaves then use each ray's own
 // box test and the watertight pack test, so hits equal closest_hit's bit for bit.
+//
+// Measured on 1M primary rays of the 1.02M-triangle yardstick scene (trace CPU time, one
+// thread, same hits) and not kept: the per-ray leaf kernels in AVX-512 (16 rays in one
+// register, a GCC target region picked at run time) 82-87 ms against 79-80 for the two
+// AVX2 halves, and 87 ms with only the leaf box test in AVX-512; tiles in 16x16-pixel
+// blocks per chunk instead of 64x4 strips 87-89 ms against 77-79; the packet setup's
+// seven divisions and square root per ray in 8-lane registers 80.3 against 80.8; leaf
+// children in near-to-far order 10.79 -> 10.54 triangle tests per ray, time unchanged.
 #include "trace/packet_traversal.h"
 
 #include <immintrin.h>
