@@ -2,8 +2,13 @@
 #include "raster/reflector_maps.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
+
+#include "core/optics.h"
+#include "core/sampling.h"
 
 #include "raster/composite.h"
 #include "raster/direct_light.h"
@@ -42,7 +47,95 @@ float map_lookup_exponent(const Material& material, const SurfaceParams& s) {
   return s.phong_exponent;
 }
 
+// The finest share of a reflector's samples whose need sets its map's side: a few samples
+// on a concave spot or a crease (reflected directions almost equal) do not force the cap on
+// the whole map, while the reflector's smooth bulk is sampled at least as finely as it is
+// seen.
+constexpr double kFootprintQuantile = 0.05;
+
+// Texels per step between neighbouring samples' reflected directions: 2 would be the
+// sampling rate, twice that keeps the bilinear blur of a lookup well under the pixel step
+// (at 2 the exact specular error of a mirror sphere seen at 160×120 grew by 0.5%).
+constexpr float kTexelsPerSampleStep = 4.0f;
+
+// Half-power angle of a Phong lobe of exponent n (cos^n θ = 1/2, small-angle form).
+float lobe_half_power_angle(float n) { return std::sqrt(2.0f * 0.69314718f / std::max(n, 1e-6f)); }
+
+// The coarsest texel angle camera sample i can use without losing what the frame shows,
+// or NaN when i reads no map or has no neighbour on its object. Samples sit one pixel
+// apart; their reflected directions R differ by δ (the chord, at most the angle), and a
+// texel of δ / kTexelsPerSampleStep keeps that many texels per sample step. A glossy lookup reads the map blurred by
+// its lobe; the widest read is distance-map's sub-lobe of exponent 4n (distance_map_reflect.cpp),
+// half the lobe's angle, and a texel of a quarter of that keeps its read level at 1 or above
+// (prefiltered, as with the full-size map) — the coarser of the two is enough.
+float sample_need(const GBuffer& g, std::size_t i) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (!g.covered(i)) return nan;
+  const SurfaceParams& s = g.surface.pixels[i];
+  if (!is_specular(s) || s.is_refractor()) return nan;
+  const std::uint32_t object = g.object.pixels[i];
+  const auto reflected = [&](std::size_t j) { return reflect(-g.view_direction(j), g.normal.pixels[j]); };
+  const glm::vec3 r = reflected(i);
+  const std::size_t w = static_cast<std::size_t>(g.width);
+  const std::size_t x = i % w, y = i / w;
+  float delta = std::numeric_limits<float>::infinity();
+  const auto neighbour = [&](std::size_t j) {
+    if (g.object.pixels[j] != object || !is_specular(g.surface.pixels[j])) return;
+    delta = std::min(delta, glm::length(reflected(j) - r));
+  };
+  if (x + 1 < w) neighbour(i + 1);
+  if (x > 0) neighbour(i - 1);
+  if (y + 1 < static_cast<std::size_t>(g.height)) neighbour(i + w);
+  if (y > 0) neighbour(i - w);
+  if (!std::isfinite(delta)) return nan;
+  float need = delta / kTexelsPerSampleStep;
+  if (!s.is_mirror_lobe() && s.phong_exponent > 0.0f && s.phong_exponent < 1e6f)
+    need = std::max(need, 0.25f * lobe_half_power_angle(4.0f * s.phong_exponent));
+  return need;
+}
+
 }  // namespace
+
+std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, const GBuffer& g, int size) {
+  std::vector<int> sizes(scene.objects.size(), 0);
+  std::vector<float> need(g.object.size());
+  executor.parallel_for("reflector_cube_maps.footprint", need.size(), 4096,
+                        [&](std::size_t begin, std::size_t end) {
+                          for (std::size_t i = begin; i < end; ++i) need[i] = sample_need(g, i);
+                        });
+  // Per object, in sample order (serial: the lists and their quantiles do not depend on the
+  // thread count).
+  std::vector<std::vector<float>> per_object(scene.objects.size());
+  std::vector<std::uint8_t> seen(scene.objects.size(), 0);
+  for (std::size_t i = 0; i < need.size(); ++i) {
+    if (!g.covered(i)) continue;
+    const std::uint32_t o = g.object.pixels[i];
+    if (o >= scene.objects.size()) continue;
+    const SurfaceParams& s = g.surface.pixels[i];
+    if (!is_specular(s)) continue;
+    seen[o] = 1;
+    // A refractor's sample, or a specular sample with no neighbour on its object: need 0
+    // (the cap) for refractors; a lone sample is no evidence either way and is left out.
+    if (s.is_refractor()) per_object[o].push_back(0.0f);
+    else if (!std::isnan(need[i])) per_object[o].push_back(need[i]);
+  }
+  constexpr float kTexelAngleTimesSize = 0.5f * kPi;  // texel angle of a side-s face: (π/2)/s
+  for (std::size_t o = 0; o < per_object.size(); ++o) {
+    if (!seen[o]) continue;
+    std::vector<float>& v = per_object[o];
+    if (v.empty()) {
+      sizes[o] = size;
+      continue;
+    }
+    const std::size_t k = static_cast<std::size_t>(kFootprintQuantile * double(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    const float q = v[k];
+    int side = kMinFootprintSize;
+    while (side < size && !(kTexelAngleTimesSize / static_cast<float>(side) <= q)) side *= 2;
+    sizes[o] = std::min(side, size);
+  }
+  return sizes;
+}
 
 const char* to_string(ReflectorSelection which) {
   switch (which) {
@@ -56,9 +149,13 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size,
                                     const GBuffer* camera_view, ReflectorSelection which,
-                                    const FaceLight& add_light, const std::vector<std::uint8_t>* skip) {
+                                    const FaceLight& add_light, const std::vector<std::uint8_t>* skip,
+                                    const MapSizing& sizing) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
+  std::vector<int> sizes;
+  if (camera_view && (sizing.from_footprint || sizing.skip_unseen))
+    sizes = footprint_sizes(executor, scene, *camera_view, size);
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   const TriangleMesh& m = scene.mesh;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
@@ -82,6 +179,11 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     if (which == ReflectorSelection::not_planar_mirrors && planar_mirror_plane(scene, static_cast<std::uint32_t>(o)))
       continue;
     if (which == ReflectorSelection::refractors && !refracts) continue;
+    int side = size;
+    if (!sizes.empty()) {
+      if (sizing.skip_unseen && sizes[o] == 0) continue;
+      if (sizing.from_footprint && sizes[o] > 0) side = sizes[o];
+    }
     glm::vec3 centre = b.center();
     const glm::vec3 e = b.extent();
     const float smallest = std::min({e.x, e.y, e.z}), largest = std::max({e.x, e.y, e.z});
@@ -90,7 +192,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
         visible_centroid(*camera_view, static_cast<std::uint32_t>(o), seen, normal))
       centre = seen + normal * (0.01f * glm::length(e));
     CubeMapOptions opt;
-    opt.size = size;
+    opt.size = side;
     opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
@@ -104,7 +206,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
     out.maps.push_back(environment_from_faces(executor, cube.colour, false,
-                                              levels_for_lobes(size, widest_lobe)));
+                                              levels_for_lobes(side, widest_lobe)));
     out.cubes.push_back(std::move(cube));
     out.centres.push_back(centre);
   }
@@ -115,8 +217,11 @@ ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const Shado
                                                 const EnvironmentMap& environment,
                                                 const GBuffer& gbuffer) const {
   ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
-                                             which);
+                                             which, {}, nullptr, sizing);
   c.count("cube_maps", maps.cubes.size());
+  double texels = 0.0;
+  for (const CubeMap& cube : maps.cubes) texels += double(kCubeFaces) * cube.size * cube.size;
+  c.count("cube_texels", texels);
   return maps;
 }
 

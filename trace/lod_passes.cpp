@@ -27,7 +27,7 @@ TriangleLightingPtr RadianceBakePass::operator()(par::NodeContext& c, const BvhP
 LodBvhPtr LodBuildPass::operator()(par::NodeContext& c, const BvhPtr& bvh,
                                    const TriangleLightingPtr& lighting) const {
   LodBvhPtr lod = cache ? cache->lod : nullptr;
-  if (!lod) lod = std::make_shared<const LodBvh>(build_lod_bvh(*bvh, lighting->radiance));
+  if (!lod) lod = std::make_shared<const LodBvh>(build_lod_bvh(*bvh, lighting->radiance, &c.executor()));
   else c.count("cached");
   if (cache) cache->lod = lod;
   return lod;

@@ -9,6 +9,7 @@
 #include "apps/techniques/frame_settings.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
+#include "raster/reflector_maps.h"
 #include "raster/shadow_map.h"
 #include "raster/visibility.h"
 
@@ -33,6 +34,12 @@ struct SurfaceResources {
 SurfaceResources add_surface_passes(par::Graph& graph, const Scene* scene,
                                     const FrameSettings& settings,
                                     const SurfacePassNotes& notes = {});
+
+// The reflector maps of a technique whose maps only the camera's samples read: none for
+// reflectors the camera does not see, and with `by_direction` (the maps are looked up along
+// a direction, envmap_reflect) each sized from its reflector's footprint in the G-buffer
+// (raster/reflector_maps.h MapSizing).
+inline raster::MapSizing camera_read_maps(bool by_direction) { return {by_direction, true}; }
 
 // composite (direct + specular) → resolve (k×k) → tonemap.
 FrameOutputs add_output_passes(par::Graph& graph, const FrameSettings& settings,
