@@ -91,8 +91,9 @@ void fill_proxy(const Bvh& bvh, const std::vector<glm::vec3>& triangle_radiance,
   }
   node.coverage = coverage;
   if (node.texels == kNoTexels) return;
-  for (int c = 0; c < kTexels; ++c)
+  for (int c = 0; c < kTexels; ++c) {
     lod.proxy_texels[node.texels + c] = weight[c] > 0.0 ? glm::vec3(sum[c] / weight[c]) : node.radiance;
+  }
 }
 
 // Every inner quad proxy gets its coverage; those over at least kProxyGrid² triangles get a
@@ -126,21 +127,24 @@ bool LodBvh::proxy_covers(const LodNode& n, float s, float t) {
   return (n.coverage >> (grid_cell(s) + kProxyGrid * grid_cell(t))) & 1u;
 }
 
-glm::vec3 LodBvh::proxy_radiance(std::uint32_t node, float s, float t) const {
-  const LodNode& n = nodes[node];
-  if (n.texels == kNoTexels) return n.radiance;
+namespace {
+
+// Bilinear over the covered texels' centres of a textured proxy (weights renormalized over
+// them); a covered texel whose bilinear neighbours carry no weight reads itself.
+template <class T>
+T covered_bilinear(const LodNode& n, const std::vector<T>& texels, float s, float t) {
   // Texel centres sit at (x + ½)/kProxyGrid: the four around (s, t), clamped at the border.
   const float fx = std::clamp(s * kProxyGrid - 0.5f, 0.0f, float(kProxyGrid - 1));
   const float fy = std::clamp(t * kProxyGrid - 0.5f, 0.0f, float(kProxyGrid - 1));
   const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   const int x1 = std::min(x0 + 1, kProxyGrid - 1), y1 = std::min(y0 + 1, kProxyGrid - 1);
   const float tx = fx - x0, ty = fy - y0;
-  glm::vec3 sum(0.0f);
+  T sum{};
   float total = 0.0f;
   const auto tap = [&](int x, int y, float w) {
     const int c = x + kProxyGrid * y;
     if (!((n.coverage >> c) & 1u) || !(w > 0.0f)) return;
-    sum += w * proxy_texels[n.texels + c];
+    sum += w * texels[n.texels + c];
     total += w;
   };
   tap(x0, y0, (1.0f - tx) * (1.0f - ty));
@@ -148,8 +152,15 @@ glm::vec3 LodBvh::proxy_radiance(std::uint32_t node, float s, float t) const {
   tap(x0, y1, (1.0f - tx) * ty);
   tap(x1, y1, tx * ty);
   if (total > 0.0f) return sum / total;
-  // (s, t) in a covered texel whose bilinear neighbours carry no weight: the texel itself.
-  return proxy_texels[n.texels + grid_cell(s) + kProxyGrid * grid_cell(t)];
+  return texels[n.texels + grid_cell(s) + kProxyGrid * grid_cell(t)];
+}
+
+}  // namespace
+
+glm::vec3 LodBvh::proxy_radiance(std::uint32_t node, float s, float t) const {
+  const LodNode& n = nodes[node];
+  if (n.texels == kNoTexels) return n.radiance;
+  return covered_bilinear(n, proxy_texels, s, t);
 }
 
 LodBvh build_lod_bvh(const Bvh& bvh, const std::vector<glm::vec3>& triangle_radiance,
