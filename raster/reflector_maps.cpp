@@ -2,6 +2,7 @@
 #include "raster/reflector_maps.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -94,7 +95,93 @@ float sample_need(const GBuffer& g, std::size_t i) {
   return need;
 }
 
+// Faces within angle `margin` of unit direction p. Face f (axis k, sign σ) holds the
+// directions with σ p_k ≥ |p_j| for j ≠ k; a direction within `margin` of it is at most
+// `margin` (as a chord, at most the angle) outside each of the four bounding great circles
+// (unit normals (σ e_k ∓ e_j)/√2): a superset test, so no face that is read is left out.
+unsigned faces_near(const glm::vec3& p, float margin) {
+  const float slack = 1.4142136f * margin;
+  unsigned mask = 0;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const int k = f / 2;
+    const float along = (f % 2 == 0 ? 1.0f : -1.0f) * p[k];
+    bool near = true;
+    for (int j = 0; j < 3 && near; ++j)
+      if (j != k) near = along - std::fabs(p[j]) >= -slack;
+    if (near) mask |= 1u << f;
+  }
+  return mask;
+}
+
+// Faces within `margin` of the great-circle arc from unit a to unit b: points along it at
+// most 0.1 rad apart, each tested with the margin grown by half a step (every point of the
+// arc is that close to one of them). Nearly opposite ends have no one arc: every face.
+unsigned faces_near_arc(const glm::vec3& a, const glm::vec3& b, float margin) {
+  const float angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+  if (!(angle < kPi - 0.05f)) return 0x3fu;
+  const int steps = std::max(1, static_cast<int>(std::ceil(angle / 0.1f)));
+  const float step = angle / static_cast<float>(steps);
+  const float sin_angle = std::sin(angle);
+  unsigned mask = 0;
+  for (int i = 0; i <= steps; ++i) {
+    const float u = static_cast<float>(i) / static_cast<float>(steps);
+    const glm::vec3 p = sin_angle > 1e-6f ? glm::normalize((std::sin((1.0f - u) * angle) * a + std::sin(u * angle) * b) / sin_angle)
+                                          : a;
+    mask |= faces_near(p, margin + 0.5f * step + 1e-3f);
+  }
+  return mask;
+}
+
+// The widest of `count` Hamersley directions of a Phong lobe of exponent n about its axis
+// (sample_phong_lobe: u.x = (count−1)/count gives cos θ = (1/count)^(1/(n+1))).
+float widest_lobe_sample(int count, float n) {
+  return std::acos(std::pow(1.0f / static_cast<float>(count), 1.0f / (n + 1.0f)));
+}
+
 }  // namespace
+
+unsigned faces_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
+                    const glm::vec3& centre, int size, int level_count, const MapSizing& sizing) {
+  if (sizing.reads == MapSizing::Reads::anywhere) return 0x3fu;
+  // distance_map_reflect searches a glossy lobe along sub-lobes below this exponent.
+  constexpr float kGlossySearchExponent = 1e4f;
+  constexpr std::size_t kChunk = 1024;
+  std::vector<unsigned> per_chunk((samples.size() + kChunk - 1) / kChunk, 0u);
+  executor.parallel_for("reflector_cube_maps.faces", samples.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    unsigned mask = 0;
+    for (std::size_t k = begin; k < end && mask != 0x3fu; ++k) {
+      const std::size_t i = samples[k];
+      const SurfaceParams& s = g.surface.pixels[i];
+      if (!is_specular(s)) continue;
+      if (s.is_refractor()) {
+        mask = 0x3fu;
+        break;
+      }
+      // specular_radiance's lookup: along R with the material's exponent.
+      const glm::vec3 r = glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i]));
+      const float exponent = s.phong_exponent;
+      if (sizing.reads == MapSizing::Reads::direction) {
+        mask |= faces_near(r, std::max(lookup_reach(size, level_count, exponent), 1e-3f));
+        continue;
+      }
+      // A search reads distances and colour along the directions from the centre to the
+      // points x + t d of its ray (t ≥ 0): the arc from x − o to d. A glossy lobe is searched
+      // along sub-lobes (exponent 4n/3 about R, each read at 4n): their arcs lie within the
+      // widest sub-lobe direction's angle of R's.
+      float margin = std::max(lookup_reach(size, level_count, exponent), 1e-3f);
+      if (sizing.lobe_directions > 1 && exponent < kGlossySearchExponent)
+        margin = std::max(lookup_reach(size, level_count, 4.0f * exponent), 1e-3f) +
+                 widest_lobe_sample(sizing.lobe_directions, exponent * (4.0f / 3.0f)) + 0.02f;
+      const glm::vec3 from = g.position.pixels[i] - centre;
+      const float from_length = glm::length(from);
+      mask |= from_length > 0.0f ? faces_near_arc(from / from_length, r, margin) : faces_near(r, margin);
+    }
+    per_chunk[begin / kChunk] = mask;
+  });
+  unsigned mask = 0;
+  for (const unsigned m : per_chunk) mask |= m;
+  return mask;
+}
 
 std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, const GBuffer& g, int size) {
   std::vector<int> sizes(scene.objects.size(), 0);
@@ -156,6 +243,15 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
   std::vector<int> sizes;
   if (camera_view && (sizing.from_footprint || sizing.skip_unseen))
     sizes = footprint_sizes(executor, scene, *camera_view, size);
+  // Each object's camera samples, in sample order, for the faces its readers reach.
+  std::vector<std::vector<std::uint32_t>> samples_of;
+  if (camera_view && sizing.reads != MapSizing::Reads::anywhere) {
+    samples_of.resize(scene.objects.size());
+    for (std::size_t i = 0; i < camera_view->object.size(); ++i) {
+      const std::uint32_t object = camera_view->object.pixels[i];
+      if (object < samples_of.size()) samples_of[object].push_back(static_cast<std::uint32_t>(i));
+    }
+  }
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   const TriangleMesh& m = scene.mesh;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
@@ -191,8 +287,11 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     if (camera_view && smallest < 0.05f * largest &&
         visible_centroid(*camera_view, static_cast<std::uint32_t>(o), seen, normal))
       centre = seen + normal * (0.01f * glm::length(e));
+    const int levels = levels_for_lobes(side, widest_lobe);
     CubeMapOptions opt;
     opt.size = side;
+    if (!samples_of.empty())
+      opt.face_mask = faces_read(executor, *camera_view, samples_of[o], centre, side, levels, sizing);
     opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
@@ -205,12 +304,20 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
           return composite(executor, direct, envmap_reflect(executor, g, env));
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
-    out.maps.push_back(environment_from_faces(executor, cube.colour, false,
-                                              levels_for_lobes(side, widest_lobe)));
+    out.maps.push_back(environment_from_faces(executor, cube.colour, false, levels, opt.face_mask));
     out.cubes.push_back(std::move(cube));
     out.centres.push_back(centre);
+    out.faces.push_back(opt.face_mask);
   }
   return out;
+}
+
+double rendered_texels(const ReflectorMaps& maps) {
+  double texels = 0.0;
+  for (std::size_t m = 0; m < maps.cubes.size(); ++m)
+    texels += double(m < maps.faces.size() ? std::popcount(maps.faces[m]) : kCubeFaces) * maps.cubes[m].size *
+              maps.cubes[m].size;
+  return texels;
 }
 
 ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
@@ -219,9 +326,7 @@ ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const Shado
   ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
                                              which, {}, nullptr, sizing);
   c.count("cube_maps", maps.cubes.size());
-  double texels = 0.0;
-  for (const CubeMap& cube : maps.cubes) texels += double(kCubeFaces) * cube.size * cube.size;
-  c.count("cube_texels", texels);
+  c.count("cube_texels", rendered_texels(maps));
   return maps;
 }
 

@@ -25,6 +25,7 @@ struct ReflectorMaps {
   std::vector<CubeMap> cubes;         // colour + distance, as rendered
   std::vector<EnvironmentMap> maps;   // the same colour, prefiltered for lookups
   std::vector<glm::vec3> centres;     // reference point o of each map
+  std::vector<unsigned> faces;        // bit f: face f rendered (the others black, never read)
   const EnvironmentMap* for_object(std::uint32_t object) const {
     if (object >= map_of_object.size() || map_of_object[object] < 0) return nullptr;
     return &maps[map_of_object[object]];
@@ -49,7 +50,19 @@ struct MapSizing {
   bool from_footprint = false;
   // Reflectors with no camera sample get no map: nothing would read it.
   bool skip_unseen = false;
+  // How the camera's samples read a reflector's map; unless `anywhere`, faces that no read
+  // comes near (lookup_reach of its lobe, and for a search every direction from the map's
+  // centre to the points of its ray) are not rendered or prefiltered. Refractors' maps keep
+  // every face.
+  enum class Reads { anywhere, direction, search } reads = Reads::anywhere;
+  int lobe_directions = 8;  // search: sub-lobe searches per glossy lobe (distance_map_reflect)
 };
+
+// Bit f set: face f of a map centred at `centre` is read by the camera samples `samples` of
+// one reflector (G-buffer indices) under `sizing.reads`, on a map of side `size` with
+// `level_count` levels; exposed for tests.
+unsigned faces_read(par::Executor& executor, const GBuffer& camera_view, const std::vector<std::uint32_t>& samples,
+                    const glm::vec3& centre, int size, int level_count, const MapSizing& sizing);
 constexpr int kMinFootprintSize = 16;
 
 // The side render_reflector_maps gives each object under `from_footprint` (0: the object
@@ -77,6 +90,9 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<std::uint8_t>* skip = nullptr,
                                     const MapSizing& sizing = {});
 
+// Texels rendered: the faces each map has, times their side squared.
+double rendered_texels(const ReflectorMaps& maps);
+
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {
   static constexpr const char* description =
@@ -91,6 +107,8 @@ struct ReflectorCubeMapsPass {
     p.set("reflectors", to_string(which));
     p.set("footprint_size", sizing.from_footprint ? 1 : 0);
     p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
+    p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all"
+                   : sizing.reads == MapSizing::Reads::direction ? "read along R" : "read by searches");
   }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows,
                            const EnvironmentMap& environment, const GBuffer& gbuffer) const;
