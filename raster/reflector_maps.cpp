@@ -65,10 +65,11 @@ float lobe_half_power_angle(float n) { return std::sqrt(2.0f * 0.69314718f / std
 // The coarsest texel angle camera sample i can use without losing what the frame shows,
 // or NaN when i reads no map or has no neighbour on its object. Samples sit one pixel
 // apart; their reflected directions R differ by δ (the chord, at most the angle), and a
-// texel of δ / kTexelsPerSampleStep keeps that many texels per sample step. A glossy lookup reads the map blurred by
-// its lobe; the widest read is distance-map's sub-lobe of exponent 4n (distance_map_reflect.cpp),
-// half the lobe's angle, and a texel of a quarter of that keeps its read level at 1 or above
-// (prefiltered, as with the full-size map) — the coarser of the two is enough.
+// texel of δ / kTexelsPerSampleStep keeps that many texels per sample step. A glossy lookup
+// reads the map blurred by its lobe; the sharpest read is distance-map's sub-lobe of exponent
+// 4n (distance_map_reflect.cpp), half the lobe's angle, and a texel of a quarter of that
+// keeps every read at level 2 or above (prefiltered, as with the full-size map) — the coarser
+// of the two is enough.
 float sample_need(const GBuffer& g, std::size_t i) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   if (!g.covered(i)) return nan;

@@ -40,9 +40,10 @@ const char* to_string(ReflectorSelection which);
 struct MapSizing {
   // A reflector's side is the cap `size` or less: the smallest power of two (at least
   // kMinFootprintSize) whose texels are finer than a quarter of the angle between the
-  // reflected directions of neighbouring camera samples, or than a quarter of the glossy
-  // lobe's when that is wider — the map holds what the frame can show, and a map read only
-  // through prefiltered levels (glossy) is not rendered finer than its finest read level.
+  // reflected directions of neighbouring camera samples, or than an eighth of the glossy
+  // lobe's half-power angle when that is coarser — the map holds what the frame can show,
+  // and a glossy map, read only through prefiltered levels, is not rendered much finer than
+  // the finest level it is read at. The 5 % finest samples of a reflector decide.
   // Only for maps read along a direction (envmap_reflect): a distance-map search reads
   // distances at the points its rays pass, which the reflected directions' rate does not
   // bound (at 160×120 the mirror ball of sphere-in-room: exact specular mae8 4.76 → 7.11). Refractors
