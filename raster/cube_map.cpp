@@ -109,6 +109,11 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
   cube.size = options.size;
   cube.centre = centre;
   for (int face = 0; face < kCubeFaces; ++face) {
+    if (!((options.face_mask >> face) & 1u)) {
+      cube.distance[face] = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
+      if (shade) cube.colour[face] = ImageRGBA(options.size, options.size, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+      continue;
+    }
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
     const VisibilityBuffer vis =
         render_visibility(executor, scene, cam, options.size, options.size, options.raster);

@@ -67,6 +67,9 @@ struct CubeMapOptions {
   float znear = 0.01f;
   float zfar = 1000.0f;
   RasterOptions raster;  // e.g. excluded_objects: leave the reflector out of its own map
+  // Bit f: render face f. The others are left black with distance +inf, for a map whose
+  // readers provably never look there (reflector_maps.h MapSizing::cull_faces).
+  unsigned face_mask = 0x3fu;
 
   void set_depth_range(const CubeDepthRange& range) {
     znear = range.znear;

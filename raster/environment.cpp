@@ -77,7 +77,7 @@ EnvironmentMap build_environment(par::Executor& executor, const Environment& env
 
 EnvironmentMap environment_from_faces(par::Executor& executor,
                                       std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
-                                      int level_count) {
+                                      int level_count, unsigned face_mask) {
   EnvironmentMap map;
   const int size = faces[0].width;
   map.size = size;
@@ -97,6 +97,7 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
     for (int face = 0; face < kCubeFaces; ++face) {
       ImageRGBA& img = map.levels[l][face];
       img = ImageRGBA(s, s);
+      if (!((face_mask >> face) & 1u)) continue;
       executor.parallel_for("environment.prefilter", img.size(), 256,
                             [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
@@ -149,6 +150,24 @@ int levels_for_lobes(int size, float min_phong_exponent) {
   if (!(level < float(all))) return all;
   const int whole = static_cast<int>(level);
   return std::min(all, whole + (level > float(whole) ? 2 : 1));
+}
+
+float lookup_reach(int size, int level_count, float phong_exponent) {
+  const int last = std::max(level_count, 1) - 1;
+  const int read = std::min(last, static_cast<int>(lobe_level(size, phong_exponent)) + 1);
+  // Within a face the bilinear taps are under a texel's diagonal away: 2√2 / side radians
+  // bounds it (a texel is 2/side wide on the unit-distance face plane).
+  const auto texel_reach = [&](int l) { return 2.0f * 1.4142136f / static_cast<float>(std::max(1, size >> l)); };
+  float reach = texel_reach(read);
+  for (int l = 1; l <= read; ++l) {
+    // The cascade's step l (environment_from_faces): its widest sample is the Hamersley
+    // point u.x = (N−1)/N, at cos θ = (1/N)^(1/(n+1)).
+    const float target = texel_angle(std::max(1, size >> l));
+    const float previous = l == 1 ? 0.0f : texel_angle(std::max(1, size >> (l - 1)));
+    const float step_exponent = lobe_exponent(std::sqrt(target * target - previous * previous));
+    reach += std::acos(std::pow(1.0f / kPrefilterSamples, 1.0f / (step_exponent + 1.0f))) + texel_reach(l - 1);
+  }
+  return reach;
 }
 
 glm::vec3 EnvironmentMap::radiance(const glm::vec3& d, float phong_exponent) const {

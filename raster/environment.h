@@ -33,9 +33,17 @@ struct EnvironmentMap {
 // Mip levels and glossy prefiltering of given level-0 faces (e.g. a rendered cube map's
 // colour, for the dynamic environment maps of SURVEY §3.1); SH only when asked. level_count
 // > 0 keeps only the finest level_count levels (see levels_for_lobes); 0 builds all.
+// `face_mask` (bit f: face f) limits the prefiltering to those faces; the others' coarser
+// levels stay black (for a map whose other faces nothing reads: lookup_reach).
 EnvironmentMap environment_from_faces(par::Executor& executor,
                                       std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
-                                      int level_count = 0);
+                                      int level_count = 0, unsigned face_mask = 0x3fu);
+
+// An angle around d within which every level-0 texel lies that radiance(d, n) on a map of
+// side `size` with `level_count` levels depends on: the bilinear taps of the levels it reads
+// and, below them, the widest sample of every prefiltering step of the cascade (plus one
+// texel's diagonal per level). A face no lookup comes that close to is never read.
+float lookup_reach(int size, int level_count, float phong_exponent);
 
 // How many levels (finest first) EnvironmentMap::radiance can read on a map of side `size`
 // for lobes of exponent ≥ min_phong_exponent (≥ 1e6: mirror, level 0 only; ≤ 0: all of

@@ -16,6 +16,7 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
   ReflectorMaps next;
   next.map_of_object = current.map_of_object;
   next.centres = current.centres;
+  next.faces = current.faces;
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   // Reflectors seen in a cube face are a few texels wide: one search along each lobe's axis.
   DistanceSearchOptions face_search = options;

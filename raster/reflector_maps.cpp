@@ -2,8 +2,14 @@
 #include "raster/reflector_maps.h"
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
+
+#include "core/optics.h"
+#include "core/sampling.h"
 
 #include "raster/composite.h"
 #include "raster/direct_light.h"
@@ -42,7 +48,182 @@ float map_lookup_exponent(const Material& material, const SurfaceParams& s) {
   return s.phong_exponent;
 }
 
+// The finest share of a reflector's samples whose need sets its map's side: a few samples
+// on a concave spot or a crease (reflected directions almost equal) do not force the cap on
+// the whole map, while the reflector's smooth bulk is sampled at least as finely as it is
+// seen.
+constexpr double kFootprintQuantile = 0.05;
+
+// Texels per step between neighbouring samples' reflected directions: 2 would be the
+// sampling rate, twice that keeps the bilinear blur of a lookup well under the pixel step
+// (at 2 the exact specular error of a mirror sphere seen at 160×120 grew by 0.5%).
+constexpr float kTexelsPerSampleStep = 4.0f;
+
+// Half-power angle of a Phong lobe of exponent n (cos^n θ = 1/2, small-angle form).
+float lobe_half_power_angle(float n) { return std::sqrt(2.0f * 0.69314718f / std::max(n, 1e-6f)); }
+
+// The coarsest texel angle camera sample i can use without losing what the frame shows,
+// or NaN when i reads no map or has no neighbour on its object. Samples sit one pixel
+// apart; their reflected directions R differ by δ (the chord, at most the angle), and a
+// texel of δ / kTexelsPerSampleStep keeps that many texels per sample step. A glossy lookup
+// reads the map blurred by its lobe; the sharpest read is distance-map's sub-lobe of exponent
+// 4n (distance_map_reflect.cpp), half the lobe's angle, and a texel of a quarter of that
+// keeps every read at level 2 or above (prefiltered, as with the full-size map) — the coarser
+// of the two is enough.
+float sample_need(const GBuffer& g, std::size_t i) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (!g.covered(i)) return nan;
+  const SurfaceParams& s = g.surface.pixels[i];
+  if (!is_specular(s) || s.is_refractor()) return nan;
+  const std::uint32_t object = g.object.pixels[i];
+  const auto reflected = [&](std::size_t j) { return reflect(-g.view_direction(j), g.normal.pixels[j]); };
+  const glm::vec3 r = reflected(i);
+  const std::size_t w = static_cast<std::size_t>(g.width);
+  const std::size_t x = i % w, y = i / w;
+  float delta = std::numeric_limits<float>::infinity();
+  const auto neighbour = [&](std::size_t j) {
+    if (g.object.pixels[j] != object || !is_specular(g.surface.pixels[j])) return;
+    delta = std::min(delta, glm::length(reflected(j) - r));
+  };
+  if (x + 1 < w) neighbour(i + 1);
+  if (x > 0) neighbour(i - 1);
+  if (y + 1 < static_cast<std::size_t>(g.height)) neighbour(i + w);
+  if (y > 0) neighbour(i - w);
+  if (!std::isfinite(delta)) return nan;
+  float need = delta / kTexelsPerSampleStep;
+  if (!s.is_mirror_lobe() && s.phong_exponent > 0.0f && s.phong_exponent < 1e6f)
+    need = std::max(need, 0.25f * lobe_half_power_angle(4.0f * s.phong_exponent));
+  return need;
+}
+
+// Faces within angle `margin` of unit direction p. Face f (axis k, sign σ) holds the
+// directions with σ p_k ≥ |p_j| for j ≠ k; a direction within `margin` of it is at most
+// `margin` (as a chord, at most the angle) outside each of the four bounding great circles
+// (unit normals (σ e_k ∓ e_j)/√2): a superset test, so no face that is read is left out.
+unsigned faces_near(const glm::vec3& p, float margin) {
+  const float slack = 1.4142136f * margin;
+  unsigned mask = 0;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const int k = f / 2;
+    const float along = (f % 2 == 0 ? 1.0f : -1.0f) * p[k];
+    bool near = true;
+    for (int j = 0; j < 3 && near; ++j)
+      if (j != k) near = along - std::fabs(p[j]) >= -slack;
+    if (near) mask |= 1u << f;
+  }
+  return mask;
+}
+
+// Faces within `margin` of the great-circle arc from unit a to unit b: points along it at
+// most 0.1 rad apart, each tested with the margin grown by half a step (every point of the
+// arc is that close to one of them). Nearly opposite ends have no one arc: every face.
+unsigned faces_near_arc(const glm::vec3& a, const glm::vec3& b, float margin) {
+  const float angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+  if (!(angle < kPi - 0.05f)) return 0x3fu;
+  const int steps = std::max(1, static_cast<int>(std::ceil(angle / 0.1f)));
+  const float step = angle / static_cast<float>(steps);
+  const float sin_angle = std::sin(angle);
+  unsigned mask = 0;
+  for (int i = 0; i <= steps; ++i) {
+    const float u = static_cast<float>(i) / static_cast<float>(steps);
+    const glm::vec3 p = sin_angle > 1e-6f ? glm::normalize((std::sin((1.0f - u) * angle) * a + std::sin(u * angle) * b) / sin_angle)
+                                          : a;
+    mask |= faces_near(p, margin + 0.5f * step + 1e-3f);
+  }
+  return mask;
+}
+
+// The widest of `count` Hamersley directions of a Phong lobe of exponent n about its axis
+// (sample_phong_lobe: u.x = (count−1)/count gives cos θ = (1/count)^(1/(n+1))).
+float widest_lobe_sample(int count, float n) {
+  return std::acos(std::pow(1.0f / static_cast<float>(count), 1.0f / (n + 1.0f)));
+}
+
 }  // namespace
+
+unsigned faces_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
+                    const glm::vec3& centre, int size, int level_count, const MapSizing& sizing) {
+  if (sizing.reads == MapSizing::Reads::anywhere) return 0x3fu;
+  // distance_map_reflect searches a glossy lobe along sub-lobes below this exponent.
+  constexpr float kGlossySearchExponent = 1e4f;
+  constexpr std::size_t kChunk = 1024;
+  std::vector<unsigned> per_chunk((samples.size() + kChunk - 1) / kChunk, 0u);
+  executor.parallel_for("reflector_cube_maps.faces", samples.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    unsigned mask = 0;
+    for (std::size_t k = begin; k < end && mask != 0x3fu; ++k) {
+      const std::size_t i = samples[k];
+      const SurfaceParams& s = g.surface.pixels[i];
+      if (!is_specular(s)) continue;
+      if (s.is_refractor()) {
+        mask = 0x3fu;
+        break;
+      }
+      // specular_radiance's lookup: along R with the material's exponent.
+      const glm::vec3 r = glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i]));
+      const float exponent = s.phong_exponent;
+      if (sizing.reads == MapSizing::Reads::direction) {
+        mask |= faces_near(r, std::max(lookup_reach(size, level_count, exponent), 1e-3f));
+        continue;
+      }
+      // A search reads distances and colour along the directions from the centre to the
+      // points x + t d of its ray (t ≥ 0): the arc from x − o to d. A glossy lobe is searched
+      // along sub-lobes (exponent 4n/3 about R, each read at 4n): their arcs lie within the
+      // widest sub-lobe direction's angle of R's.
+      float margin = std::max(lookup_reach(size, level_count, exponent), 1e-3f);
+      if (sizing.lobe_directions > 1 && exponent < kGlossySearchExponent)
+        margin = std::max(lookup_reach(size, level_count, 4.0f * exponent), 1e-3f) +
+                 widest_lobe_sample(sizing.lobe_directions, exponent * (4.0f / 3.0f)) + 0.02f;
+      const glm::vec3 from = g.position.pixels[i] - centre;
+      const float from_length = glm::length(from);
+      mask |= from_length > 0.0f ? faces_near_arc(from / from_length, r, margin) : faces_near(r, margin);
+    }
+    per_chunk[begin / kChunk] = mask;
+  });
+  unsigned mask = 0;
+  for (const unsigned m : per_chunk) mask |= m;
+  return mask;
+}
+
+std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, const GBuffer& g, int size) {
+  std::vector<int> sizes(scene.objects.size(), 0);
+  std::vector<float> need(g.object.size());
+  executor.parallel_for("reflector_cube_maps.footprint", need.size(), 4096,
+                        [&](std::size_t begin, std::size_t end) {
+                          for (std::size_t i = begin; i < end; ++i) need[i] = sample_need(g, i);
+                        });
+  // Per object, in sample order (serial: the lists and their quantiles do not depend on the
+  // thread count).
+  std::vector<std::vector<float>> per_object(scene.objects.size());
+  std::vector<std::uint8_t> seen(scene.objects.size(), 0);
+  for (std::size_t i = 0; i < need.size(); ++i) {
+    if (!g.covered(i)) continue;
+    const std::uint32_t o = g.object.pixels[i];
+    if (o >= scene.objects.size()) continue;
+    const SurfaceParams& s = g.surface.pixels[i];
+    if (!is_specular(s)) continue;
+    seen[o] = 1;
+    // A refractor's sample, or a specular sample with no neighbour on its object: need 0
+    // (the cap) for refractors; a lone sample is no evidence either way and is left out.
+    if (s.is_refractor()) per_object[o].push_back(0.0f);
+    else if (!std::isnan(need[i])) per_object[o].push_back(need[i]);
+  }
+  constexpr float kTexelAngleTimesSize = 0.5f * kPi;  // texel angle of a side-s face: (π/2)/s
+  for (std::size_t o = 0; o < per_object.size(); ++o) {
+    if (!seen[o]) continue;
+    std::vector<float>& v = per_object[o];
+    if (v.empty()) {
+      sizes[o] = size;
+      continue;
+    }
+    const std::size_t k = static_cast<std::size_t>(kFootprintQuantile * double(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    const float q = v[k];
+    int side = kMinFootprintSize;
+    while (side < size && !(kTexelAngleTimesSize / static_cast<float>(side) <= q)) side *= 2;
+    sizes[o] = std::min(side, size);
+  }
+  return sizes;
+}
 
 const char* to_string(ReflectorSelection which) {
   switch (which) {
@@ -56,9 +237,22 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size,
                                     const GBuffer* camera_view, ReflectorSelection which,
-                                    const FaceLight& add_light, const std::vector<std::uint8_t>* skip) {
+                                    const FaceLight& add_light, const std::vector<std::uint8_t>* skip,
+                                    const MapSizing& sizing) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
+  std::vector<int> sizes;
+  if (camera_view && (sizing.from_footprint || sizing.skip_unseen))
+    sizes = footprint_sizes(executor, scene, *camera_view, size);
+  // Each object's camera samples, in sample order, for the faces its readers reach.
+  std::vector<std::vector<std::uint32_t>> samples_of;
+  if (camera_view && sizing.reads != MapSizing::Reads::anywhere) {
+    samples_of.resize(scene.objects.size());
+    for (std::size_t i = 0; i < camera_view->object.size(); ++i) {
+      const std::uint32_t object = camera_view->object.pixels[i];
+      if (object < samples_of.size()) samples_of[object].push_back(static_cast<std::uint32_t>(i));
+    }
+  }
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   const TriangleMesh& m = scene.mesh;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
@@ -82,6 +276,11 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     if (which == ReflectorSelection::not_planar_mirrors && planar_mirror_plane(scene, static_cast<std::uint32_t>(o)))
       continue;
     if (which == ReflectorSelection::refractors && !refracts) continue;
+    int side = size;
+    if (!sizes.empty()) {
+      if (sizing.skip_unseen && sizes[o] == 0) continue;
+      if (sizing.from_footprint && sizes[o] > 0) side = sizes[o];
+    }
     glm::vec3 centre = b.center();
     const glm::vec3 e = b.extent();
     const float smallest = std::min({e.x, e.y, e.z}), largest = std::max({e.x, e.y, e.z});
@@ -89,8 +288,11 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     if (camera_view && smallest < 0.05f * largest &&
         visible_centroid(*camera_view, static_cast<std::uint32_t>(o), seen, normal))
       centre = seen + normal * (0.01f * glm::length(e));
+    const int levels = levels_for_lobes(side, widest_lobe);
     CubeMapOptions opt;
-    opt.size = size;
+    opt.size = side;
+    if (!samples_of.empty())
+      opt.face_mask = faces_read(executor, *camera_view, samples_of[o], centre, side, levels, sizing);
     opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
@@ -103,20 +305,29 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
           return composite(executor, direct, envmap_reflect(executor, g, env));
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
-    out.maps.push_back(environment_from_faces(executor, cube.colour, false,
-                                              levels_for_lobes(size, widest_lobe)));
+    out.maps.push_back(environment_from_faces(executor, cube.colour, false, levels, opt.face_mask));
     out.cubes.push_back(std::move(cube));
     out.centres.push_back(centre);
+    out.faces.push_back(opt.face_mask);
   }
   return out;
+}
+
+double rendered_texels(const ReflectorMaps& maps) {
+  double texels = 0.0;
+  for (std::size_t m = 0; m < maps.cubes.size(); ++m)
+    texels += double(m < maps.faces.size() ? std::popcount(maps.faces[m]) : kCubeFaces) * maps.cubes[m].size *
+              maps.cubes[m].size;
+  return texels;
 }
 
 ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
                                                 const EnvironmentMap& environment,
                                                 const GBuffer& gbuffer) const {
   ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
-                                             which);
+                                             which, {}, nullptr, sizing);
   c.count("cube_maps", maps.cubes.size());
+  c.count("cube_texels", rendered_texels(maps));
   return maps;
 }
 

@@ -440,8 +440,9 @@ ReflectorMaps FallbackCubeMapsPass::operator()(par::NodeContext& c, const Reflec
   std::vector<std::uint8_t> skip(scene->objects.size(), 0);
   for (const ReflectorParam& p : params.reflectors) skip[p.object] = 1;
   ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
-                                             ReflectorSelection::all, {}, &skip);
+                                             ReflectorSelection::all, {}, &skip, sizing);
   c.count("cube_maps", double(maps.cubes.size()));
+  c.count("cube_texels", rendered_texels(maps));
   return maps;
 }
 

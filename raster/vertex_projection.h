@@ -156,7 +156,11 @@ struct FallbackCubeMapsPass {
       "distance cube map at its reference point for the environment-map fallback (SURVEY §3.1).";
   const Scene* scene = nullptr;
   int size = 256;
-  void parameters(par::Params& p) const { p.set("size", size); }
+  MapSizing sizing;  // only the camera's fallback samples read these maps (envmap_reflect)
+  void parameters(par::Params& p) const {
+    p.set("size", size);
+    p.set("footprint_size", sizing.from_footprint ? 1 : 0);
+  }
   ReflectorMaps operator()(par::NodeContext& c, const ReflectorParams& params, const ShadowMaps& shadows,
                            const EnvironmentMap& environment, const GBuffer& gbuffer) const;
 };

@@ -141,7 +141,7 @@ glm::vec3 hit_radiance(const Scene& scene, const LodBvh& lod, const TriangleLigh
                        const glm::vec3& dir_in, float solid_angle, const LodHit& hit) {
   const glm::vec3 dir = glm::normalize(dir_in);
   if (!hit.hit()) return environment_radiance(scene.environment, dir);
-  if (hit.proxy != kNoHit) return lod.nodes[hit.proxy].radiance;
+  if (hit.proxy != kNoHit) return lod.proxy_radiance(hit.proxy, hit.u, hit.v);
   const std::uint32_t t = hit.triangle;
   const SurfacePoint sp = surface_point(scene, t, hit.u, hit.v);
   glm::vec3 ng = sp.ng, n = sp.n;

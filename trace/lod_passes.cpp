@@ -27,9 +27,10 @@ TriangleLightingPtr RadianceBakePass::operator()(par::NodeContext& c, const BvhP
 LodBvhPtr LodBuildPass::operator()(par::NodeContext& c, const BvhPtr& bvh,
                                    const TriangleLightingPtr& lighting) const {
   LodBvhPtr lod = cache ? cache->lod : nullptr;
-  if (!lod) lod = std::make_shared<const LodBvh>(build_lod_bvh(*bvh, lighting->radiance));
+  if (!lod) lod = std::make_shared<const LodBvh>(build_lod_bvh(*bvh, lighting->radiance, &c.executor()));
   else c.count("cached");
   if (cache) cache->lod = lod;
+  c.count("proxy_textures", static_cast<double>(lod->proxy_texels.size() / (kProxyGrid * kProxyGrid)));
   return lod;
 }
 

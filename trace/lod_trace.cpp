@@ -39,6 +39,7 @@ inline bool intersect_proxy(const RayPrep& r, const LodNode& n, float tmax, floa
   const float s = uu > 0.0f ? glm::dot(p, n.edge_u) / uu : 0.0f;
   const float w = vv > 0.0f ? glm::dot(p, n.edge_v) / vv : 0.0f;
   if (s < 0.0f || s > 1.0f || w < 0.0f || w > 1.0f) return false;
+  if (!LodBvh::proxy_covers(n, s, w)) return false;  // the surface does not reach this texel
   t_out = t;
   s_out = s;
   w_out = w;

@@ -22,7 +22,7 @@ DistanceSearchOptions distance_search_options(const FrameSettings& f) {
 
 FrameOutputs add_distance_map_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   const SurfaceResources s = add_surface_passes(g, scene, f);
-  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size},
+  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, camera_read_maps(false, distance_search_options(f).lobe_directions)},
                     s.shadow_maps, s.environment, s.gbuffer);
   auto specular = g.add("distance_map_reflect", DistanceMapReflectPass{distance_search_options(f)},
                         s.gbuffer, s.environment, maps);

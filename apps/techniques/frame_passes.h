@@ -9,6 +9,7 @@
 #include "apps/techniques/frame_settings.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
+#include "raster/reflector_maps.h"
 #include "raster/shadow_map.h"
 #include "raster/visibility.h"
 
@@ -33,6 +34,20 @@ struct SurfaceResources {
 SurfaceResources add_surface_passes(par::Graph& graph, const Scene* scene,
                                     const FrameSettings& settings,
                                     const SurfacePassNotes& notes = {});
+
+// The reflector maps of a technique whose maps only the camera's samples read: none for
+// reflectors the camera does not see, only the faces those samples reach, and with
+// `by_direction` (looked up along a direction, envmap_reflect; otherwise searched,
+// distance_map_reflect with `lobe_directions` sub-lobes) each sized from its reflector's
+// footprint in the G-buffer (raster/reflector_maps.h MapSizing).
+inline raster::MapSizing camera_read_maps(bool by_direction, int lobe_directions = 8) {
+  raster::MapSizing m;
+  m.from_footprint = by_direction;
+  m.skip_unseen = true;
+  m.reads = by_direction ? raster::MapSizing::Reads::direction : raster::MapSizing::Reads::search;
+  m.lobe_directions = lobe_directions;
+  return m;
+}
 
 // composite (direct + specular) → resolve (k×k) → tonemap.
 FrameOutputs add_output_passes(par::Graph& graph, const FrameSettings& settings,

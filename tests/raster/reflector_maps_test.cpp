@@ -1,0 +1,135 @@
+// The reflector maps a frame reads only from the camera (raster/reflector_maps.h MapSizing):
+// leaving out the faces no read comes near changes no output byte of the reads it was
+// derived for (distance-map searches, envmap lookups, mirror and glossy lobes); reflectors
+// the camera does not see get no map; footprint sizes are powers of two under the cap that
+// grow with the reflector's size on screen.
+#include "raster/reflector_maps.h"
+
+#include <bit>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/scene_loader.h"
+#include "raster/distance_map_reflect.h"
+#include "raster/envmap_reflect.h"
+
+namespace speculum::raster {
+namespace {
+
+struct View {
+  Scene scene;
+  ShadowMaps shadows;
+  EnvironmentMap env;
+  GBuffer g;
+};
+
+View view_of(const std::string& name, int width, int height, par::Executor& ex) {
+  View v;
+  v.scene = load_scene(name);
+  const Camera cam = v.scene.cameras.front();
+  v.shadows = render_shadow_maps(ex, v.scene, 128);
+  v.env = build_environment(ex, v.scene.environment);
+  v.g = resolve_gbuffer(ex, v.scene, render_visibility(ex, v.scene, cam, width, height), cam.eye);
+  return v;
+}
+
+bool same_bytes(const ImageRGBA& a, const ImageRGBA& b) {
+  return a.width == b.width && a.height == b.height &&
+         std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])) == 0;
+}
+
+int culled_faces(const ReflectorMaps& maps) {
+  int culled = 0;
+  for (const unsigned f : maps.faces) culled += kCubeFaces - std::popcount(f);
+  return culled;
+}
+
+// Built-in scenes with mirrors and glossy reflectors: the specular layer from maps with only
+// the read faces equals the one from complete maps, byte for byte, while faces were indeed
+// left out (searches reach further than lookups along R, so they keep more).
+TEST(ReflectorMaps, UnreadFacesChangeNoSearchedOrLookedUpSample) {
+  par::Executor ex(2);
+  int culled_searched = 0, culled_looked_up = 0;
+  for (const char* name : {"sphere-in-room", "glossy-plane", "living-room"}) {
+    SCOPED_TRACE(name);
+    const View v = view_of(name, 96, 72, ex);
+    const int size = 64;
+    const ReflectorMaps all = render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g);
+    DistanceSearchOptions search;
+    MapSizing searched;
+    searched.reads = MapSizing::Reads::search;
+    searched.lobe_directions = search.lobe_directions;
+    const ReflectorMaps culled =
+        render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g, ReflectorSelection::all, {}, nullptr, searched);
+    ASSERT_EQ(all.cubes.size(), culled.cubes.size());
+    culled_searched += culled_faces(culled);
+    EXPECT_EQ(rendered_texels(culled) < rendered_texels(all), culled_faces(culled) > 0);
+    EXPECT_TRUE(same_bytes(distance_map_reflect(ex, v.g, v.env, all, search),
+                           distance_map_reflect(ex, v.g, v.env, culled, search)));
+    MapSizing looked_up;
+    looked_up.reads = MapSizing::Reads::direction;
+    const ReflectorMaps by_direction =
+        render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g, ReflectorSelection::all, {}, nullptr, looked_up);
+    culled_looked_up += culled_faces(by_direction);
+    EXPECT_TRUE(same_bytes(envmap_reflect(ex, v.g, v.env, &all), envmap_reflect(ex, v.g, v.env, &by_direction)));
+  }
+  // The mirror ball reads every face; the floors and the wall mirror do not.
+  EXPECT_GT(culled_searched, 0);
+  EXPECT_GT(culled_looked_up, culled_searched);
+}
+
+// A reflector with no sample in the camera's view gets no map under skip_unseen (nothing
+// reads it), and the specular layer is unchanged.
+TEST(ReflectorMaps, ReflectorsTheCameraDoesNotSeeGetNoMap) {
+  par::Executor ex(2);
+  View v = view_of("living-room", 96, 72, ex);
+  // Look at the floor in a corner: most reflectors leave the view.
+  Camera cam = v.scene.cameras.front();
+  cam.target = cam.eye + glm::vec3(0.3f, -1.0f, 0.2f);
+  v.g = resolve_gbuffer(ex, v.scene, render_visibility(ex, v.scene, cam, 96, 72), cam.eye);
+  MapSizing skip;
+  skip.skip_unseen = true;
+  const ReflectorMaps all = render_reflector_maps(ex, v.scene, v.shadows, v.env, 32, &v.g);
+  const ReflectorMaps seen =
+      render_reflector_maps(ex, v.scene, v.shadows, v.env, 32, &v.g, ReflectorSelection::all, {}, nullptr, skip);
+  EXPECT_LT(seen.cubes.size(), all.cubes.size());
+  for (std::size_t o = 0; o < v.scene.objects.size(); ++o) {
+    if (seen.map_of_object[o] < 0) continue;
+    bool visible = false;
+    for (std::size_t i = 0; i < v.g.object.size() && !visible; ++i) visible = v.g.object.pixels[i] == o;
+    EXPECT_TRUE(visible) << o;
+  }
+  DistanceSearchOptions search;
+  EXPECT_TRUE(same_bytes(distance_map_reflect(ex, v.g, v.env, all, search),
+                         distance_map_reflect(ex, v.g, v.env, seen, search)));
+}
+
+// Footprint sizes: powers of two in [kMinFootprintSize, cap], 0 for objects that read no
+// map; the same mirror ball seen on more pixels never gets a smaller map.
+TEST(ReflectorMaps, FootprintSizesArePowersOfTwoThatGrowWithTheView) {
+  par::Executor ex(2);
+  const View small = view_of("sphere-in-room", 80, 60, ex);
+  const View large = view_of("sphere-in-room", 640, 480, ex);
+  const std::vector<int> a = footprint_sizes(ex, small.scene, small.g, 256);
+  const std::vector<int> b = footprint_sizes(ex, large.scene, large.g, 256);
+  ASSERT_EQ(a.size(), small.scene.objects.size());
+  int sized = 0;
+  for (std::size_t o = 0; o < a.size(); ++o) {
+    for (const int s : {a[o], b[o]})
+      if (s != 0) {
+        EXPECT_TRUE(std::has_single_bit(static_cast<unsigned>(s))) << s;
+        EXPECT_GE(s, kMinFootprintSize);
+        EXPECT_LE(s, 256);
+      }
+    if (a[o] == 0) continue;
+    ++sized;
+    EXPECT_LE(a[o], b[o]) << o;
+  }
+  EXPECT_GT(sized, 0);
+}
+
+}  // namespace
+}  // namespace speculum::raster
