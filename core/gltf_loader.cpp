@@ -687,6 +687,34 @@ void check_schema_minimums(const std::string& path, const nlohmann::json& doc) {
   }
 }
 
+// The glTF 2.0 schema's shapes that tinygltf skips silently when wrong (glTF.schema.json,
+// mesh.schema.json, mesh.primitive.schema.json): the top-level collections are arrays of
+// objects, a mesh's primitives a non-empty array of objects with an attributes object. A
+// mesh whose "primitives" is an object would otherwise load as "no triangles".
+void check_schema_shapes(const std::string& path, const nlohmann::json& doc) {
+  for (const char* key : {"accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials",
+                          "meshes", "nodes", "samplers", "scenes", "skins", "textures"}) {
+    const auto c = doc.find(key);
+    if (c == doc.end()) continue;
+    if (!c->is_array()) throw InputError(path, std::string(key) + " is not an array");
+    for (std::size_t i = 0; i < c->size(); ++i)
+      if (!(*c)[i].is_object())
+        throw InputError(path, std::string(key) + "[" + std::to_string(i) + "] is not an object");
+  }
+  if (const auto meshes = doc.find("meshes"); meshes != doc.end())
+    for (std::size_t i = 0; i < meshes->size(); ++i) {
+      const std::string where = "meshes[" + std::to_string(i) + "].primitives";
+      const auto prims = (*meshes)[i].find("primitives");
+      if (prims == (*meshes)[i].end() || !prims->is_array() || prims->empty())
+        throw InputError(path, where + " must be a non-empty array (required by glTF 2.0)");
+      for (std::size_t j = 0; j < prims->size(); ++j) {
+        const auto& p = (*prims)[j];
+        if (!p.is_object() || !p.contains("attributes") || !p["attributes"].is_object())
+          throw InputError(path, where + "[" + std::to_string(j) + "] has no attributes object");
+      }
+    }
+}
+
 // An absolute URI (a path from /, or a file: URL) names a file wherever it is; tinygltf
 // would append it to the scene's folder, which hides what the file asked for. Refused
 // unless external files are allowed; relative URIs are checked where they resolve
@@ -745,6 +773,7 @@ void check_before_parsing(const std::string& path, const char* json, std::size_t
   for (const char* key : {"meshes", "accessors", "nodes", "bufferViews", "materials"})
     if (const auto c = doc.find(key); c != doc.end() && c->is_object() && !c->empty()) version1 = true;
   if (version1) throw InputError(path, "glTF 1.0 is not supported, 2.0 is");
+  check_schema_shapes(path, doc);
   const auto required = doc.find("extensionsRequired");
   if (required == doc.end() || !required->is_array()) return;
   std::string missing;

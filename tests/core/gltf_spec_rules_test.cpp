@@ -277,6 +277,18 @@ TEST(GltfSpecRules, DataUrisMustBeValidBase64OfTheDeclaredLength) {
   EXPECT_NE(load_error("base64_short.gltf", short_data.json()), "");
 }
 
+TEST(GltfSpecRules, SchemaShapesAreChecked) {
+  Asset a;
+  std::string json = a.json();
+  json.replace(json.find(R"("primitives":[{)"), 15, R"("primitives":{"p":{)");
+  json.replace(json.find(R"(,"indices":1}]})"), 15, R"(,"indices":1}}})");
+  EXPECT_NE(load_error("primitives_object.gltf", json).find("meshes[0].primitives must be a non-empty array"),
+            std::string::npos);
+  json = a.json();
+  json.replace(json.find(R"("nodes":[{)"), 10, R"("nodes":[7,{)");
+  EXPECT_NE(load_error("node_not_object.gltf", json).find("nodes[0] is not an object"), std::string::npos);
+}
+
 // A .glb of `json` (padded to 4 bytes) followed by the given chunks (type, payload).
 std::string glb(std::string json, const std::vector<std::pair<std::uint32_t, std::vector<unsigned char>>>& chunks,
                 int json_pad = -1) {
