@@ -26,6 +26,7 @@
 #include "core/gltf_environment.h"
 #include "core/gltf_material.h"
 #include "core/mesh_normals.h"
+#include "core/png_check.h"
 
 namespace speculum {
 namespace {
@@ -803,6 +804,10 @@ bool tolerant_image_loader(tinygltf::Image* image, const int, std::string*, std:
                        : size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0 ? "jpeg"
                                                                         : nullptr;
   if (!format) return true;
+  constexpr long long kMaxPixels = 1ll << 28;  // as read_image (core/image_io.cpp)
+  if (is_png(bytes, static_cast<std::size_t>(size)) &&
+      !png_problem(bytes, static_cast<std::size_t>(size), kMaxPixels).empty())
+    return true;  // undecodable: left empty, named by MaterialTable
   // The PNG or JPEG reader alone: ImageInput::open would fall back to every other format,
   // and OpenImageIO 2.4's DPX reader reads past the end of a memory buffer.
   OIIO::Filesystem::IOMemReader reader(bytes, static_cast<std::size_t>(size));
@@ -813,7 +818,6 @@ bool tolerant_image_loader(tinygltf::Image* image, const int, std::string*, std:
     (void)OIIO::geterror();
     return true;
   }
-  constexpr long long kMaxPixels = 1ll << 28;  // as read_image (core/image_io.cpp)
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 ||
       static_cast<long long>(spec.width) * spec.height > kMaxPixels)
     return true;
