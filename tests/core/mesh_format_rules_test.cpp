@@ -135,5 +135,19 @@ TEST(MeshFormatRules, BinaryStlIsRecognisedBySizeAndItsCountMustMatch) {
   EXPECT_PROBLEM(write("short.stl", other.substr(0, 120)), "(truncated)");
 }
 
+TEST(MeshFormatRules, ObjVerticesHaveThreeCoordinatesAndFaceIndicesFitAnInt) {
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  EXPECT_EQ(problem(write("ok.obj", v + "vt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\nf -3//-1 -2//-1 -1//-1\n")), "");
+  EXPECT_PROBLEM(write("two_coords.obj", "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n"),
+                 "vertex 2 has 2 coordinates (OBJ's v line needs x y z)");
+  EXPECT_PROBLEM(write("wrap.obj", v + "f 1 2 3 99999999999999999999\n"),
+                 "line 4: face index '99999999999999999999' is not an integer within the int range");
+  EXPECT_PROBLEM(write("word_index.obj", v + "f 1 2/x 3\n"), "line 4: face index 'x' is not an integer");
+  LoadReport report;
+  EXPECT_EQ(problem(write("short_face.obj", v + "f 1 2\nf 1 2 3\n"), &report), "");
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_EQ(report.warnings[0], "1 faces with fewer than 3 corners left out");
+}
+
 }  // namespace
 }  // namespace speculum
