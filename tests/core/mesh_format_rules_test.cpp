@@ -149,5 +149,22 @@ TEST(MeshFormatRules, ObjVerticesHaveThreeCoordinatesAndFaceIndicesFitAnInt) {
   EXPECT_EQ(report.warnings[0], "1 faces with fewer than 3 corners left out");
 }
 
+// The built-in scene spec NAME[:key=value,...]: each key once, size a whole number.
+TEST(SceneSpecRules, KeysAreGivenOnceAndSizeIsWhole) {
+  auto spec_problem = [](const std::string& spec) -> std::string {
+    try {
+      (void)parse_builtin_spec(spec);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(spec_problem("bowl:size=2000,"), "");
+  EXPECT_EQ(spec_problem("bowl:size=1.5k"), "");
+  EXPECT_EQ(spec_problem("bowl:size=1000,size=2000"), "bowl:size=1000,size=2000: option 'size' is given twice");
+  EXPECT_EQ(spec_problem("bumpy-sphere:n=3,n=4"), "bumpy-sphere:n=3,n=4: option 'n' is given twice");
+  EXPECT_EQ(spec_problem("bowl:size=1000.5"), "bowl:size=1000.5: size must be a whole number");
+}
+
 }  // namespace
 }  // namespace speculum
