@@ -564,11 +564,11 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
   read_with_openmesh(path, om, opt);
   if (report && ply.short_faces)
     report->warn(std::to_string(ply.short_faces) + " faces with fewer than 3 corners left out");
-  // OpenMesh's half-edge mesh refuses faces that would make an edge non-manifold (three or
-  // more faces on one edge, or a flipped neighbour): say so rather than render holes quietly.
+  // OpenMesh refuses faces it cannot add to its half-edge mesh (a corner repeated, say):
+  // say how many rather than render holes quietly.
   if (report && ply.triangles > om.n_faces())
     report->warn(std::to_string(ply.triangles - om.n_faces()) +
-                 " triangles left out (OpenMesh refuses non-manifold faces)");
+                 " triangles left out (degenerate faces OpenMesh refuses)");
 
   Scene scene;
   scene.name = path;

@@ -98,6 +98,34 @@ TEST(MeshFormatRules, PlyFacesWithFewerThanThreeCornersAreReported) {
   EXPECT_NE(report.warnings[0].find("1 faces with fewer than 3 corners left out"), std::string::npos);
 }
 
+TEST(MeshFormatRules, NonManifoldPlyFacesAreKept) {
+  // Three triangles on the edge 0-1: OpenMesh's importer keeps the third by duplicating
+  // vertices (were a face refused, the loader would warn how many triangles were left out).
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 3\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n";
+  const fs::path file = write("non_manifold.ply", ply);
+  LoadReport report;
+  SceneOptions o;
+  o.report = &report;
+  const Scene s = load_scene(file.string(), o);
+  EXPECT_EQ(s.mesh.triangle_count(), 3u);
+  EXPECT_TRUE(report.warnings.empty());
+}
+
+TEST(MeshFormatRules, PlyFacesOpenMeshRefusesAreReported) {
+  std::string head = kPlyHead;
+  head.replace(head.find("element face 1"), 14, "element face 2");
+  LoadReport report;
+  SceneOptions o;
+  o.report = &report;
+  const Scene s = load_scene(write("repeated_corner.ply", head + kVerts + "3 0 1 2\n3 0 0 1\n").string(), o);
+  EXPECT_EQ(s.mesh.triangle_count(), 1u);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_EQ(report.warnings[0], "1 triangles left out (degenerate faces OpenMesh refuses)");
+}
+
 const std::string kFacet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
 
 TEST(MeshFormatRules, AsciiStlFacetsHaveThreeFiniteVertices) {
