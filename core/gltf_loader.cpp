@@ -846,8 +846,11 @@ struct ExternalFiles {
   bool inside(const std::string& file) {
     if (allow) return true;
     std::error_code ec;
-    const auto root = std::filesystem::weakly_canonical(folder.empty() ? "." : folder, ec);
-    const auto real = std::filesystem::weakly_canonical(file, ec);
+    // Absolute first: weakly_canonical leaves a relative path whose first component does
+    // not exist relative, which no folder contains (a missing image next to a scene given
+    // without a folder was named as outside it).
+    const auto root = std::filesystem::weakly_canonical(std::filesystem::absolute(folder.empty() ? "." : folder), ec);
+    const auto real = std::filesystem::weakly_canonical(std::filesystem::absolute(file), ec);
     if (!ec) {
       const auto rel = real.lexically_relative(root);
       if (!rel.empty() && *rel.begin() != ".." && !rel.is_absolute()) return true;

@@ -289,6 +289,33 @@ TEST(GltfSpecRules, SchemaShapesAreChecked) {
   EXPECT_NE(load_error("node_not_object.gltf", json).find("nodes[0] is not an object"), std::string::npos);
 }
 
+// A missing image beside a scene named without a folder (the current directory's) is a
+// missing texture, not a file outside the scene's folder.
+TEST(GltfSpecRules, MissingImageBesideASceneInTheCurrentDirectoryIsNotOutside) {
+  Asset a;
+  a.primitive_extra = R"(,"material":0)";
+  a.top_extra = R"(,"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],)"
+                R"("textures":[{"source":0}],"images":[{"uri":"missing.png"}])";
+  const fs::path dir = scratch();
+  std::ofstream(dir / "cwd.gltf") << a.json();
+  const fs::path before = fs::current_path();
+  fs::current_path(dir);
+  LoadReport report;
+  SceneOptions o;
+  o.report = &report;
+  std::string error;
+  try {
+    (void)load_scene("cwd.gltf", o);
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  fs::current_path(before);
+  EXPECT_EQ(error, "");
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("'missing.png' is missing or could not be decoded"), std::string::npos)
+      << report.warnings[0];
+}
+
 // A .glb of `json` (padded to 4 bytes) followed by the given chunks (type, payload).
 std::string glb(std::string json, const std::vector<std::pair<std::uint32_t, std::vector<unsigned char>>>& chunks,
                 int json_pad = -1) {
