@@ -7,7 +7,7 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -q
 $SUDO apt-get install -y -q --no-install-recommends \
   g++ cmake ninja-build pkg-config \
-  libglm-dev libopenimageio-dev openimageio-tools \
+  libglm-dev libopenimageio-dev openimageio-tools libpng-dev \
   libtinygltf-dev nlohmann-json3-dev libstb-dev libtinyobjloader-dev \
   libopenmesh-dev libtbb-dev libnanoflann-dev \
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev \

@@ -17,6 +17,8 @@ namespace speculum::gltf {
 constexpr std::size_t kMaxAccessorCount = std::size_t{1} << 28;
 
 // A validated accessor: `data` points at element 0 (nullptr: all zeros, no bufferView).
+// A sparse accessor (glTF 2.0 §3.6.2.3) replaces the elements `sparse_indices` (strictly
+// increasing, each below count) with the tightly packed elements at `sparse_values`.
 struct AccessorView {
   const unsigned char* data = nullptr;
   std::size_t count = 0;
@@ -24,6 +26,8 @@ struct AccessorView {
   int components = 0;
   int component_type = 0;
   bool normalized = false;
+  std::vector<std::uint32_t> sparse_indices;
+  const unsigned char* sparse_values = nullptr;
 };
 
 // Validates accessor `index` for use as `what` (e.g. "POSITION of mesh 'x' primitive 0")

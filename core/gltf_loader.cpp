@@ -3,6 +3,7 @@
 #include "core/gltf_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -25,6 +26,7 @@
 #include "core/gltf_environment.h"
 #include "core/gltf_material.h"
 #include "core/mesh_normals.h"
+#include "core/png_check.h"
 
 namespace speculum {
 namespace {
@@ -71,15 +73,52 @@ void check_glb_container(const std::string& path, const std::vector<unsigned cha
   if (total > b.size())
     throw InputError(path, "truncated .glb: header says " + std::to_string(total) +
                                " bytes, file has " + std::to_string(b.size()));
+  if (total < b.size())
+    throw InputError(path, ".glb header says " + std::to_string(total) + " bytes, file has " +
+                               std::to_string(b.size()) + " (trailing data)");
   const std::uint64_t json_len = le32(&b[12]);
   if (le32(&b[16]) != 0x4E4F534Au) throw InputError(path, "first .glb chunk is not JSON");
   if (20 + json_len > total) throw InputError(path, "truncated .glb: JSON chunk runs past the end");
-  std::uint64_t at = 20 + ((json_len + 3) & ~std::uint64_t{3});
-  if (at + 8 <= total) {
-    const std::uint64_t bin_len = le32(&b[at]);
-    if (at + 8 + bin_len > total)
-      throw InputError(path, "truncated .glb: BIN chunk runs past the end");
+  // Every chunk starts and ends on a 4-byte boundary (the JSON padded with spaces, the BIN
+  // chunk with zeros); a BIN chunk may follow the JSON chunk only directly, once; chunks of
+  // other types are skipped (glTF 2.0 §4.4.3).
+  if (json_len == 0 || json_len % 4 != 0)
+    throw InputError(path, ".glb JSON chunk length " + std::to_string(json_len) + " is not a positive multiple of 4");
+  std::uint64_t at = 20 + json_len;
+  for (int chunk = 1; at < total; ++chunk) {
+    if (at + 8 > total) throw InputError(path, "truncated .glb: chunk " + std::to_string(chunk) + " header runs past the end");
+    const std::uint64_t len = le32(&b[at]);
+    const std::uint32_t type = le32(&b[at + 4]);
+    if (at + 8 + len > total)
+      throw InputError(path, "truncated .glb: chunk " + std::to_string(chunk) + " runs past the end");
+    if (len % 4 != 0) throw InputError(path, ".glb chunk " + std::to_string(chunk) + " length is not a multiple of 4");
+    if (type == 0x4E4F534Au) throw InputError(path, ".glb has a second JSON chunk");
+    if (type == 0x004E4942u && chunk != 1)
+      throw InputError(path, ".glb BIN chunk must directly follow the JSON chunk, once");
+    at += 8 + len;
   }
+}
+
+// Data URIs of buffers and images hold base64 (RFC 4648 §4): tinygltf's decoder stops at
+// the first character outside the alphabet and keeps what it decoded, so a corrupted
+// payload could load as a shorter, or padded-out, garbage buffer.
+void check_data_uri(const std::string& path, const std::string& uri, const std::string& where) {
+  const std::size_t comma = uri.find(',');
+  if (comma == std::string::npos || uri.compare(0, 5, "data:") != 0) return;
+  if (uri.rfind(";base64", comma) == std::string::npos || uri.rfind(";base64", comma) + 7 != comma)
+    throw InputError(path, where + " data URI is not base64");
+  std::size_t n = uri.size() - comma - 1, pad = 0;
+  for (std::size_t i = comma + 1; i < uri.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(uri[i]);
+    if (c == '=') {
+      ++pad;
+      continue;
+    }
+    if (pad > 0 || !(std::isalnum(c) || c == '+' || c == '/'))
+      throw InputError(path, where + " data URI has invalid base64 at character " + std::to_string(i - comma - 1));
+  }
+  if (pad > 2 || n % 4 == 1 || (pad > 0 && n % 4 != 0))
+    throw InputError(path, where + " data URI has a base64 payload of invalid length " + std::to_string(n));
 }
 
 struct Loader {
@@ -176,7 +215,22 @@ struct Loader {
           model, prim.indices, path, what + " indices", {TINYGLTF_TYPE_SCALAR},
           {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+      // glTF 2.0 §3.7.2.1: index data is tightly packed (its bufferView defines no
+      // byteStride), not normalized, and never holds the component type's largest value
+      // (the primitive restart value of graphics APIs).
+      const tinygltf::Accessor& acc = model.accessors[static_cast<std::size_t>(prim.indices)];
+      if (acc.normalized) throw InputError(path, what + " indices accessor " + std::to_string(prim.indices) + " is normalized");
+      if (acc.bufferView >= 0 && model.bufferViews[static_cast<std::size_t>(acc.bufferView)].byteStride != 0)
+        throw InputError(path, what + " indices accessor " + std::to_string(prim.indices) +
+                                   " uses a bufferView with byteStride (index data must be tightly packed)");
       idx = gltf::read_indices(iv);
+      const std::uint32_t restart = iv.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 0xffu
+                                    : iv.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 0xffffu
+                                                                                                  : 0xffffffffu;
+      for (std::size_t i = 0; i < idx.size(); ++i)
+        if (idx[i] == restart)
+          throw InputError(path, what + " index " + std::to_string(i) + " = " + std::to_string(restart) +
+                                     " is the primitive restart value, which glTF forbids");
       for (std::size_t i = 0; i < idx.size(); ++i)
         if (idx[i] >= nv)
           throw InputError(path, what + " index " + std::to_string(i) + " = " +
@@ -246,6 +300,11 @@ struct Loader {
         {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
          TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
     if (v.count != nv) throw InputError(path, what + " " + name + " count differs from POSITION count");
+    // glTF 2.0 §3.7.2.1: integer texture coordinates are "unsigned byte normalized" or
+    // "unsigned short normalized"; un-normalized they would be texel counts, not [0, 1].
+    if (v.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT && !v.normalized)
+      throw InputError(path, what + " " + name + ": accessor " + std::to_string(a) +
+                                 " has integer components but is not normalized");
     const auto f = gltf::read_floats(v);
     uv.resize(nv);
     for (std::size_t i = 0; i < nv; ++i) {
@@ -384,6 +443,12 @@ struct Loader {
     const std::string what = "mesh " + std::to_string(mesh_index) +
                              (gmesh.name.empty() ? "" : " '" + gmesh.name + "'") +
                              " primitive " + std::to_string(prim_index);
+    // Every accessor the primitive names exists, also those of attributes not drawn here
+    // (COLOR_0, JOINTS_0, ...): a file naming a missing one is broken (glTF 2.0 §3.7.2.1).
+    for (const auto& [name, a] : prim.attributes)
+      if (a < 0 || static_cast<std::size_t>(a) >= model.accessors.size())
+        throw InputError(path, what + " attribute " + name + " names accessor " + std::to_string(a) +
+                                   " which does not exist");
     const int mode = triangle_mode(prim, what);
     if (mode < 0) return;
     check_counts(prim, mode);
@@ -472,9 +537,9 @@ struct Loader {
     }
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end()) {
       const tinygltf::Value& v = it->second;
-      if (!v.IsObject() || !v.Has("light") || !v.Get("light").IsNumber())
+      if (!v.IsObject() || !v.Has("light") || !v.Get("light").IsInt())
         throw InputError(path, "node " + std::to_string(n) + " has a malformed KHR_lights_punctual");
-      const int light = v.Get("light").GetNumberAsInt();
+      const int light = v.Get("light").Get<int>();
       if (light < 0 || static_cast<std::size_t>(light) >= model.lights.size())
         throw InputError(path, "node " + std::to_string(n) + " names light " +
                                    std::to_string(light) + " which does not exist");
@@ -489,6 +554,13 @@ struct Loader {
         ++skipped_ortho;
         continue;
       }
+      // glTF 2.0 §5.13: yfov > 0 and znear > 0; zfar, when given, > znear (absent: infinite).
+      const auto& pp = gc.perspective;
+      if (!(pp.yfov > 0.0 && pp.yfov < 3.14159265358979) || !(pp.znear > 0.0) || !std::isfinite(pp.znear) ||
+          !(pp.zfar == 0.0 || (pp.zfar > pp.znear && std::isfinite(static_cast<float>(pp.zfar)))) ||
+          pp.znear > std::numeric_limits<float>::max() || pp.aspectRatio < 0.0)
+        throw InputError(path, "camera " + std::to_string(index) +
+                                   " needs 0 < yfov < pi, znear > 0 and zfar > znear (or no zfar)");
       Camera cam;
       cam.name = gc.name.empty() ? "camera " + std::to_string(index) : gc.name;
       cam.eye = glm::vec3(world[3]);
@@ -530,6 +602,14 @@ struct Loader {
       const float check = l.color.x + l.color.y + l.color.z + l.intensity + l.range +
                           l.position.x + l.position.y + l.position.z + l.direction.x +
                           l.direction.y + l.direction.z + l.inner_cone + l.outer_cone;
+      // KHR_lights_punctual: range > 0 when given, 0 <= inner < outer <= pi/2 for spots
+      // (inner == outer, a hard-edged spot some exporters write, is let through).
+      const bool bad_cone = l.type == LightType::Spot &&
+                            !(l.inner_cone >= 0.0f && l.inner_cone <= l.outer_cone && l.outer_cone > 0.0f &&
+                              l.outer_cone <= 1.5707964f);
+      if (l.range < 0.0f || bad_cone)
+        throw InputError(path, "light " + std::to_string(index) +
+                                   " has a negative range or spot cone angles outside 0 <= inner <= outer <= pi/2");
       if (!std::isfinite(check) || l.intensity < 0.0f)
         throw InputError(path, "light " + std::to_string(index) + " has non-finite or negative values");
       scene.lights.push_back(l);
@@ -608,6 +688,34 @@ void check_schema_minimums(const std::string& path, const nlohmann::json& doc) {
   }
 }
 
+// The glTF 2.0 schema's shapes that tinygltf skips silently when wrong (glTF.schema.json,
+// mesh.schema.json, mesh.primitive.schema.json): the top-level collections are arrays of
+// objects, a mesh's primitives a non-empty array of objects with an attributes object. A
+// mesh whose "primitives" is an object would otherwise load as "no triangles".
+void check_schema_shapes(const std::string& path, const nlohmann::json& doc) {
+  for (const char* key : {"accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials",
+                          "meshes", "nodes", "samplers", "scenes", "skins", "textures"}) {
+    const auto c = doc.find(key);
+    if (c == doc.end()) continue;
+    if (!c->is_array()) throw InputError(path, std::string(key) + " is not an array");
+    for (std::size_t i = 0; i < c->size(); ++i)
+      if (!(*c)[i].is_object())
+        throw InputError(path, std::string(key) + "[" + std::to_string(i) + "] is not an object");
+  }
+  if (const auto meshes = doc.find("meshes"); meshes != doc.end())
+    for (std::size_t i = 0; i < meshes->size(); ++i) {
+      const std::string where = "meshes[" + std::to_string(i) + "].primitives";
+      const auto prims = (*meshes)[i].find("primitives");
+      if (prims == (*meshes)[i].end() || !prims->is_array() || prims->empty())
+        throw InputError(path, where + " must be a non-empty array (required by glTF 2.0)");
+      for (std::size_t j = 0; j < prims->size(); ++j) {
+        const auto& p = (*prims)[j];
+        if (!p.is_object() || !p.contains("attributes") || !p["attributes"].is_object())
+          throw InputError(path, where + "[" + std::to_string(j) + "] has no attributes object");
+      }
+    }
+}
+
 // An absolute URI (a path from /, or a file: URL) names a file wherever it is; tinygltf
 // would append it to the scene's folder, which hides what the file asked for. Refused
 // unless external files are allowed; relative URIs are checked where they resolve
@@ -641,6 +749,19 @@ void check_before_parsing(const std::string& path, const char* json, std::size_t
   const nlohmann::json doc = nlohmann::json::parse(json, json + size, nullptr, false);
   if (!doc.is_object()) return;
   check_schema_minimums(path, doc);
+  // glTF 2.0 §3.5.3: "When matrix is defined, translation, rotation, and scale MUST NOT be
+  // present" — which one a file meant is unknowable (tinygltf keeps the matrix silently).
+  if (const auto nodes = doc.find("nodes"); nodes != doc.end() && nodes->is_array())
+    for (std::size_t i = 0; i < nodes->size(); ++i) {
+      const nlohmann::json& n = (*nodes)[i];
+      if (n.is_object() && n.contains("matrix") && (n.contains("translation") || n.contains("rotation") || n.contains("scale")))
+        throw InputError(path, "node " + std::to_string(i) + " has both a matrix and translation/rotation/scale");
+    }
+  for (const char* array : {"buffers", "images"})
+    if (const auto arr = doc.find(array); arr != doc.end() && arr->is_array())
+      for (std::size_t i = 0; i < arr->size(); ++i)
+        if (const auto uri = (*arr)[i].find("uri"); uri != (*arr)[i].end() && uri->is_string())
+          check_data_uri(path, uri->get<std::string>(), std::string(array) + "[" + std::to_string(i) + "]");
   if (!allow_external_files) check_uris_are_relative(path, doc);
   bool version1 = false;
   if (const auto asset = doc.find("asset"); asset != doc.end() && asset->is_object()) {
@@ -653,6 +774,7 @@ void check_before_parsing(const std::string& path, const char* json, std::size_t
   for (const char* key : {"meshes", "accessors", "nodes", "bufferViews", "materials"})
     if (const auto c = doc.find(key); c != doc.end() && c->is_object() && !c->empty()) version1 = true;
   if (version1) throw InputError(path, "glTF 1.0 is not supported, 2.0 is");
+  check_schema_shapes(path, doc);
   const auto required = doc.find("extensionsRequired");
   if (required == doc.end() || !required->is_array()) return;
   std::string missing;
@@ -682,6 +804,10 @@ bool tolerant_image_loader(tinygltf::Image* image, const int, std::string*, std:
                        : size >= 3 && std::memcmp(bytes, kJpeg, 3) == 0 ? "jpeg"
                                                                         : nullptr;
   if (!format) return true;
+  constexpr long long kMaxPixels = 1ll << 28;  // as read_image (core/image_io.cpp)
+  if (is_png(bytes, static_cast<std::size_t>(size)) &&
+      !png_problem(bytes, static_cast<std::size_t>(size), kMaxPixels).empty())
+    return true;  // undecodable: left empty, named by MaterialTable
   // The PNG or JPEG reader alone: ImageInput::open would fall back to every other format,
   // and OpenImageIO 2.4's DPX reader reads past the end of a memory buffer.
   OIIO::Filesystem::IOMemReader reader(bytes, static_cast<std::size_t>(size));
@@ -692,7 +818,6 @@ bool tolerant_image_loader(tinygltf::Image* image, const int, std::string*, std:
     (void)OIIO::geterror();
     return true;
   }
-  constexpr long long kMaxPixels = 1ll << 28;  // as read_image (core/image_io.cpp)
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 ||
       static_cast<long long>(spec.width) * spec.height > kMaxPixels)
     return true;
@@ -721,8 +846,11 @@ struct ExternalFiles {
   bool inside(const std::string& file) {
     if (allow) return true;
     std::error_code ec;
-    const auto root = std::filesystem::weakly_canonical(folder.empty() ? "." : folder, ec);
-    const auto real = std::filesystem::weakly_canonical(file, ec);
+    // Absolute first: weakly_canonical leaves a relative path whose first component does
+    // not exist relative, which no folder contains (a missing image next to a scene given
+    // without a folder was named as outside it).
+    const auto root = std::filesystem::weakly_canonical(std::filesystem::absolute(folder.empty() ? "." : folder), ec);
+    const auto real = std::filesystem::weakly_canonical(std::filesystem::absolute(file), ec);
     if (!ec) {
       const auto rel = real.lexically_relative(root);
       if (!rel.empty() && *rel.begin() != ".." && !rel.is_absolute()) return true;

@@ -18,6 +18,19 @@ float number(const tinygltf::Value& obj, const char* key, float fallback) {
   return static_cast<float>(obj.Get(key).GetNumberAsDouble());
 }
 
+// An integer property of an extension's object (tinygltf leaves extensions as raw JSON
+// values): `fallback` when absent, InputError when it is not an integer an int holds — a
+// double such as 1e300 would otherwise be converted with undefined behaviour.
+int integer(const std::string& path, const tinygltf::Value& obj, const char* key, int fallback,
+            const std::string& what) {
+  if (!obj.IsObject() || !obj.Has(key)) return fallback;
+  const tinygltf::Value& v = obj.Get(key);
+  const double x = v.IsNumber() ? v.GetNumberAsDouble() : 0.5;
+  if (!(x >= -2147483648.0 && x <= 2147483647.0) || std::floor(x) != x)
+    throw InputError(path, what + "." + key + " must be an integer");
+  return static_cast<int>(x);
+}
+
 const tinygltf::Value* extension(const tinygltf::ExtensionMap& ext, const char* name) {
   auto it = ext.find(name);
   return it == ext.end() || !it->second.IsObject() ? nullptr : &it->second;
@@ -110,8 +123,8 @@ Material MaterialTable::convert(std::size_t index) {
     m.transmission = number(*e, "transmissionFactor", 0.0f);
     if (e->Has("transmissionTexture")) {
       const auto& ti = e->Get("transmissionTexture");
-      const int tex = ti.Has("index") ? ti.Get("index").GetNumberAsInt() : -1;
-      const int set = ti.Has("texCoord") ? ti.Get("texCoord").GetNumberAsInt() : 0;
+      const int tex = integer(path_, ti, "index", -1, what + " transmissionTexture");
+      const int set = integer(path_, ti, "texCoord", 0, what + " transmissionTexture");
       tinygltf::ExtensionMap ext;
       if (ti.Has("extensions") && ti.Get("extensions").IsObject()) {
         const auto& ev = ti.Get("extensions");
@@ -155,7 +168,7 @@ void MaterialTable::bind(int texture, int texcoord, const tinygltf::ExtensionMap
   ref.texcoord = texcoord;
   if (const auto* t = extension(ext, "KHR_texture_transform")) {
     ref.uv_transform = texture_transform(*t);
-    if (t->Has("texCoord")) ref.texcoord = t->Get("texCoord").GetNumberAsInt();
+    ref.texcoord = integer(path_, *t, "texCoord", ref.texcoord, what + " KHR_texture_transform");
     for (int c = 0; c < 3; ++c)
       for (int r = 0; r < 3; ++r)
         if (!finite(ref.uv_transform[c][r]))
@@ -174,6 +187,9 @@ int MaterialTable::scene_texture(int texture, bool srgb, const std::string& what
   auto key = std::make_pair(texture, srgb);
   if (auto it = texture_map_.find(key); it != texture_map_.end()) return it->second;
   const tinygltf::Texture& t = model_.textures[static_cast<std::size_t>(texture)];
+  if (t.sampler >= 0 && static_cast<std::size_t>(t.sampler) >= model_.samplers.size())
+    throw InputError(path_, what + ": texture " + std::to_string(texture) + " names sampler " +
+                                std::to_string(t.sampler) + " which does not exist");
   if (t.source < 0 || static_cast<std::size_t>(t.source) >= model_.images.size())
     throw InputError(path_, what + ": texture " + std::to_string(texture) +
                                 " has no valid image source");

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/output_file.h"
+#include "core/png_check.h"
 
 namespace speculum {
 
@@ -86,6 +87,13 @@ ImageRGBA read_image(const std::string& path, bool to_linear) {
       file.seekg(0);
       const std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
       check_exr_header(path, bytes);
+    }
+    if (file && std::memcmp(magic, "\x89PNG", 4) == 0) {
+      file.seekg(0);
+      const std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+      const std::string problem =
+          png_problem(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), kMaxPixels);
+      if (!problem.empty()) throw InputError(path, "cannot read image: " + problem);
     }
   }
   auto in = OIIO::ImageInput::open(path);

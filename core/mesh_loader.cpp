@@ -5,6 +5,7 @@
 #include "core/mesh_loader.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -46,11 +47,19 @@ struct PlyProperty {
   int item_bytes = 0;   // the scalar's size, or each list item's
   bool count_signed = false;
   bool coordinate = false;  // x, y or z of a vertex
+  bool item_float = false, item_signed = false;
+  bool corners = false;  // a face's vertex_indices (or vertex_index) list
 };
 struct PlyElement {
   unsigned long long count = 0;
   bool vertex = false;
   std::vector<PlyProperty> properties;
+  bool face = false;
+};
+// What the body walk learned: faces with fewer than 3 corners (OpenMesh drops them) and
+// the triangles the others make when fanned.
+struct PlyFaces {
+  unsigned long long short_faces = 0, triangles = 0;
 };
 struct PlyLayout {
   bool binary = false, big_endian = false;
@@ -113,7 +122,7 @@ PlyLayout check_ply_header(const std::string& path, std::istream& in, std::uintm
                                    std::to_string(w[1] == "vertex" ? kMaxSceneVertices : kMaxSceneTriangles) +
                                    (w[1] == "vertex" ? " (2^25)" : " (2^24)"));
       element = true;
-      layout.elements.push_back({n, w[1] == "vertex", {}});
+      layout.elements.push_back({n, w[1] == "vertex", {}, w[1] == "face"});
       vertex = vertex || w[1] == "vertex";
       face = face || w[1] == "face";
     } else if (w[0] == "property") {
@@ -122,12 +131,17 @@ PlyLayout check_ply_header(const std::string& path, std::istream& in, std::uintm
         if (!kTypes.count(w[1])) bad();
         layout.elements.back().properties.push_back(
             {false, 0, ply_type_bytes(w[1]), false,
-             layout.elements.back().vertex && (w[2] == "x" || w[2] == "y" || w[2] == "z")});
+             layout.elements.back().vertex && (w[2] == "x" || w[2] == "y" || w[2] == "z"),
+             w[1].find("float") != std::string::npos || w[1] == "double", w[1][0] != 'u', false});
       } else if (w.size() == 5 && w[1] == "list") {
         if (!kTypes.count(w[2]) || !kTypes.count(w[3])) bad();
         if (w[2] == "float" || w[2] == "double" || w[2] == "float32" || w[2] == "float64") bad();
+        const bool face_corners = w[4] == "vertex_indices" || w[4] == "vertex_index";
+        if (face_corners && (w[3].find("float") != std::string::npos || w[3] == "double")) bad();
         layout.elements.back().properties.push_back(
-            {true, ply_type_bytes(w[2]), ply_type_bytes(w[3]), w[2][0] != 'u', false});
+            {true, ply_type_bytes(w[2]), ply_type_bytes(w[3]), w[2][0] != 'u', false,
+             w[3].find("float") != std::string::npos || w[3] == "double", w[3][0] != 'u',
+             face_corners && layout.elements.back().face});
       } else {
         bad();
       }
@@ -143,37 +157,83 @@ PlyLayout check_ply_header(const std::string& path, std::istream& in, std::uintm
 // out), so each count must be a whole number >= 0 whose items the file still holds, and the
 // file must hold every element the header declares (PLY's element data follow the header in
 // declaration order, each property in turn; ASCII separates values by white space).
-void check_ply_body(const std::string& path, std::istream& in, const PlyLayout& layout) {
+PlyFaces check_ply_body(const std::string& path, std::istream& in, const PlyLayout& layout) {
   auto truncated = [&](const char* what) {
     throw InputError(path, std::string("PLY data truncated or malformed: ") + what);
   };
+  unsigned long long vertices = 0;
+  for (const PlyElement& e : layout.elements)
+    if (e.vertex) vertices += e.count;
+  PlyFaces faces;
+  // A face's corner `v` (its `k`th) must name a vertex the file has.
+  auto corner = [&](long long v, unsigned long long face, unsigned long long k) {
+    if (v < 0 || static_cast<unsigned long long>(v) >= vertices)
+      throw InputError(path, "face " + std::to_string(face) + " corner " + std::to_string(k) + " indexes vertex " +
+                                 std::to_string(v) + ", the file has " + std::to_string(vertices) + " vertices");
+  };
+  auto count_face = [&](unsigned long long corners) {
+    if (corners < 3) ++faces.short_faces;
+    else faces.triangles += corners - 2;
+  };
   if (!layout.binary) {
     std::string tok;
+    // One ASCII value of the property's type: an integer within its type's range (PLY
+    // writes integer types as integers), or a number for float types.
+    auto value = [&](bool is_float, bool is_signed, int bytes, const char* what) -> double {
+      if (!(in >> tok)) truncated("fewer values than the header declares");
+      char* stop = nullptr;
+      errno = 0;
+      if (is_float) {
+        const double x = std::strtod(tok.c_str(), &stop);
+        if (*stop != '\0' || stop == tok.c_str())
+          throw InputError(path, std::string(what) + " '" + tok.substr(0, 20) + "' is not a number");
+        return x;
+      }
+      const long long x = std::strtoll(tok.c_str(), &stop, 10);
+      const long long lo = is_signed ? -(1ll << (8 * bytes - 1)) : 0;
+      const long long hi = is_signed ? (1ll << (8 * bytes - 1)) - 1 : (1ll << (8 * bytes)) - 1;
+      if (*stop != '\0' || stop == tok.c_str() || errno == ERANGE || x < lo || x > hi)
+        throw InputError(path, std::string(what) + " '" + tok.substr(0, 20) + "' is not an integer of its declared type");
+      return static_cast<double>(x);
+    };
     for (const PlyElement& e : layout.elements)
       for (unsigned long long i = 0; i < e.count; ++i)
         for (const PlyProperty& p : e.properties) {
-          if (!(in >> tok)) truncated("fewer values than the header declares");
-          if (p.coordinate) {
+          if (!p.list) {
+            const double x = value(p.item_float, p.item_signed, p.item_bytes, "PLY value");
             // OpenMesh's stream read stops at a value past a float's range and the faces go
             // unread ("no faces"): name the vertex instead.
-            char* stop = nullptr;
-            const double x = std::strtod(tok.c_str(), &stop);
-            if (*stop == '\0' && !(std::fabs(x) < double(std::numeric_limits<float>::max())))
+            if (p.coordinate && !(std::fabs(x) < double(std::numeric_limits<float>::max())))
               throw InputError(path, "non-finite vertex " + std::to_string(i) + " (coordinate '" + tok.substr(0, 20) +
                                          "' is NaN, infinite or overflows a float)");
+            continue;
           }
-          if (!p.list) continue;
+          if (!(in >> tok)) truncated("fewer values than the header declares");
           if (tok.empty() || tok.size() > 9 || tok.find_first_not_of("0123456789") != std::string::npos)
             throw InputError(path, "PLY list count '" + tok.substr(0, 20) + "' is not a whole number below 10^9");
-          for (unsigned long n = std::stoul(tok); n > 0; --n)
-            if (!(in >> tok)) truncated("a list is longer than the data left");
+          const unsigned long n = std::stoul(tok);
+          if (p.corners) count_face(n);
+          for (unsigned long k = 0; k < n; ++k) {
+            const double x = value(p.item_float, p.item_signed, p.item_bytes, "PLY list item");
+            if (p.corners) corner(static_cast<long long>(x), i, k);
+          }
         }
-    return;
+    return faces;
   }
   const std::string body{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   std::size_t at = 0;
   auto need = [&](unsigned long long bytes) {
     if (bytes > body.size() - at) truncated("fewer bytes than the header declares");
+  };
+  // An integer of `bytes` bytes at `at`, in the file's byte order.
+  auto integer = [&](int bytes, bool is_signed) -> long long {
+    unsigned char b[8] = {};
+    std::memcpy(b, body.data() + at, static_cast<std::size_t>(bytes));
+    if (layout.big_endian) std::reverse(b, b + bytes);
+    std::uint64_t raw = 0;
+    for (int k = bytes - 1; k >= 0; --k) raw = (raw << 8) | b[k];
+    if (is_signed && (raw >> (8 * bytes - 1)) & 1u) return static_cast<long long>(raw) - (1ll << (8 * bytes - 1)) * 2;
+    return static_cast<long long>(raw);
   };
   for (const PlyElement& e : layout.elements) {
     const bool has_list = std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.list; });
@@ -192,45 +252,133 @@ void check_ply_body(const std::string& path, std::istream& in, const PlyLayout& 
           continue;
         }
         need(static_cast<unsigned long long>(p.count_bytes));
-        unsigned char b[4] = {};
-        std::memcpy(b, body.data() + at, static_cast<std::size_t>(p.count_bytes));
+        const long long n = integer(p.count_bytes, p.count_signed);
         at += static_cast<std::size_t>(p.count_bytes);
-        if (layout.big_endian) std::reverse(b, b + p.count_bytes);
-        std::uint32_t raw = 0;
-        for (int k = p.count_bytes - 1; k >= 0; --k) raw = (raw << 8) | b[k];
-        long long n = raw;
-        if (p.count_signed && (raw >> (8 * p.count_bytes - 1)) & 1u) n = -1;
         if (n < 0) throw InputError(path, "PLY list count is negative");
         need(static_cast<unsigned long long>(n) * static_cast<unsigned long long>(p.item_bytes));
-        at += static_cast<std::size_t>(n) * static_cast<std::size_t>(p.item_bytes);
+        if (p.corners) {
+          count_face(static_cast<unsigned long long>(n));
+          for (long long k = 0; k < n; ++k)
+            corner(integer(p.item_bytes, p.item_signed), i, static_cast<unsigned long long>(k)),
+                at += static_cast<std::size_t>(p.item_bytes);
+        } else {
+          at += static_cast<std::size_t>(n) * static_cast<std::size_t>(p.item_bytes);
+        }
       }
   }
+  return faces;
+}
+
+// An ASCII STL walked before OpenMesh reads it, which takes a word where a number belongs as
+// 0 and keeps only three vertices of a facet: the grammar of the format ("solid name",
+// then per facet "facet normal ni nj nk", "outer loop", exactly three "vertex x y z",
+// "endloop", "endfacet"; "endsolid name"), every vertex coordinate a finite number.
+void check_ascii_stl(const std::string& path, std::istream& in) {
+  std::string line;
+  unsigned long long lineno = 0, facets = 0;
+  enum { kSolid, kFacet, kOuter, kVertex, kEndLoop, kEndFacet } want = kSolid;
+  int vertices = 0;
+  auto bad = [&](const std::string& what) {
+    throw InputError(path, "ASCII STL line " + std::to_string(lineno) + ": " + what);
+  };
+  auto numbers = [&](std::istringstream& ls, const char* what, bool finite) {
+    for (int k = 0; k < 3; ++k) {
+      std::string tok;
+      if (!(ls >> tok)) bad(std::string(what) + " needs 3 numbers");
+      char* stop = nullptr;
+      const double x = std::strtod(tok.c_str(), &stop);
+      if (*stop != '\0' || stop == tok.c_str()) bad(std::string(what) + " '" + tok.substr(0, 20) + "' is not a number");
+      if (finite && !(std::fabs(x) < double(std::numeric_limits<float>::max())))
+        bad("non-finite vertex (coordinate '" + tok.substr(0, 20) + "' is NaN, infinite or overflows a float)");
+    }
+  };
+  while (std::getline(in, line)) {
+    ++lineno;
+    std::istringstream ls(line);
+    std::string w;
+    if (!(ls >> w)) continue;
+    std::transform(w.begin(), w.end(), w.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::string w2;
+    switch (want) {
+      case kSolid:
+        if (w != "solid") bad("expected 'solid', found '" + w.substr(0, 20) + "'");
+        want = kFacet;
+        continue;  // the rest of the line is the solid's name
+      case kFacet:
+        if (w == "endsolid") {
+          want = kSolid;
+          continue;
+        }
+        if (w != "facet" || !(ls >> w2) || w2 != "normal") bad("expected 'facet normal' or 'endsolid'");
+        numbers(ls, "facet normal", false);  // the normal is recomputed: NaN is harmless
+        if (++facets > kMaxSceneTriangles)
+          throw InputError(path, "more than the limit of " + std::to_string(kMaxSceneTriangles) + " facets (2^24)");
+        want = kOuter;
+        break;
+      case kOuter:
+        if (w != "outer" || !(ls >> w2) || w2 != "loop") bad("expected 'outer loop'");
+        want = kVertex;
+        vertices = 0;
+        break;
+      case kVertex:
+        if (w == "endloop") bad("a facet has " + std::to_string(vertices) + " vertices, not 3");
+        if (w != "vertex") bad("expected 'vertex'");
+        numbers(ls, "vertex", true);
+        if (++vertices == 3) want = kEndLoop;
+        break;
+      case kEndLoop:
+        if (w == "vertex") bad("a facet has more than 3 vertices");
+        if (w != "endloop") bad("expected 'endloop'");
+        want = kEndFacet;
+        break;
+      case kEndFacet:
+        if (w != "endfacet") bad("expected 'endfacet'");
+        want = kFacet;
+        break;
+    }
+    if (ls >> w2) bad("unexpected '" + w2.substr(0, 20) + "' at the end of the line");
+  }
+  // A file that stops between facets without "endsolid" is accepted (some exporters omit it).
+  if (want != kSolid && want != kFacet) throw InputError(path, "ASCII STL is truncated inside a facet");
+  if (facets == 0) throw InputError(path, "contains no faces (no facets)");
 }
 
 // Rejects headers that promise more elements than the file could hold (each vertex or
-// face takes at least a few bytes in every encoding).
-void check_declared_counts(const std::string& path, const std::string& ext, std::uintmax_t size) {
+// face takes at least a few bytes in every encoding) and bodies that break the format.
+PlyFaces check_declared_counts(const std::string& path, const std::string& ext, std::uintmax_t size) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open file");
   if (ext == ".ply") {
     const PlyLayout layout = check_ply_header(path, in, size);
-    check_ply_body(path, in, layout);
-  } else if (ext == ".stl") {
+    return check_ply_body(path, in, layout);
+  }
+  if (ext == ".stl") {
     char head[84] = {};
     in.read(head, 84);
-    const bool ascii = std::string(head, std::min<std::streamsize>(in.gcount(), 5)) == "solid";
-    if (!ascii) {
+    const bool solid = std::string(head, std::min<std::streamsize>(in.gcount(), 5)) == "solid";
+    std::uint32_t n = 0;
+    if (in.gcount() == 84) std::memcpy(&n, head + 80, 4);
+    // Binary exactly when the size is that of the declared triangles (how OpenMesh tells
+    // them apart too): binary files may begin with "solid" as well.
+    const bool binary = in.gcount() == 84 && 84 + 50ull * n == size;
+    if (!binary && solid) {
+      in.clear();
+      in.seekg(0);
+      check_ascii_stl(path, in);
+    } else if (!binary) {
       if (in.gcount() < 84) throw InputError(path, "truncated binary STL header");
-      std::uint32_t n = 0;
-      std::memcpy(&n, head + 80, 4);
       if (n > kMaxSceneTriangles)
         throw InputError(path, "binary STL declares " + std::to_string(n) + " triangles: more than the limit of " +
                                    std::to_string(kMaxSceneTriangles) + " (2^24)");
-      if (84 + 50ull * n > size)
-        throw InputError(path, "binary STL declares " + std::to_string(n) +
-                                   " triangles but the file is truncated");
+      throw InputError(path, "binary STL declares " + std::to_string(n) + " triangles (" +
+                                 std::to_string(84 + 50ull * n) + " bytes) but the file has " + std::to_string(size) +
+                                 (84 + 50ull * n > size ? " (truncated)" : ""));
+    } else if (n > kMaxSceneTriangles) {
+      throw InputError(path, "binary STL declares " + std::to_string(n) + " triangles: more than the limit of " +
+                                 std::to_string(kMaxSceneTriangles) + " (2^24)");
     }
   }
+  return {};
 }
 
 struct SilenceOpenMesh {
@@ -410,10 +558,17 @@ Scene load_mesh_file(const std::string& path, LoadReport* report) {
     return scene;
   }
   static const SilenceOpenMesh silence;
-  check_declared_counts(path, lower_ext(path), size);
+  const PlyFaces ply = check_declared_counts(path, lower_ext(path), size);
   OmMesh om;
   OpenMesh::IO::Options opt;
   read_with_openmesh(path, om, opt);
+  if (report && ply.short_faces)
+    report->warn(std::to_string(ply.short_faces) + " faces with fewer than 3 corners left out");
+  // OpenMesh refuses faces it cannot add to its half-edge mesh (a corner repeated, say):
+  // say how many rather than render holes quietly.
+  if (report && ply.triangles > om.n_faces())
+    report->warn(std::to_string(ply.triangles - om.n_faces()) +
+                 " triangles left out (degenerate faces OpenMesh refuses)");
 
   Scene scene;
   scene.name = path;

@@ -245,20 +245,45 @@ std::vector<std::string> lines_of(const std::string& text) {
 }
 
 // tinyobjloader reads a coordinate it cannot parse ("nan", "inf", a word) as 0, which
-// would move the vertex silently: every `v` line's coordinates must start with a finite
-// number (as strtod reads it; a trailing oddity such as assimp's "3.1+e2" reads as 3.1).
+// would move the vertex silently: every `v` line's three coordinates (the OBJ format's
+// "v x y z [w]") must start with a finite number (as strtod reads it; a trailing oddity
+// such as assimp's "3.1+e2" reads as 3.1). It also reads face indices with atoi, so an
+// index past the int range wraps to any vertex: every `f` corner's indices ("v", "v/vt",
+// "v//vn", "v/vt/vn") must be integers of at most 10 digits.
 void check_vertex_lines(const std::string& path, const std::string& text) {
-  std::size_t vertex = 0, at = 0;
+  std::size_t vertex = 0, at = 0, line = 0;
   while (at < text.size()) {
     std::size_t end = text.find('\n', at);
     if (end == std::string::npos) end = text.size();
     std::size_t p = text.find_first_not_of(" \t", at);
     // p is npos when only blanks are left (p + 1 would wrap to 0).
+    ++line;
+    if (p != std::string::npos && p + 1 < end && text[p] == 'f' && (text[p + 1] == ' ' || text[p + 1] == '\t')) {
+      std::istringstream ls(text.substr(p + 2, end - p - 2));
+      for (std::string corner; ls >> corner;) {
+        std::size_t from = 0;
+        for (int k = 0; k < 3 && from <= corner.size(); ++k) {
+          std::size_t to = corner.find('/', from);
+          if (to == std::string::npos) to = corner.size();
+          const std::string index = corner.substr(from, to - from);
+          const std::size_t digits = index.size() - (index[0] == '-' ? 1 : 0);
+          if (!index.empty() && (digits == 0 || digits > 10 ||
+                                 index.find_first_not_of("0123456789", index[0] == '-' ? 1 : 0) != std::string::npos ||
+                                 std::stoll(index) > 2147483647ll || std::stoll(index) < -2147483647ll))
+            throw InputError(path, "line " + std::to_string(line) + ": face index '" + index.substr(0, 20) +
+                                       "' is not an integer within the int range");
+          from = to + 1;
+        }
+      }
+    }
     if (p != std::string::npos && p + 1 < end && text[p] == 'v' && (text[p + 1] == ' ' || text[p + 1] == '\t')) {
       ++vertex;
       std::istringstream ls(text.substr(p + 2, end - p - 2));
       std::string token;
-      for (int k = 0; k < 3 && ls >> token; ++k) {
+      for (int k = 0; k < 3; ++k) {
+        if (!(ls >> token))
+          throw InputError(path, "vertex " + std::to_string(vertex) + " has " + std::to_string(k) +
+                                     " coordinates (OBJ's v line needs x y z)");
         char* stop = nullptr;
         const double x = std::strtod(token.c_str(), &stop);
         // A value past a float's range overflows to infinity when tinyobjloader reads it.
@@ -310,7 +335,14 @@ Scene load_obj(const std::string& path, LoadReport& report) {
   for (const std::string& p : reader.problems()) report.substitute(path, p);
   // tinyobjloader's own warnings; a usemtl naming no material is reported in our words,
   // and not at all when the library itself is missing (that warning says it already).
+  std::size_t degenerate = 0;
   for (const std::string& w : lines_of(warn)) {
+    // tinyobjloader's "Degenerated face found\n." for each face of fewer than 3 corners.
+    if (w.rfind("Degenerated face found", 0) == 0) {
+      ++degenerate;
+      continue;
+    }
+    if (w == ".") continue;
     if (w.find("Material file") != std::string::npos || w.find("Failed to load material file") != std::string::npos)
       continue;
     const std::size_t open = w.find("[ '"), close = w.find("' ] not found in .mtl");
@@ -323,6 +355,7 @@ Scene load_obj(const std::string& path, LoadReport& report) {
     }
     report.warn(w);
   }
+  if (degenerate) report.warn(std::to_string(degenerate) + " faces with fewer than 3 corners left out");
 
   Scene scene;
   scene.name = path;

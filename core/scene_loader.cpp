@@ -2,6 +2,7 @@
 #include "core/scene_loader.h"
 
 #include <algorithm>
+#include <set>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -73,6 +74,7 @@ BuiltinSpec parse_builtin_spec(const std::string& spec, std::uint64_t default_si
     std::string rest = spec.substr(colon + 1);
     std::replace(rest.begin(), rest.end(), ':', ',');
     std::size_t at = 0;
+    std::set<std::string> seen;
     while (at <= rest.size()) {
       const std::size_t end = std::min(rest.find(',', at), rest.size());
       const std::string item = rest.substr(at, end - at);
@@ -81,9 +83,12 @@ BuiltinSpec parse_builtin_spec(const std::string& spec, std::uint64_t default_si
       const std::size_t eq = item.find('=');
       if (eq == std::string::npos) throw InputError(spec, "expected key=value, got '" + item + "'");
       const std::string key = item.substr(0, eq);
+      // A key given twice is a typo or a generated spec gone wrong: which one was meant is unknowable.
+      if (!seen.insert(key).second) throw InputError(spec, "option '" + key + "' is given twice");
       const double value = parse_number(spec, key, item.substr(eq + 1));
       if (key == "size") {
         if (value < 0 || value > 1e12) throw InputError(spec, "size out of range");
+        if (value != std::floor(value)) throw InputError(spec, "size must be a whole number");
         params.size = static_cast<std::uint64_t>(value);
       } else if (takes_option(def->extra_params, key)) {
         params.extra[key] = value;
