@@ -61,9 +61,11 @@ std::set<std::string> extensions_used(const json& doc) {
   return used;
 }
 
-// Exact equality, float bits included (so -0.0 vs 0.0 or a rounding would fail).
+// Exact equality, float bits included (so -0.0 vs 0.0 or a rounding would fail). memcmp may
+// not be given the null data() of an empty vector, even for zero bytes.
 bool same_bits(const std::vector<glm::vec4>& a, const std::vector<glm::vec4>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec4)) == 0;
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec4)) == 0);
 }
 
 void expect_same_environment(const Environment& back, const Environment& src) {
