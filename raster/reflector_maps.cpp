@@ -184,6 +184,15 @@ unsigned faces_read(par::Executor& executor, const GBuffer& g, const std::vector
   return mask;
 }
 
+std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& g) {
+  std::vector<std::uint8_t> seen(scene.objects.size(), 0);
+  for (std::size_t i = 0; i < g.object.size(); ++i) {
+    const std::uint32_t o = g.object.pixels[i];
+    if (g.covered(i) && o < seen.size() && is_specular(g.surface.pixels[i])) seen[o] = 1;
+  }
+  return seen;
+}
+
 std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, const GBuffer& g, int size) {
   std::vector<int> sizes(scene.objects.size(), 0);
   std::vector<float> need(g.object.size());
@@ -194,14 +203,13 @@ std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, co
   // Per object, in sample order (serial: the lists and their quantiles do not depend on the
   // thread count).
   std::vector<std::vector<float>> per_object(scene.objects.size());
-  std::vector<std::uint8_t> seen(scene.objects.size(), 0);
+  const std::vector<std::uint8_t> seen = seen_reflectors(scene, g);
   for (std::size_t i = 0; i < need.size(); ++i) {
     if (!g.covered(i)) continue;
     const std::uint32_t o = g.object.pixels[i];
     if (o >= scene.objects.size()) continue;
     const SurfaceParams& s = g.surface.pixels[i];
     if (!is_specular(s)) continue;
-    seen[o] = 1;
     // A refractor's sample, or a specular sample with no neighbour on its object: need 0
     // (the cap) for refractors; a lone sample is no evidence either way and is left out.
     if (s.is_refractor()) per_object[o].push_back(0.0f);
@@ -241,9 +249,12 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const MapSizing& sizing) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
+  // Seen reflectors alone need one pass over the samples; sizes need every sample's
+  // neighbours as well, so they are computed only where they are used.
+  std::vector<std::uint8_t> seen_by_camera;
+  if (camera_view && sizing.skip_unseen) seen_by_camera = seen_reflectors(scene, *camera_view);
   std::vector<int> sizes;
-  if (camera_view && (sizing.from_footprint || sizing.skip_unseen))
-    sizes = footprint_sizes(executor, scene, *camera_view, size);
+  if (camera_view && sizing.from_footprint) sizes = footprint_sizes(executor, scene, *camera_view, size);
   // Each object's camera samples, in sample order, for the faces its readers reach.
   std::vector<std::vector<std::uint32_t>> samples_of;
   if (camera_view && sizing.reads != MapSizing::Reads::anywhere) {
@@ -277,10 +288,8 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
       continue;
     if (which == ReflectorSelection::refractors && !refracts) continue;
     int side = size;
-    if (!sizes.empty()) {
-      if (sizing.skip_unseen && sizes[o] == 0) continue;
-      if (sizing.from_footprint && sizes[o] > 0) side = sizes[o];
-    }
+    if (!seen_by_camera.empty() && !seen_by_camera[o]) continue;
+    if (!sizes.empty() && sizes[o] > 0) side = sizes[o];
     glm::vec3 centre = b.center();
     const glm::vec3 e = b.extent();
     const float smallest = std::min({e.x, e.y, e.z}), largest = std::max({e.x, e.y, e.z});

@@ -66,6 +66,9 @@ unsigned faces_read(par::Executor& executor, const GBuffer& camera_view, const s
                     const glm::vec3& centre, int size, int level_count, const MapSizing& sizing);
 constexpr int kMinFootprintSize = 16;
 
+// 1 for each object with a specular sample in `camera_view` (what `skip_unseen` keeps).
+std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& camera_view);
+
 // The side render_reflector_maps gives each object under `from_footprint` (0: the object
 // reads no map in this view), capped at `size`; exposed for tests.
 std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, const GBuffer& camera_view,
