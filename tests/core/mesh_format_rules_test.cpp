@@ -133,18 +133,18 @@ TEST(MeshFormatRules, AsciiStlFacetsHaveThreeFiniteVertices) {
   EXPECT_EQ(problem(write("no_end.stl", "solid t\n" + kFacet)), "") << "a missing endsolid is tolerated";
   EXPECT_EQ(problem(write("nan_normal.stl", "solid t\nfacet normal nan nan nan\n" + kFacet.substr(kFacet.find("outer")))), "")
       << "the normal is recomputed";
-  std::string nan_vertex = kFacet;
-  nan_vertex.replace(nan_vertex.find("vertex 0 1 0"), 12, "vertex 0 1 nan");
-  EXPECT_PROBLEM(write("nan_vertex.stl", "solid t\n" + nan_vertex), "ASCII STL line 6: non-finite vertex");
-  std::string word = kFacet;
-  word.replace(word.find("vertex 1 0 0"), 12, "vertex 1 0 x");
-  EXPECT_PROBLEM(write("word.stl", "solid t\n" + word), "ASCII STL line 5: vertex 'x' is not a number");
-  std::string four = kFacet;
-  four.replace(four.find("endloop"), 7, "vertex 1 1 0\nendloop");
-  EXPECT_PROBLEM(write("four.stl", "solid t\n" + four), "a facet has more than 3 vertices");
-  std::string two = kFacet;
-  two.replace(two.find("vertex 0 1 0\n"), 13, "");
-  EXPECT_PROBLEM(write("two.stl", "solid t\n" + two), "a facet has 2 vertices, not 3");
+  // kFacet with its first `from` replaced by `to`.
+  const auto facet_with = [](const std::string& from, const std::string& to) {
+    std::string f = kFacet;
+    return f.replace(f.find(from), from.size(), to);
+  };
+  EXPECT_PROBLEM(write("nan_vertex.stl", "solid t\n" + facet_with("vertex 0 1 0", "vertex 0 1 nan")),
+                 "ASCII STL line 6: non-finite vertex");
+  EXPECT_PROBLEM(write("word.stl", "solid t\n" + facet_with("vertex 1 0 0", "vertex 1 0 x")),
+                 "ASCII STL line 5: vertex 'x' is not a number");
+  EXPECT_PROBLEM(write("four.stl", "solid t\n" + facet_with("endloop", "vertex 1 1 0\nendloop")),
+                 "a facet has more than 3 vertices");
+  EXPECT_PROBLEM(write("two.stl", "solid t\n" + facet_with("vertex 0 1 0\n", "")), "a facet has 2 vertices, not 3");
   EXPECT_PROBLEM(write("cut.stl", "solid t\n" + kFacet.substr(0, kFacet.find("vertex"))), "ASCII STL is truncated inside a facet");
   EXPECT_PROBLEM(write("empty_solid.stl", "solid t\nendsolid t\n"), "contains no faces");
 }
