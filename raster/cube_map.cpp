@@ -77,6 +77,13 @@ CubeCoord cube_coord(const glm::vec3& d, int size) {
                  std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
 }
 
+glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size) {
+  const FaceFrame& f = frame(face);
+  const float depth = glm::dot(d, f.forward);
+  const float s = static_cast<float>(size);
+  return {(glm::dot(d, f.right) / depth + 1.0f) * 0.5f * s, (1.0f - glm::dot(d, f.up) / depth) * 0.5f * s};
+}
+
 glm::vec3 cube_direction(int face, glm::vec2 pixel, int size) {
   const FaceFrame& f = frame(face);
   const float s = static_cast<float>(size);
@@ -103,6 +110,45 @@ float CubeMap::distance_towards(const glm::vec3& d) const {
   return distance[c.face].at(x, y);
 }
 
+bool CubeTileMask::covers(int face, int level, int x, int y) const {
+  if (!active()) return true;
+  const std::vector<std::uint8_t>& t = tiles[face];
+  if (t.empty()) return false;
+  const int n = tiles_per_side();
+  // The level-0 texels under level-`level` texel (x, y), and the tiles they fall in.
+  const int x0 = (x << level) / kTile, x1 = std::min(n - 1, (((x + 1) << level) - 1) / kTile);
+  const int y0 = (y << level) / kTile, y1 = std::min(n - 1, (((y + 1) << level) - 1) / kTile);
+  for (int ty = y0; ty <= y1; ++ty)
+    for (int tx = x0; tx <= x1; ++tx)
+      if (t[static_cast<std::size_t>(ty) * n + tx]) return true;
+  return false;
+}
+
+std::vector<std::uint8_t> CubeTileMask::texels(int face) const {
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(size) * size, 0);
+  const std::vector<std::uint8_t>& t = tiles[face];
+  if (t.empty()) return out;
+  const int n = tiles_per_side();
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x)
+      out[static_cast<std::size_t>(y) * size + x] = t[static_cast<std::size_t>(y / kTile) * n + x / kTile];
+  return out;
+}
+
+double CubeTileMask::texel_count(unsigned face_mask) const {
+  double count = 0.0;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    if (!((face_mask >> f) & 1u)) continue;
+    if (!active()) {
+      count += double(size) * size;
+      continue;
+    }
+    const std::vector<std::uint8_t> t = texels(f);
+    for (const std::uint8_t v : t) count += v;
+  }
+  return count;
+}
+
 CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
                         const CubeMapOptions& options, const CubeFaceShader& shade) {
   CubeMap cube;
@@ -115,8 +161,16 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
       continue;
     }
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
-    const VisibilityBuffer vis =
-        render_visibility(executor, scene, cam, options.size, options.size, options.raster);
+    VisibilityBuffer vis = render_visibility(executor, scene, cam, options.size, options.size, options.raster);
+    // Texels no reader reaches become background: not resolved, not shaded.
+    std::vector<std::uint8_t> read;
+    if (options.tiles && options.tiles->active()) {
+      read = options.tiles->texels(face);
+      executor.parallel_for("cube_map.unread", read.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+          if (!read[i]) vis.triangle.pixels[i] = vis.object.pixels[i] = kNoId;
+      });
+    }
     ImageF& dist = cube.distance[face];
     dist = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
     executor.parallel_for("cube_map.distance", dist.size(), 4096,
@@ -127,7 +181,7 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
                                     visible_position(scene.mesh, vis, i) - centre);
                           });
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
-    if (shade) cube.colour[face] = shade(resolve_gbuffer(executor, scene, vis, centre), cam);
+    if (shade) cube.colour[face] = shade(resolve_gbuffer(executor, scene, vis, centre), cam, face, read.empty() ? nullptr : &read);
   }
   return cube;
 }

@@ -4,7 +4,9 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <functional>
+#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -31,6 +33,10 @@ struct CubeCoord {
   glm::vec2 pixel{0.0f};
 };
 CubeCoord cube_coord(const glm::vec3& d, int size);
+// Continuous pixel coordinates of direction d on the plane of face `face` (any face whose axis
+// d makes an acute angle with: not clamped to the face, no face chosen), so that a
+// neighbourhood of d can be bounded on a face next to the one d lands on.
+glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size);
 // The direction through continuous pixel coordinates of a face (unit length).
 glm::vec3 cube_direction(int face, glm::vec2 pixel, int size);
 
@@ -46,8 +52,29 @@ struct CubeMap {
   float distance_towards(const glm::vec3& d) const;
 };
 
-// Colour of one face from its G-buffer; background samples (object == kNoId) too.
-using CubeFaceShader = std::function<ImageRGBA(const GBuffer&, const Camera&)>;
+// Which texels of each face a map's readers can reach, in square tiles of kTile level-0
+// texels: a refinement of CubeMapOptions::face_mask for maps whose reads are known (the
+// directions a frame looks up; reflector_maps.h). A texel outside every read tile is never
+// read at any level, so it need not be shaded or prefiltered.
+struct CubeTileMask {
+  static constexpr int kTile = 8;
+  int size = 0;  // level-0 side; 0: no mask (every texel of the faces in face_mask)
+  std::array<std::vector<std::uint8_t>, kCubeFaces> tiles;  // tiles_per_side()² per face, 1: read
+
+  bool active() const { return size > 0; }
+  int tiles_per_side() const { return (size + kTile - 1) / kTile; }
+  // Level-`level` texel (x, y) of `face` (a side of size >> level) overlaps a read tile.
+  bool covers(int face, int level, int x, int y) const;
+  // The level-0 texels of `face` in read tiles, one byte each (1: read), row-major.
+  std::vector<std::uint8_t> texels(int face) const;
+  // Level-0 texels in read tiles, over the faces in `face_mask`.
+  double texel_count(unsigned face_mask) const;
+};
+
+// Colour of face `face` from its G-buffer; background samples (object == kNoId) too. `read`
+// (null: every texel) flags the texels a reader can reach: the others may be left black.
+using CubeFaceShader = std::function<ImageRGBA(const GBuffer&, const Camera&, int face,
+                                               const std::vector<std::uint8_t>* read)>;
 
 // Near and far planes of a cube map rendered from a point inside or just beside a region
 // whose bounding-box diagonal is `extent`: no point of the region is farther than about one
@@ -68,8 +95,11 @@ struct CubeMapOptions {
   float zfar = 1000.0f;
   RasterOptions raster;  // e.g. excluded_objects: leave the reflector out of its own map
   // Bit f: render face f. The others are left black with distance +inf, for a map whose
-  // readers provably never look there (reflector_maps.h MapSizing::cull_faces).
+  // readers provably never look there (reflector_maps.h MapSizing::reads).
   unsigned face_mask = 0x3fu;
+  // Within the faces rendered, only the texels of the read tiles are resolved and shaded
+  // (null or inactive: all); the others hold distance +inf and black.
+  const CubeTileMask* tiles = nullptr;
 
   void set_depth_range(const CubeDepthRange& range) {
     znear = range.znear;

@@ -77,7 +77,7 @@ EnvironmentMap build_environment(par::Executor& executor, const Environment& env
 
 EnvironmentMap environment_from_faces(par::Executor& executor,
                                       std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
-                                      int level_count, unsigned face_mask) {
+                                      int level_count, unsigned face_mask, const CubeTileMask* tiles) {
   EnvironmentMap map;
   const int size = faces[0].width;
   map.size = size;
@@ -101,6 +101,7 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
       executor.parallel_for("environment.prefilter", img.size(), 256,
                             [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
+          if (tiles && !tiles->covers(face, l, static_cast<int>(i % s), static_cast<int>(i / s))) continue;
           const glm::vec3 axis = cube_direction(face, {i % s + 0.5f, i / s + 0.5f}, s);
           const Onb onb(axis);
           glm::vec3 sum(0.0f);

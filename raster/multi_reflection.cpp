@@ -12,7 +12,8 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
                                       const std::vector<ShadowMap>& shadows,
                                       const EnvironmentMap& env, const ReflectorMaps& current,
                                       const DistanceSearchOptions& options,
-                                      DistanceReflectStats* stats) {
+                                      DistanceReflectStats* stats,
+                                      const std::vector<MapFaceLayers>* layers) {
   ReflectorMaps next;
   next.map_of_object = current.map_of_object;
   next.centres = current.centres;
@@ -24,6 +25,27 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
   for (std::size_t o = 0; o < current.map_of_object.size(); ++o) {
     const int m = current.map_of_object[o];
     if (m < 0) continue;
+    if (layers && static_cast<std::size_t>(m) < layers->size()) {
+      const MapFaceLayers& kept = (*layers)[m];
+      const CubeMap& was = current.cubes[m];
+      CubeMap cube;
+      cube.size = was.size;
+      cube.centre = was.centre;
+      cube.distance = was.distance;
+      for (int f = 0; f < kCubeFaces; ++f) {
+        ImageRGBA specular(was.size, was.size, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+        if (kept.direct[f].size() == 0) {  // a face render_cube_map left out: black
+          cube.colour[f] = std::move(specular);
+          continue;
+        }
+        const ImageRGBA seen = distance_map_reflect(executor, kept.specular[f], env, current, face_search, stats);
+        for (std::size_t k = 0; k < kept.specular_texel[f].size(); ++k)
+          specular.pixels[kept.specular_texel[f][k]] = seen.pixels[k];
+        cube.colour[f] = composite(executor, kept.direct[f], specular);
+      }
+      next.cubes.push_back(std::move(cube));
+      continue;
+    }
     // Same cube set-up as render_reflector_maps (reflector_maps.cpp).
     CubeMapOptions opt;
     opt.size = current.cubes[m].size;
@@ -31,7 +53,7 @@ ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scen
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;
     next.cubes.push_back(render_cube_map(
-        executor, scene, current.centres[m], opt, [&](const GBuffer& g, const Camera& cam) {
+        executor, scene, current.centres[m], opt, [&](const GBuffer& g, const Camera& cam, int, const std::vector<std::uint8_t>*) {
           return composite(executor, direct_light(executor, scene, g, cam, shadows, env),
                            distance_map_reflect(executor, g, env, current, face_search, stats));
         }));
@@ -50,9 +72,11 @@ ReflectorMaps render_multi_reflection_maps(par::Executor& executor, const Scene&
                                            const GBuffer* camera_view, int rounds,
                                            const DistanceSearchOptions& options,
                                            DistanceReflectStats* stats) {
-  ReflectorMaps maps = render_reflector_maps(executor, scene, shadows, env, size, camera_view);
+  std::vector<MapFaceLayers> layers;
+  ReflectorMaps maps = render_reflector_maps(executor, scene, shadows, env, size, camera_view, ReflectorSelection::all,
+                                             {}, nullptr, {}, rounds > 1 ? &layers : nullptr);
   for (int k = 1; k < rounds; ++k)
-    maps = rerender_reflector_maps(executor, scene, shadows, env, maps, options, stats);
+    maps = rerender_reflector_maps(executor, scene, shadows, env, maps, options, stats, &layers);
   return maps;
 }
 
