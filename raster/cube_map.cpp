@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -75,6 +76,24 @@ CubeCoord cube_coord(const glm::vec3& d, int size) {
   const float s = static_cast<float>(size);
   return {face, {std::clamp((ndc_x + 1.0f) * 0.5f * s, 0.0f, s),
                  std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
+}
+
+CubeFaceAxes cube_face_axes(int face) {
+  const FaceFrame& f = frame(face);
+  const auto axis = [](const glm::vec3& v, int& index, float& sign) {
+    index = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (v[k] == 0.0f) continue;
+      if (index >= 0 || std::fabs(v[k]) != 1.0f) throw std::logic_error("cube face frame is not axis-aligned");
+      index = k;
+      sign = v[k];
+    }
+  };
+  CubeFaceAxes a;
+  axis(f.forward, a.forward, a.forward_sign);
+  axis(f.right, a.right, a.right_sign);
+  axis(f.up, a.up, a.up_sign);
+  return a;
 }
 
 glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size) {

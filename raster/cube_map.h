@@ -33,6 +33,14 @@ struct CubeCoord {
   glm::vec2 pixel{0.0f};
 };
 CubeCoord cube_coord(const glm::vec3& d, int size);
+// The axes of face `face`'s frame (forward, right, up): each is a signed unit axis, so a dot
+// product with it is one signed component (up to the sign of a zero).
+struct CubeFaceAxes {
+  int forward = 0, right = 0, up = 0;                       // axis index 0..2
+  float forward_sign = 1.0f, right_sign = 1.0f, up_sign = 1.0f;
+};
+CubeFaceAxes cube_face_axes(int face);
+
 // Continuous pixel coordinates of direction d on the plane of face `face` (any face whose axis
 // d makes an acute angle with: not clamped to the face, no face chosen), so that a
 // neighbourhood of d can be bounded on a face next to the one d lands on.
