@@ -714,8 +714,10 @@ ReflectorMaps CausticReflectorMapsPass::operator()(par::NodeContext& c, const Sh
       c.executor(), *scene, shadows, environment, size, &gbuffer, ReflectorSelection::all,
       [&](const GBuffer& face, const ImageRGBA& direct) {
         return gather_caustics(c.executor(), face, caustics, direct, tolerance);
-      });
+      },
+      nullptr, sizing);
   c.count("cube_maps", static_cast<double>(maps.cubes.size()));
+  c.count("cube_texels", rendered_texels(maps));
   return maps;
 }
 

@@ -421,6 +421,16 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
+    if (!sizing.colour_read) {
+      out.map_of_object[o] = static_cast<int>(out.cubes.size());
+      out.cubes.push_back(render_cube_map(executor, scene, centre, opt));
+      out.maps.emplace_back();
+      out.centres.push_back(centre);
+      out.faces.push_back(opt.face_mask);
+      out.tiles.emplace_back();
+      if (layers) layers->emplace_back();
+      continue;
+    }
     MapFaceLayers kept;
     CubeMap cube = render_cube_map(
         executor, scene, centre, opt, [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* read) {

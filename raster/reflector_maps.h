@@ -24,7 +24,8 @@ namespace speculum::raster {
 struct ReflectorMaps {
   std::vector<int> map_of_object;     // per object: index into maps, -1 when not a reflector
   std::vector<CubeMap> cubes;         // colour + distance, as rendered
-  std::vector<EnvironmentMap> maps;   // the same colour, prefiltered for lookups
+  std::vector<EnvironmentMap> maps;   // the same colour, prefiltered for lookups (no levels
+                                      // when only distances are read: MapSizing::colour_read)
   std::vector<glm::vec3> centres;     // reference point o of each map
   std::vector<unsigned> faces;        // bit f: face f rendered (the others black, never read)
   std::vector<CubeTileMask> tiles;    // per map: within those faces, the tiles rendered
@@ -71,6 +72,10 @@ struct MapSizing {
   // every face.
   enum class Reads { anywhere, direction, search } reads = Reads::anywhere;
   int lobe_directions = 8;  // search: sub-lobe searches per glossy lobe (distance_map_reflect)
+  // Whether anything reads the maps' colour. When only their distances are searched (the
+  // caustics' photons, SURVEY §6.1), no face is resolved or shaded and nothing is prefiltered:
+  // the cubes hold distances alone.
+  bool colour_read = true;
 };
 
 // Bit f set: face f of a map centred at `centre` is read by the camera samples `samples` of
@@ -142,6 +147,7 @@ struct ReflectorCubeMapsPass {
     p.set("reflectors", to_string(which));
     p.set("footprint_size", sizing.from_footprint ? 1 : 0);
     p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
+    if (!sizing.colour_read) p.set("colour", "none (distances only)");
     p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all"
                    : sizing.reads == MapSizing::Reads::direction ? "read along R" : "read by searches");
   }
