@@ -63,21 +63,6 @@ CubeDepthRange scene_cube_depth_range(const Scene& scene) {
   return cube_depth_range(all.valid() ? glm::length(all.extent()) : 1.0f);
 }
 
-CubeCoord cube_coord(const glm::vec3& d, int size) {
-  const glm::vec3 a = glm::abs(d);
-  int face;
-  if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
-  else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
-  else face = d.z >= 0.0f ? 4 : 5;
-  const FaceFrame& f = frame(face);
-  const float depth = glm::dot(d, f.forward);
-  const float ndc_x = glm::dot(d, f.right) / depth;
-  const float ndc_y = glm::dot(d, f.up) / depth;
-  const float s = static_cast<float>(size);
-  return {face, {std::clamp((ndc_x + 1.0f) * 0.5f * s, 0.0f, s),
-                 std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
-}
-
 CubeFaceAxes cube_face_axes(int face) {
   const FaceFrame& f = frame(face);
   const auto axis = [](const glm::vec3& v, int& index, float& sign) {
@@ -96,6 +81,30 @@ CubeFaceAxes cube_face_axes(int face) {
   return a;
 }
 
+namespace {
+// Initialized after kFrames (same translation unit, in order).
+const std::array<CubeFaceAxes, kCubeFaces> kAxes = {cube_face_axes(0), cube_face_axes(1), cube_face_axes(2),
+                                                    cube_face_axes(3), cube_face_axes(4), cube_face_axes(5)};
+}  // namespace
+
+CubeCoord cube_coord(const glm::vec3& d, int size) {
+  const glm::vec3 a = glm::abs(d);
+  int face;
+  if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
+  else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
+  else face = d.z >= 0.0f ? 4 : 5;
+  // The frame's axes are signed unit axes, so each dot product with them is one signed
+  // component: the same value (up to the sign of a zero, which the +1 below removes) for a
+  // fraction of the work — this runs for every shadow tap, map lookup and search step.
+  const CubeFaceAxes& f = kAxes[face];
+  const float depth = f.forward_sign * d[f.forward];
+  const float ndc_x = f.right_sign * d[f.right] / depth;
+  const float ndc_y = f.up_sign * d[f.up] / depth;
+  const float s = static_cast<float>(size);
+  return {face, {std::clamp((ndc_x + 1.0f) * 0.5f * s, 0.0f, s),
+                 std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
+}
+
 glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size) {
   const FaceFrame& f = frame(face);
   const float depth = glm::dot(d, f.forward);
@@ -110,8 +119,7 @@ glm::vec3 cube_direction(int face, glm::vec2 pixel, int size) {
   return glm::normalize(f.forward + f.right * ndc_x + f.up * ndc_y);
 }
 
-glm::vec4 CubeMap::colour_towards(const glm::vec3& d) const {
-  const CubeCoord c = cube_coord(d, size);
+glm::vec4 CubeMap::colour_at(const CubeCoord& c) const {
   const ImageRGBA& img = colour[c.face];
   const float fx = std::clamp(c.pixel.x - 0.5f, 0.0f, float(size - 1));
   const float fy = std::clamp(c.pixel.y - 0.5f, 0.0f, float(size - 1));
@@ -122,8 +130,7 @@ glm::vec4 CubeMap::colour_towards(const glm::vec3& d) const {
          (img.at(x0, y1) * (1 - tx) + img.at(x1, y1) * tx) * ty;
 }
 
-float CubeMap::distance_towards(const glm::vec3& d) const {
-  const CubeCoord c = cube_coord(d, size);
+float CubeMap::distance_at(const CubeCoord& c) const {
   const int x = std::min(static_cast<int>(c.pixel.x), size - 1);
   const int y = std::min(static_cast<int>(c.pixel.y), size - 1);
   return distance[c.face].at(x, y);

@@ -55,9 +55,12 @@ struct CubeMap {
   std::array<ImageF, kCubeFaces> distance;    // |y − o|, +inf where nothing was hit
 
   // Bilinear colour towards d (clamped at face borders).
-  glm::vec4 colour_towards(const glm::vec3& d) const;
+  glm::vec4 colour_towards(const glm::vec3& d) const { return colour_at(cube_coord(d, size)); }
   // Nearest-texel distance towards d.
-  float distance_towards(const glm::vec3& d) const;
+  float distance_towards(const glm::vec3& d) const { return distance_at(cube_coord(d, size)); }
+  // The same at a direction's cube_coord(d, size), for a caller that needs it more than once.
+  glm::vec4 colour_at(const CubeCoord& c) const;
+  float distance_at(const CubeCoord& c) const;
 };
 
 // Which texels of each face a map's readers can reach, in square tiles of kTile level-0
