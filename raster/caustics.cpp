@@ -657,7 +657,8 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
         const glm::vec3 d = p - m.centre;
         const float dist = glm::length(d);
         if (!(dist > 0.0f)) continue;
-        const float stored = m.distance_towards(d);
+        const CubeCoord c = cube_coord(d, m.size);  // once for the distance, the texel and the colour
+        const float stored = m.distance_at(c);
         // The shadow-map-like test: only the receiver the photons found is lit. Across one
         // texel (angle ≈ 2/size) a receiver at angle α to the line of sight from the centre
         // changes its distance by about d (2/size) tanα, so grazing receivers are allowed
@@ -666,10 +667,9 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
         const float tan_view = std::min(16.0f, std::sqrt(std::max(0.0f, 1.0f - cos_view * cos_view)) / std::max(cos_view, 1e-3f));
         const float slack = tolerance * stored + 2.0f * dist * tan_view * (2.0f / static_cast<float>(m.size));
         if (!std::isfinite(stored) || std::fabs(dist - stored) > slack) continue;
-        const CubeCoord c = cube_coord(d, m.size);
         const int x = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
         const int y = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
-        const glm::vec3 flux = glm::vec3(m.colour_towards(d));
+        const glm::vec3 flux = glm::vec3(m.colour_at(c));
         const glm::vec3 wi = maps.incident[k][c.face].at(x, y);
         // The texel's flux lands on the receiver area Ω d² / |cosα| it subtends (α between
         // the normal and the line from the centre): irradiance Φ |cosα| / (Ω d²), arriving
@@ -714,8 +714,10 @@ ReflectorMaps CausticReflectorMapsPass::operator()(par::NodeContext& c, const Sh
       c.executor(), *scene, shadows, environment, size, &gbuffer, ReflectorSelection::all,
       [&](const GBuffer& face, const ImageRGBA& direct) {
         return gather_caustics(c.executor(), face, caustics, direct, tolerance);
-      });
+      },
+      nullptr, sizing);
   c.count("cube_maps", static_cast<double>(maps.cubes.size()));
+  c.count("cube_texels", rendered_texels(maps));
   return maps;
 }
 

@@ -179,7 +179,12 @@ struct CausticReflectorMapsPass {
   const Scene* scene = nullptr;
   int size = 256;
   float tolerance = 0.05f;
-  void parameters(par::Params& p) const { p.set("size", size); }
+  MapSizing sizing;  // what the frame reads of them (render_reflector_maps)
+  void parameters(par::Params& p) const {
+    p.set("size", size);
+    p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
+    p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all" : "read by searches");
+  }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
                            const GBuffer& gbuffer, const CausticMaps& caustics) const;
 };

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -62,19 +63,53 @@ CubeDepthRange scene_cube_depth_range(const Scene& scene) {
   return cube_depth_range(all.valid() ? glm::length(all.extent()) : 1.0f);
 }
 
+CubeFaceAxes cube_face_axes(int face) {
+  const FaceFrame& f = frame(face);
+  const auto axis = [](const glm::vec3& v, int& index, float& sign) {
+    index = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (v[k] == 0.0f) continue;
+      if (index >= 0 || std::fabs(v[k]) != 1.0f) throw std::logic_error("cube face frame is not axis-aligned");
+      index = k;
+      sign = v[k];
+    }
+  };
+  CubeFaceAxes a;
+  axis(f.forward, a.forward, a.forward_sign);
+  axis(f.right, a.right, a.right_sign);
+  axis(f.up, a.up, a.up_sign);
+  return a;
+}
+
+namespace {
+// Initialized after kFrames (same translation unit, in order).
+const std::array<CubeFaceAxes, kCubeFaces> kAxes = {cube_face_axes(0), cube_face_axes(1), cube_face_axes(2),
+                                                    cube_face_axes(3), cube_face_axes(4), cube_face_axes(5)};
+}  // namespace
+
 CubeCoord cube_coord(const glm::vec3& d, int size) {
   const glm::vec3 a = glm::abs(d);
   int face;
   if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
   else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
   else face = d.z >= 0.0f ? 4 : 5;
-  const FaceFrame& f = frame(face);
-  const float depth = glm::dot(d, f.forward);
-  const float ndc_x = glm::dot(d, f.right) / depth;
-  const float ndc_y = glm::dot(d, f.up) / depth;
+  // The frame's axes are signed unit axes, so each dot product with them is one signed
+  // component: the same value (up to the sign of a zero, which the +1 below removes) for a
+  // fraction of the work — this runs for every shadow tap, map lookup and search step.
+  const CubeFaceAxes& f = kAxes[face];
+  const float depth = f.forward_sign * d[f.forward];
+  const float ndc_x = f.right_sign * d[f.right] / depth;
+  const float ndc_y = f.up_sign * d[f.up] / depth;
   const float s = static_cast<float>(size);
   return {face, {std::clamp((ndc_x + 1.0f) * 0.5f * s, 0.0f, s),
                  std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
+}
+
+glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size) {
+  const FaceFrame& f = frame(face);
+  const float depth = glm::dot(d, f.forward);
+  const float s = static_cast<float>(size);
+  return {(glm::dot(d, f.right) / depth + 1.0f) * 0.5f * s, (1.0f - glm::dot(d, f.up) / depth) * 0.5f * s};
 }
 
 glm::vec3 cube_direction(int face, glm::vec2 pixel, int size) {
@@ -84,8 +119,7 @@ glm::vec3 cube_direction(int face, glm::vec2 pixel, int size) {
   return glm::normalize(f.forward + f.right * ndc_x + f.up * ndc_y);
 }
 
-glm::vec4 CubeMap::colour_towards(const glm::vec3& d) const {
-  const CubeCoord c = cube_coord(d, size);
+glm::vec4 CubeMap::colour_at(const CubeCoord& c) const {
   const ImageRGBA& img = colour[c.face];
   const float fx = std::clamp(c.pixel.x - 0.5f, 0.0f, float(size - 1));
   const float fy = std::clamp(c.pixel.y - 0.5f, 0.0f, float(size - 1));
@@ -96,11 +130,49 @@ glm::vec4 CubeMap::colour_towards(const glm::vec3& d) const {
          (img.at(x0, y1) * (1 - tx) + img.at(x1, y1) * tx) * ty;
 }
 
-float CubeMap::distance_towards(const glm::vec3& d) const {
-  const CubeCoord c = cube_coord(d, size);
+float CubeMap::distance_at(const CubeCoord& c) const {
   const int x = std::min(static_cast<int>(c.pixel.x), size - 1);
   const int y = std::min(static_cast<int>(c.pixel.y), size - 1);
   return distance[c.face].at(x, y);
+}
+
+bool CubeTileMask::covers(int face, int level, int x, int y) const {
+  if (!active()) return true;
+  const std::vector<std::uint8_t>& t = tiles[face];
+  if (t.empty()) return false;
+  const int n = tiles_per_side();
+  // The level-0 texels under level-`level` texel (x, y), and the tiles they fall in.
+  const int x0 = (x << level) / kTile, x1 = std::min(n - 1, (((x + 1) << level) - 1) / kTile);
+  const int y0 = (y << level) / kTile, y1 = std::min(n - 1, (((y + 1) << level) - 1) / kTile);
+  for (int ty = y0; ty <= y1; ++ty)
+    for (int tx = x0; tx <= x1; ++tx)
+      if (t[static_cast<std::size_t>(ty) * n + tx]) return true;
+  return false;
+}
+
+std::vector<std::uint8_t> CubeTileMask::texels(int face) const {
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(size) * size, 0);
+  const std::vector<std::uint8_t>& t = tiles[face];
+  if (t.empty()) return out;
+  const int n = tiles_per_side();
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x)
+      out[static_cast<std::size_t>(y) * size + x] = t[static_cast<std::size_t>(y / kTile) * n + x / kTile];
+  return out;
+}
+
+double CubeTileMask::texel_count(unsigned face_mask) const {
+  double count = 0.0;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    if (!((face_mask >> f) & 1u)) continue;
+    if (!active()) {
+      count += double(size) * size;
+      continue;
+    }
+    const std::vector<std::uint8_t> t = texels(f);
+    for (const std::uint8_t v : t) count += v;
+  }
+  return count;
 }
 
 CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
@@ -115,8 +187,16 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
       continue;
     }
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
-    const VisibilityBuffer vis =
-        render_visibility(executor, scene, cam, options.size, options.size, options.raster);
+    VisibilityBuffer vis = render_visibility(executor, scene, cam, options.size, options.size, options.raster);
+    // Texels no reader reaches become background: not resolved, not shaded.
+    std::vector<std::uint8_t> read;
+    if (options.tiles && options.tiles->active()) {
+      read = options.tiles->texels(face);
+      executor.parallel_for("cube_map.unread", read.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+          if (!read[i]) vis.triangle.pixels[i] = vis.object.pixels[i] = kNoId;
+      });
+    }
     ImageF& dist = cube.distance[face];
     dist = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
     executor.parallel_for("cube_map.distance", dist.size(), 4096,
@@ -127,7 +207,7 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
                                     visible_position(scene.mesh, vis, i) - centre);
                           });
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
-    if (shade) cube.colour[face] = shade(resolve_gbuffer(executor, scene, vis, centre), cam);
+    if (shade) cube.colour[face] = shade(resolve_gbuffer(executor, scene, vis, centre), cam, face, read.empty() ? nullptr : &read);
   }
   return cube;
 }

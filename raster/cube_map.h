@@ -4,7 +4,9 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <functional>
+#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -31,6 +33,18 @@ struct CubeCoord {
   glm::vec2 pixel{0.0f};
 };
 CubeCoord cube_coord(const glm::vec3& d, int size);
+// The axes of face `face`'s frame (forward, right, up): each is a signed unit axis, so a dot
+// product with it is one signed component (up to the sign of a zero).
+struct CubeFaceAxes {
+  int forward = 0, right = 0, up = 0;                       // axis index 0..2
+  float forward_sign = 1.0f, right_sign = 1.0f, up_sign = 1.0f;
+};
+CubeFaceAxes cube_face_axes(int face);
+
+// Continuous pixel coordinates of direction d on the plane of face `face` (any face whose axis
+// d makes an acute angle with: not clamped to the face, no face chosen), so that a
+// neighbourhood of d can be bounded on a face next to the one d lands on.
+glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size);
 // The direction through continuous pixel coordinates of a face (unit length).
 glm::vec3 cube_direction(int face, glm::vec2 pixel, int size);
 
@@ -41,13 +55,37 @@ struct CubeMap {
   std::array<ImageF, kCubeFaces> distance;    // |y − o|, +inf where nothing was hit
 
   // Bilinear colour towards d (clamped at face borders).
-  glm::vec4 colour_towards(const glm::vec3& d) const;
+  glm::vec4 colour_towards(const glm::vec3& d) const { return colour_at(cube_coord(d, size)); }
   // Nearest-texel distance towards d.
-  float distance_towards(const glm::vec3& d) const;
+  float distance_towards(const glm::vec3& d) const { return distance_at(cube_coord(d, size)); }
+  // The same at a direction's cube_coord(d, size), for a caller that needs it more than once.
+  glm::vec4 colour_at(const CubeCoord& c) const;
+  float distance_at(const CubeCoord& c) const;
 };
 
-// Colour of one face from its G-buffer; background samples (object == kNoId) too.
-using CubeFaceShader = std::function<ImageRGBA(const GBuffer&, const Camera&)>;
+// Which texels of each face a map's readers can reach, in square tiles of kTile level-0
+// texels: a refinement of CubeMapOptions::face_mask for maps whose reads are known (the
+// directions a frame looks up; reflector_maps.h). A texel outside every read tile is never
+// read at any level, so it need not be shaded or prefiltered.
+struct CubeTileMask {
+  static constexpr int kTile = 8;
+  int size = 0;  // level-0 side; 0: no mask (every texel of the faces in face_mask)
+  std::array<std::vector<std::uint8_t>, kCubeFaces> tiles;  // tiles_per_side()² per face, 1: read
+
+  bool active() const { return size > 0; }
+  int tiles_per_side() const { return (size + kTile - 1) / kTile; }
+  // Level-`level` texel (x, y) of `face` (a side of size >> level) overlaps a read tile.
+  bool covers(int face, int level, int x, int y) const;
+  // The level-0 texels of `face` in read tiles, one byte each (1: read), row-major.
+  std::vector<std::uint8_t> texels(int face) const;
+  // Level-0 texels in read tiles, over the faces in `face_mask`.
+  double texel_count(unsigned face_mask) const;
+};
+
+// Colour of face `face` from its G-buffer; background samples (object == kNoId) too. `read`
+// (null: every texel) flags the texels a reader can reach: the others may be left black.
+using CubeFaceShader = std::function<ImageRGBA(const GBuffer&, const Camera&, int face,
+                                               const std::vector<std::uint8_t>* read)>;
 
 // Near and far planes of a cube map rendered from a point inside or just beside a region
 // whose bounding-box diagonal is `extent`: no point of the region is farther than about one
@@ -68,8 +106,11 @@ struct CubeMapOptions {
   float zfar = 1000.0f;
   RasterOptions raster;  // e.g. excluded_objects: leave the reflector out of its own map
   // Bit f: render face f. The others are left black with distance +inf, for a map whose
-  // readers provably never look there (reflector_maps.h MapSizing::cull_faces).
+  // readers provably never look there (reflector_maps.h MapSizing::reads).
   unsigned face_mask = 0x3fu;
+  // Within the faces rendered, only the texels of the read tiles are resolved and shaded
+  // (null or inactive: all); the others hold distance +inf and black.
+  const CubeTileMask* tiles = nullptr;
 
   void set_depth_range(const CubeDepthRange& range) {
     znear = range.znear;

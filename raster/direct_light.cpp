@@ -27,11 +27,12 @@ glm::vec3 shade_surface(const Scene& scene, const SurfaceParams& s, const glm::v
 
 ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,
                        const Camera& camera, const std::vector<ShadowMap>& shadows,
-                       const EnvironmentMap& env) {
-  ImageRGBA out(g.width, g.height);
+                       const EnvironmentMap& env, const std::vector<std::uint8_t>* read) {
+  ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   executor.parallel_for("direct_light.shade", out.size(), 4096,
                         [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
+      if (read && !(*read)[i]) continue;
       if (!g.covered(i)) {
         const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
         const Ray ray = primary_ray(camera, g.width, g.height, x + 0.5f, y + 0.5f);

@@ -25,10 +25,11 @@ glm::vec3 shade_surface(const Scene& scene, const SurfaceParams& s, const glm::v
                         const glm::vec3& v, const std::vector<ShadowMap>& shadows, const EnvironmentMap& env);
 
 // `camera` is the one the G-buffer was rendered with (for background directions).
-// `shadows` may be empty: lights are then unshadowed.
+// `shadows` may be empty: lights are then unshadowed. `read` (may be null) flags the samples
+// wanted; the others are left black (the texels of a cube face no reader reaches).
 ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,
                        const Camera& camera, const std::vector<ShadowMap>& shadows,
-                       const EnvironmentMap& env);
+                       const EnvironmentMap& env, const std::vector<std::uint8_t>* read = nullptr);
 
 // Pass "direct_light": the diffuse and glossy response to every light, plus ambient.
 struct DirectLightPass {

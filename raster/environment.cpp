@@ -11,6 +11,7 @@
 
 #include "core/sampling.h"
 #include "core/shading.h"
+#include "parallel/lanes.h"
 
 namespace speculum::raster {
 namespace {
@@ -37,6 +38,82 @@ glm::vec3 lookup_level(const std::array<ImageRGBA, kCubeFaces>& level, const glm
   const int s = level[0].width;
   const CubeCoord c = cube_coord(d, s);
   return glm::vec3(bilinear_face(level[c.face], c.pixel));
+}
+
+// Prefiltered texel i of face `face` on a level of side s: the mean of previous-level
+// lookups along the lobe directions `local` about the texel's axis (the scalar reference).
+glm::vec3 prefilter_texel(const std::array<ImageRGBA, kCubeFaces>& previous, int face, int s, std::size_t i,
+                          const glm::vec3* local, int count) {
+  const glm::vec3 axis = cube_direction(face, {i % s + 0.5f, i / s + 0.5f}, s);
+  const Onb onb(axis);
+  glm::vec3 sum(0.0f);
+  for (int k = 0; k < count; ++k) sum += lookup_level(previous, onb.to_world(local[k]));
+  return sum;
+}
+
+// Eight texels of one face at once, lane j = texel first + j: per lane the operations of
+// prefilter_texel in its order (lookup_level's face choice and projection, whose dot products
+// with the face's signed unit axes are one signed component: the same value, up to the sign
+// of a zero that the +1 of the pixel mapping removes; the bilinear weights; the sum over k
+// in order), so the result has the same bits for every texel; the taps are gathered per lane.
+void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int face, int s, std::size_t first,
+                       const glm::vec3* local, int count, glm::vec3* out) {
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
+  using i32 = L::i32;
+  static const std::array<CubeFaceAxes, kCubeFaces> axes = {cube_face_axes(0), cube_face_axes(1), cube_face_axes(2),
+                                                            cube_face_axes(3), cube_face_axes(4), cube_face_axes(5)};
+  alignas(32) float t[3][8], b[3][8], n[3][8];
+  for (int j = 0; j < 8; ++j) {
+    const std::size_t i = first + static_cast<std::size_t>(j);
+    const glm::vec3 axis = cube_direction(face, {i % s + 0.5f, i / s + 0.5f}, s);
+    const Onb onb(axis);
+    for (int c = 0; c < 3; ++c) t[c][j] = onb.t[c], b[c][j] = onb.b[c], n[c][j] = onb.n[c];
+  }
+  f32 tv[3], bv[3], nv[3];
+  for (int c = 0; c < 3; ++c) tv[c] = L::load(t[c]), bv[c] = L::load(b[c]), nv[c] = L::load(n[c]);
+  const int side = previous[0].width;
+  const float sf = static_cast<float>(side), last = static_cast<float>(side - 1);
+  const float* pixels[kCubeFaces];
+  for (int f = 0; f < kCubeFaces; ++f) pixels[f] = &previous[f].pixels[0].x;
+  f32 sum[3] = {f32(0.0f), f32(0.0f), f32(0.0f)};
+  for (int k = 0; k < count; ++k) {
+    f32 d[3];
+    for (int c = 0; c < 3; ++c) d[c] = (local[k].x * tv[c] + local[k].y * bv[c]) + local[k].z * nv[c];
+    // cube_coord: the face of the largest component (ties as there), then its projection.
+    const f32 ax = L::abs(d[0]), ay = L::abs(d[1]), az = L::abs(d[2]);
+    const auto is_x = (ax >= ay) && (ax >= az);
+    const auto is_y = !is_x && (ay >= az);
+    const f32 major = L::select(is_x, d[0], L::select(is_y, d[1], d[2]));
+    const auto negative = !(major >= 0.0f);
+    i32 fi = L::select(is_x, i32(0), L::select(is_y, i32(2), i32(4)));
+    fi = L::select(negative, fi + 1, fi);
+    f32 depth(0.0f), along_right(0.0f), along_up(0.0f);
+    for (int f = 0; f < kCubeFaces; ++f) {
+      const L::mask here = fi == f;
+      const CubeFaceAxes& a = axes[f];
+      depth = L::select(here, a.forward_sign * d[a.forward], depth);
+      along_right = L::select(here, a.right_sign * d[a.right], along_right);
+      along_up = L::select(here, a.up_sign * d[a.up], along_up);
+    }
+    const f32 ndc_x = along_right / depth, ndc_y = along_up / depth;
+    const auto clamp = [](f32 v, f32 lo, f32 hi) { return L::select(v < lo, lo, L::select(hi < v, hi, v)); };
+    const f32 px = clamp((ndc_x + 1.0f) * 0.5f * sf, f32(0.0f), f32(sf));
+    const f32 py = clamp((1.0f - ndc_y) * 0.5f * sf, f32(0.0f), f32(sf));
+    // bilinear_face
+    const f32 fx = clamp(px - 0.5f, f32(0.0f), f32(last)), fy = clamp(py - 0.5f, f32(0.0f), f32(last));
+    const i32 x0 = L::to_int(fx), y0 = L::to_int(fy);
+    const i32 x1 = L::min(x0 + 1, i32(side - 1)), y1 = L::min(y0 + 1, i32(side - 1));
+    const f32 tx = fx - L::to_float(x0), ty = fy - L::to_float(y0);
+    const f32 wx = 1.0f - tx, wy = 1.0f - ty;
+    const i32 row0 = y0 * side, row1 = y1 * side;
+    const i32 i00 = (row0 + x0) * 4, i10 = (row0 + x1) * 4, i01 = (row1 + x0) * 4, i11 = (row1 + x1) * 4;
+    for (int c = 0; c < 3; ++c) {
+      const auto tap = [&](const i32& index) { return f32([&](auto j) { return pixels[fi[j]][index[j] + c]; }); };
+      sum[c] += (tap(i00) * wx + tap(i10) * tx) * wy + (tap(i01) * wx + tap(i11) * tx) * ty;
+    }
+  }
+  for (int j = 0; j < 8; ++j) out[j] = glm::vec3(sum[0][j], sum[1][j], sum[2][j]);
 }
 
 std::array<float, 9> sh_basis(const glm::vec3& d) {
@@ -77,7 +154,7 @@ EnvironmentMap build_environment(par::Executor& executor, const Environment& env
 
 EnvironmentMap environment_from_faces(par::Executor& executor,
                                       std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
-                                      int level_count, unsigned face_mask) {
+                                      int level_count, unsigned face_mask, const CubeTileMask* tiles) {
   EnvironmentMap map;
   const int size = faces[0].width;
   map.size = size;
@@ -100,14 +177,24 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
       if (!((face_mask >> face) & 1u)) continue;
       executor.parallel_for("environment.prefilter", img.size(), 256,
                             [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
-          const glm::vec3 axis = cube_direction(face, {i % s + 0.5f, i / s + 0.5f}, s);
-          const Onb onb(axis);
-          glm::vec3 sum(0.0f);
-          for (int k = 0; k < kPrefilterSamples; ++k)
-            sum += lookup_level(map.levels[l - 1], onb.to_world(local[k]));
-          img.pixels[i] = glm::vec4(sum / float(kPrefilterSamples), 1.0f);
+        const auto wanted = [&](std::size_t i) {
+          return !tiles || tiles->covers(face, l, static_cast<int>(i % s), static_cast<int>(i / s));
+        };
+        std::size_t i = begin;
+        glm::vec3 sums[8];
+        for (; i + 8 <= end; i += 8) {
+          bool any = false;
+          for (std::size_t j = 0; j < 8 && !any; ++j) any = wanted(i + j);
+          if (!any) continue;
+          prefilter_texels8(map.levels[l - 1], face, s, i, local.data(), kPrefilterSamples, sums);
+          for (std::size_t j = 0; j < 8; ++j)
+            if (wanted(i + j)) img.pixels[i + j] = glm::vec4(sums[j] / float(kPrefilterSamples), 1.0f);
         }
+        for (; i < end; ++i)
+          if (wanted(i))
+            img.pixels[i] = glm::vec4(prefilter_texel(map.levels[l - 1], face, s, i, local.data(), kPrefilterSamples) /
+                                          float(kPrefilterSamples),
+                                      1.0f);
       });
     }
   }

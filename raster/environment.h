@@ -34,10 +34,14 @@ struct EnvironmentMap {
 // colour, for the dynamic environment maps of SURVEY §3.1); SH only when asked. level_count
 // > 0 keeps only the finest level_count levels (see levels_for_lobes); 0 builds all.
 // `face_mask` (bit f: face f) limits the prefiltering to those faces; the others' coarser
-// levels stay black (for a map whose other faces nothing reads: lookup_reach).
+// levels stay black (for a map whose other faces nothing reads: lookup_reach). `tiles` (may
+// be null) limits it further to the texels over read tiles (CubeTileMask::covers): a texel
+// that a lookup within lookup_reach of a read tile depends on lies over a read tile at every
+// level, so what is left black is never read.
 EnvironmentMap environment_from_faces(par::Executor& executor,
                                       std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
-                                      int level_count = 0, unsigned face_mask = 0x3fu);
+                                      int level_count = 0, unsigned face_mask = 0x3fu,
+                                      const CubeTileMask* tiles = nullptr);
 
 // An angle around d within which every level-0 texel lies that radiance(d, n) on a map of
 // side `size` with `level_count` levels depends on: the bilinear taps of the levels it reads

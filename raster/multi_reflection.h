@@ -19,12 +19,19 @@
 namespace speculum::raster {
 
 // One round: the maps of `current` re-rendered at the same reference points and sizes,
-// reflectors in view shaded by direct light + distance_map_reflect(current).
+// reflectors in view shaded by direct light + distance_map_reflect(current). With `layers`
+// (those render_reflector_maps kept for the maps of `current`, in map order) the faces'
+// direct light and specular texels come from there and the distances from `current`: the
+// same bytes without rasterizing, resolving and lighting the faces again. With layers,
+// `faces_needed` (bit f per map, may be null) limits the faces searched, composited and
+// prefiltered to those a reader reaches; the others are black (ReflectorMaps::faces).
 ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scene,
                                       const std::vector<ShadowMap>& shadows,
                                       const EnvironmentMap& env, const ReflectorMaps& current,
                                       const DistanceSearchOptions& options,
-                                      DistanceReflectStats* stats = nullptr);
+                                      DistanceReflectStats* stats = nullptr,
+                                      const std::vector<MapFaceLayers>* layers = nullptr,
+                                      const std::vector<unsigned>* faces_needed = nullptr);
 
 // `rounds` ≥ 1 rounds: round 1 is render_reflector_maps (direct light only: one bounce
 // once looked up from the camera), each further round one rerender.

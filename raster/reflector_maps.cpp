@@ -139,7 +139,112 @@ float widest_lobe_sample(int count, float n) {
   return std::acos(std::pow(1.0f / static_cast<float>(count), 1.0f / (n + 1.0f)));
 }
 
+// Margins at or beyond this angle mark every face they reach whole: a tile bound would cover
+// most of the face anyway, and below it the bound of mark_near holds.
+constexpr float kWholeFaceMargin = 0.5f;
+
+// Marks in `tiles` (one CubeTileMask face array each, n tiles a side, for a map of side
+// `size`) the tiles holding every texel centre within angle `margin` of unit direction d.
+// Along a great circle the face-plane coordinate ndc = (d·right)/(d·forward) moves at most
+// 1/(d·forward)² per radian; a texel t read by d lies on face f (d·forward ≥ 1/√3, i.e. within
+// acos(1/√3) of the axis) and every point of the arc from d to t is within `margin` of t, so
+// along it d·forward ≥ cos(acos(1/√3) + margin) = z: t is at most margin/z² in ndc, margin·
+// size/(2z²) texels, from d's point on the face's plane. One texel more absorbs rounding.
+void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int n, int size, const glm::vec3& d,
+               float margin) {
+  const unsigned faces = faces_near(d, margin);
+  constexpr float kFaceHalfAngle = 0.95531662f;  // acos(1/√3)
+  const float z = std::cos(kFaceHalfAngle + margin);
+  const float half = margin >= kWholeFaceMargin ? 0.0f : margin * static_cast<float>(size) / (2.0f * z * z) + 1.0f;
+  constexpr int tile = CubeTileMask::kTile;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    if (!((faces >> f) & 1u)) continue;
+    std::vector<std::uint8_t>& t = tiles[f];
+    if (margin >= kWholeFaceMargin) {
+      std::fill(t.begin(), t.end(), std::uint8_t(1));
+      continue;
+    }
+    const glm::vec2 p = cube_face_plane_pixel(f, d, size);
+    const float lo_x = (p.x - half) / tile, hi_x = (p.x + half) / tile;
+    const float lo_y = (p.y - half) / tile, hi_y = (p.y + half) / tile;
+    if (!(hi_x >= 0.0f && hi_y >= 0.0f && lo_x < float(n) && lo_y < float(n))) continue;
+    const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(n - 1, static_cast<int>(hi_x));
+    const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(n - 1, static_cast<int>(hi_y));
+    for (int y = y0; y <= y1; ++y) std::fill_n(t.begin() + static_cast<std::ptrdiff_t>(y) * n + x0, x1 - x0 + 1, std::uint8_t(1));
+  }
+}
+
 }  // namespace
+
+void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin) {
+  const int n = mask.tiles_per_side();
+  for (auto& t : mask.tiles)
+    if (t.size() != static_cast<std::size_t>(n) * n) t.assign(static_cast<std::size_t>(n) * n, 0);
+  mark_near(mask.tiles, n, mask.size, d, margin);
+}
+
+GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
+  texel.clear();
+  for (std::size_t i = 0; i < g.object.size(); ++i)
+    if (g.covered(i) && is_specular(g.surface.pixels[i])) texel.push_back(static_cast<std::uint32_t>(i));
+  GBuffer out;
+  const int n = static_cast<int>(texel.size());
+  out.width = n;
+  out.height = n > 0 ? 1 : 0;
+  out.eye = g.eye;
+  out.object = IdBuffer(n, out.height);
+  out.position = Buffer2D<glm::vec3>(n, out.height);
+  out.normal = Buffer2D<glm::vec3>(n, out.height);
+  out.uv = Buffer2D<glm::vec2>(n, out.height);
+  out.surface = Buffer2D<SurfaceParams>(n, out.height);
+  out.reflector = IdBuffer(n, out.height);
+  for (int k = 0; k < n; ++k) {
+    const std::size_t i = texel[k];
+    out.object.pixels[k] = g.object.pixels[i];
+    out.position.pixels[k] = g.position.pixels[i];
+    out.normal.pixels[k] = g.normal.pixels[i];
+    out.uv.pixels[k] = g.uv.pixels[i];
+    out.surface.pixels[k] = g.surface.pixels[i];
+    out.reflector.pixels[k] = g.reflector.pixels[i];
+  }
+  return out;
+}
+
+CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
+                        int size, int level_count) {
+  CubeTileMask mask;
+  mask.size = size;
+  const int n = mask.tiles_per_side();
+  for (auto& t : mask.tiles) t.assign(static_cast<std::size_t>(n) * n, 0);
+  constexpr std::size_t kChunk = 4096;
+  const std::size_t chunks = (samples.size() + kChunk - 1) / kChunk;
+  std::vector<std::array<std::vector<std::uint8_t>, kCubeFaces>> per_chunk(chunks);
+  executor.parallel_for("reflector_cube_maps.tiles", samples.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    auto& tiles = per_chunk[begin / kChunk];
+    for (auto& t : tiles) t.assign(static_cast<std::size_t>(n) * n, 0);
+    float last_exponent = std::numeric_limits<float>::quiet_NaN(), margin = 0.0f;
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t i = samples[k];
+      const SurfaceParams& s = g.surface.pixels[i];
+      if (!is_specular(s)) continue;
+      if (s.is_refractor()) {  // refracted lookups go anywhere (faces_read keeps every face)
+        for (auto& t : tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
+        break;
+      }
+      // specular_radiance's lookup: along R with the material's exponent (as faces_read).
+      if (!(s.phong_exponent == last_exponent)) {
+        last_exponent = s.phong_exponent;
+        margin = std::max(lookup_reach(size, level_count, s.phong_exponent), 1e-3f);
+      }
+      mark_near(tiles, n, size, glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i])), margin);
+    }
+  });
+  // OR of the chunks' marks: the same whatever thread marked what.
+  for (const auto& tiles : per_chunk)
+    for (int f = 0; f < kCubeFaces; ++f)
+      for (std::size_t k = 0; k < tiles[f].size(); ++k) mask.tiles[f][k] |= tiles[f][k];
+  return mask;
+}
 
 unsigned faces_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
                     const glm::vec3& centre, int size, int level_count, const MapSizing& sizing) {
@@ -246,7 +351,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const EnvironmentMap& env, int size,
                                     const GBuffer* camera_view, ReflectorSelection which,
                                     const FaceLight& add_light, const std::vector<std::uint8_t>* skip,
-                                    const MapSizing& sizing) {
+                                    const MapSizing& sizing, std::vector<MapFaceLayers>* layers) {
   ReflectorMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   // Seen reflectors alone need one pass over the samples; sizes need every sample's
@@ -300,33 +405,64 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     const int levels = levels_for_lobes(side, widest_lobe);
     CubeMapOptions opt;
     opt.size = side;
-    if (!samples_of.empty())
+    // Maps read along R (powers of two, so that every level's texels nest in level 0's):
+    // only the tiles around the directions read, as well as only the faces.
+    CubeTileMask tiles;
+    if (!samples_of.empty() && sizing.reads == MapSizing::Reads::direction && std::has_single_bit(unsigned(side))) {
+      tiles = tiles_read(executor, *camera_view, samples_of[o], side, levels);
+      opt.face_mask = 0;
+      for (int f = 0; f < kCubeFaces; ++f)
+        if (std::find(tiles.tiles[f].begin(), tiles.tiles[f].end(), std::uint8_t(1)) != tiles.tiles[f].end())
+          opt.face_mask |= 1u << f;
+      opt.tiles = &tiles;
+    } else if (!samples_of.empty()) {
       opt.face_mask = faces_read(executor, *camera_view, samples_of[o], centre, side, levels, sizing);
+    }
     opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
+    if (!sizing.colour_read) {
+      out.map_of_object[o] = static_cast<int>(out.cubes.size());
+      out.cubes.push_back(render_cube_map(executor, scene, centre, opt));
+      out.maps.emplace_back();
+      out.centres.push_back(centre);
+      out.faces.push_back(opt.face_mask);
+      out.tiles.emplace_back();
+      if (layers) layers->emplace_back();
+      continue;
+    }
+    MapFaceLayers kept;
     CubeMap cube = render_cube_map(
-        executor, scene, centre, opt, [&](const GBuffer& g, const Camera& cam) {
+        executor, scene, centre, opt, [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* read) {
           // Other reflectors seen in this map show the environment along their own R (and
           // T): the first-order fallback, so a mirror seen in a mirror is never black.
-          ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env);
+          ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env, read);
           if (add_light) direct = add_light(g, direct);
+          if (layers) {
+            kept.specular[face] = specular_texels(g, kept.specular_texel[face]);
+            kept.direct[face] = direct;
+          }
           return composite(executor, direct, envmap_reflect(executor, g, env));
         });
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
-    out.maps.push_back(environment_from_faces(executor, cube.colour, false, levels, opt.face_mask));
+    out.maps.push_back(environment_from_faces(executor, cube.colour, false, levels, opt.face_mask,
+                                              tiles.active() ? &tiles : nullptr));
     out.cubes.push_back(std::move(cube));
     out.centres.push_back(centre);
     out.faces.push_back(opt.face_mask);
+    out.tiles.push_back(std::move(tiles));
+    if (layers) layers->push_back(std::move(kept));
   }
   return out;
 }
 
 double rendered_texels(const ReflectorMaps& maps) {
   double texels = 0.0;
-  for (std::size_t m = 0; m < maps.cubes.size(); ++m)
-    texels += double(m < maps.faces.size() ? std::popcount(maps.faces[m]) : kCubeFaces) * maps.cubes[m].size *
-              maps.cubes[m].size;
+  for (std::size_t m = 0; m < maps.cubes.size(); ++m) {
+    const unsigned faces = m < maps.faces.size() ? maps.faces[m] : 0x3fu;
+    if (m < maps.tiles.size() && maps.tiles[m].active()) texels += maps.tiles[m].texel_count(faces);
+    else texels += double(std::popcount(faces)) * maps.cubes[m].size * maps.cubes[m].size;
+  }
   return texels;
 }
 

@@ -7,6 +7,7 @@
 // 1% of the box diagonal along their mean normal.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <vector>
 
@@ -23,13 +24,27 @@ namespace speculum::raster {
 struct ReflectorMaps {
   std::vector<int> map_of_object;     // per object: index into maps, -1 when not a reflector
   std::vector<CubeMap> cubes;         // colour + distance, as rendered
-  std::vector<EnvironmentMap> maps;   // the same colour, prefiltered for lookups
+  std::vector<EnvironmentMap> maps;   // the same colour, prefiltered for lookups (no levels
+                                      // when only distances are read: MapSizing::colour_read)
   std::vector<glm::vec3> centres;     // reference point o of each map
   std::vector<unsigned> faces;        // bit f: face f rendered (the others black, never read)
+  std::vector<CubeTileMask> tiles;    // per map: within those faces, the tiles rendered
+                                      // (inactive: all; the others black, never read)
   const EnvironmentMap* for_object(std::uint32_t object) const {
     if (object >= map_of_object.size() || map_of_object[object] < 0) return nullptr;
     return &maps[map_of_object[object]];
   }
+};
+
+// What one map's faces hold before reflections are added: each rendered face's direct light
+// (with any added light) and the G-buffer of its covered specular texels, compacted to one
+// row, with their texel indices. A later round that re-renders the same map at the same
+// point and size (multi-reflection) starts from these instead of rasterizing, resolving and
+// lighting the face again: the geometry and the lights have not changed, so neither have they.
+struct MapFaceLayers {
+  std::array<ImageRGBA, kCubeFaces> direct;  // empty: face not rendered
+  std::array<GBuffer, kCubeFaces> specular;
+  std::array<std::vector<std::uint32_t>, kCubeFaces> specular_texel;
 };
 
 enum class ReflectorSelection { all, not_planar_mirrors, refractors };
@@ -57,6 +72,10 @@ struct MapSizing {
   // every face.
   enum class Reads { anywhere, direction, search } reads = Reads::anywhere;
   int lobe_directions = 8;  // search: sub-lobe searches per glossy lobe (distance_map_reflect)
+  // Whether anything reads the maps' colour. When only their distances are searched (the
+  // caustics' photons, SURVEY §6.1), no face is resolved or shaded and nothing is prefiltered:
+  // the cubes hold distances alone.
+  bool colour_read = true;
 };
 
 // Bit f set: face f of a map centred at `centre` is read by the camera samples `samples` of
@@ -65,6 +84,17 @@ struct MapSizing {
 unsigned faces_read(par::Executor& executor, const GBuffer& camera_view, const std::vector<std::uint32_t>& samples,
                     const glm::vec3& centre, int size, int level_count, const MapSizing& sizing);
 constexpr int kMinFootprintSize = 16;
+
+// Marks the tiles of `mask` (mask.size set; tiles sized on first use) that hold a texel centre
+// within angle `margin` of unit direction d, on any face. Exposed for tests.
+void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin);
+
+// The tiles of a map of side `size` (a power of two) with `level_count` levels that the
+// lookups along R of the camera samples `samples` of one reflector can reach (every texel
+// within lookup_reach of a read direction), for maps read only along R (Reads::direction).
+// A refractor's sample marks every tile. Exposed for tests.
+CubeTileMask tiles_read(par::Executor& executor, const GBuffer& camera_view, const std::vector<std::uint32_t>& samples,
+                        int size, int level_count);
 
 // 1 for each object with a specular sample in `camera_view` (what `skip_unseen` keeps).
 std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& camera_view);
@@ -84,7 +114,8 @@ std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, co
 // from the face's G-buffer (the caustics technique gathers its caustics there).
 using FaceLight = std::function<ImageRGBA(const GBuffer& face, const ImageRGBA& direct)>;
 // Objects flagged in `skip` (indexed by object id; may be null) get no map either: a
-// technique that handles them otherwise (vertex-projection's mirrors).
+// technique that handles them otherwise (vertex-projection's mirrors). `layers` (may be
+// null) receives each map's MapFaceLayers, in map order.
 ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<ShadowMap>& shadows,
                                     const EnvironmentMap& env, int size = 256,
@@ -92,9 +123,14 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     ReflectorSelection which = ReflectorSelection::all,
                                     const FaceLight& add_light = {},
                                     const std::vector<std::uint8_t>* skip = nullptr,
-                                    const MapSizing& sizing = {});
+                                    const MapSizing& sizing = {},
+                                    std::vector<MapFaceLayers>* layers = nullptr);
 
-// Texels rendered: the faces each map has, times their side squared.
+// The covered specular samples of `g`, compacted to one row in sample order; `texel`
+// receives their indices in g.
+GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel);
+
+// Texels rendered: the texels of the tiles rendered on the faces each map has.
 double rendered_texels(const ReflectorMaps& maps);
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
@@ -111,6 +147,7 @@ struct ReflectorCubeMapsPass {
     p.set("reflectors", to_string(which));
     p.set("footprint_size", sizing.from_footprint ? 1 : 0);
     p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
+    if (!sizing.colour_read) p.set("colour", "none (distances only)");
     p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all"
                    : sizing.reads == MapSizing::Reads::direction ? "read along R" : "read by searches");
   }

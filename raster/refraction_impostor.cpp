@@ -29,7 +29,7 @@ RefractorImpostors render_refractor_impostors(par::Executor& executor, const Sce
     opt.raster.excluded_objects.assign(scene.objects.size(), 1);
     opt.raster.excluded_objects[o] = 0;  // the refractor alone
     CubeMap cube = render_cube_map(executor, scene, box.center(), opt,
-                                   [&](const GBuffer& g, const Camera&) {
+                                   [&](const GBuffer& g, const Camera&, int, const std::vector<std::uint8_t>*) {
       // The G-buffer normal of a refractor keeps its geometric (outward) orientation.
       ImageRGBA normals(g.width, g.height, glm::vec4(0.0f));
       executor.parallel_for("refraction_impostor.normals", normals.size(), 4096,

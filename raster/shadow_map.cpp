@@ -115,6 +115,13 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
   const int cx = std::min(static_cast<int>(pixel.x), size - 1);
   const int cy = std::min(static_cast<int>(pixel.y), size - 1);
   int lit = 0;
+  if (cx >= 1 && cy >= 1 && cx + 1 < size && cy + 1 < size) {  // no tap clamped: three rows
+    for (int dy = -1; dy <= 1; ++dy) {
+      const float* row = &img->at(cx - 1, cy + dy);
+      lit += (row[0] >= biased) + (row[1] >= biased) + (row[2] >= biased);
+    }
+    return lit / 9.0f;
+  }
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
       const int x = std::clamp(cx + dx, 0, size - 1), y = std::clamp(cy + dy, 0, size - 1);

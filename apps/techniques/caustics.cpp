@@ -21,10 +21,13 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   search.linear = search.linear_steps >= 2;
   search.secant_steps = static_cast<int>(f.param("secant_steps"));
   const SurfaceResources s = add_surface_passes(g, scene, f);
-  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size}, s.shadow_maps,
-                    s.environment, s.gbuffer)
-                  .describe("Colour + distance cube map around each specular object, itself left out: "
-                            "what reflected rays and the photons leaving a generator search (SURVEY §4.1, §6.1).");
+  // The photons search these maps' distances only; what reflections read are the lit maps below.
+  MapSizing distances_only;
+  distances_only.colour_read = false;
+  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, distances_only},
+                    s.shadow_maps, s.environment, s.gbuffer)
+                  .describe("Distance cube map around each specular object, itself left out: what the "
+                            "photons leaving a generator search (SURVEY §4.1, §6.1).");
   auto impostors = g.add("refractor_impostors",
                          RefractorImpostorsPass{scene, static_cast<int>(f.param("impostor_size")), true})
                        .describe("Each refractor and mirror alone from its centre: normal + distance cube map, "
@@ -46,7 +49,9 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   const float tolerance = static_cast<float>(f.param("tolerance"));
   auto lit = g.add("caustic_gather", CausticGatherPass{tolerance}, s.gbuffer, caustic_maps, s.direct);
   // What reflections and refractions look up: the maps again, with the caustics on them.
-  auto lit_maps = g.add("caustic_reflector_maps", CausticReflectorMapsPass{scene, f.cube_map_size, tolerance},
+  // Only the camera's samples read them (searched along R, refractors' maps whole).
+  auto lit_maps = g.add("caustic_reflector_maps",
+                        CausticReflectorMapsPass{scene, f.cube_map_size, tolerance, camera_read_maps(false, search.lobe_directions)},
                         s.shadow_maps, s.environment, s.gbuffer, caustic_maps);
   auto reflected = g.add("distance_map_reflect", DistanceMapReflectPass{search}, s.gbuffer, s.environment, lit_maps);
   RefractionOptions ro;

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <glm/geometric.hpp>
@@ -125,6 +126,47 @@ TEST(Environment, SkyIrradianceMatchesDirectIntegration) {
     }
     e *= kPi / m;  // pdf cosθ/π: estimator π·mean(L)
     EXPECT_NEAR(map.irradiance(n).x, e, 0.03 * e) << n.x << n.y << n.z;
+  }
+}
+
+// The prefiltering cascade, computed eight texels at a time, against its definition looked up
+// one direction at a time: level l's texel is the mean of 48 Hamersley directions of the
+// Phong lobe whose variance is the difference of levels l and l−1's (half-power angle one
+// texel each), about the texel's axis, each read bilinearly from level l−1 (a one-level map
+// read as a mirror) — bit for bit, on every face, with a random texture and tile masks off.
+TEST(Environment, PrefilteredTexelsAreTheMeanOfTheirLobesLookups) {
+  for (const int size : {16, 64}) {
+    std::array<ImageRGBA, kCubeFaces> faces;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 4.0f);
+    for (ImageRGBA& f : faces) {
+      f = ImageRGBA(size, size);
+      for (glm::vec4& p : f.pixels) p = glm::vec4(u(rng), u(rng), u(rng), 1.0f);
+    }
+    par::Executor ex(2);
+    const EnvironmentMap map = environment_from_faces(ex, faces, false, 4);
+    const auto texel_angle = [](int s) { return 0.5f * kPi / static_cast<float>(s); };
+    for (int l = 1; l < 4; ++l) {
+      EnvironmentMap previous;
+      previous.size = size >> (l - 1);
+      previous.levels = {map.levels[l - 1]};
+      const int s = size >> l;
+      const float target = texel_angle(s), before = l == 1 ? 0.0f : texel_angle(size >> (l - 1));
+      const float step = std::sqrt(target * target - before * before);
+      const float exponent = 2.0f * 0.69314718f / (step * step);
+      for (int face = 0; face < kCubeFaces; ++face)
+        for (int y = 0; y < s; ++y)
+          for (int x = 0; x < s; ++x) {
+            const Onb onb(cube_direction(face, {x + 0.5f, y + 0.5f}, s));
+            glm::vec3 sum(0.0f);
+            for (std::uint32_t k = 0; k < 48; ++k)
+              sum += previous.radiance(onb.to_world(sample_phong_lobe(hamersley(k, 48), exponent)), 1e6f);
+            const glm::vec4 want(sum / 48.0f, 1.0f);
+            const glm::vec4 got = map.levels[l][face].at(x, y);
+            ASSERT_EQ(0, std::memcmp(&want, &got, sizeof want))
+                << "size " << size << " level " << l << " face " << face << " texel " << x << "," << y;
+          }
+    }
   }
 }
 

@@ -8,6 +8,10 @@
 #include "apps/techniques/render_frame.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
+#include "raster/gbuffer.h"
+#include "raster/multi_reflection.h"
+#include "raster/shadow_map.h"
+#include "raster/visibility.h"
 
 namespace speculum::raster {
 namespace {
@@ -93,6 +97,40 @@ TEST(MultiReflection, LaggedSecondFrameEqualsTwoRounds) {
   in_frame.params["rounds"] = 2;
   EXPECT_TRUE(same_bytes(second, frame(s, "multi-reflection", in_frame)));
   EXPECT_FALSE(same_bytes(first, second));
+}
+
+// Rounds after the first start from the faces' direct light and specular texels kept by the
+// first (MapFaceLayers) instead of rendering the faces again, and search, composite and
+// prefilter only the faces the next round's (or the camera's) searches reach: every such
+// face's colour and every distance are the bytes the full re-rendering gives, and so is the
+// camera's specular layer, while faces were left out.
+TEST(MultiReflection, KeptFaceLayersGiveTheBytesOfReRenderedFaces) {
+  const Scene s = load_scene("living-room");  // flat and curved reflectors: some faces unread
+  par::Executor ex(2);
+  const Camera cam = s.cameras.front();
+  const ShadowMaps shadows = render_shadow_maps(ex, s, 128);
+  const EnvironmentMap env = build_environment(ex, s.environment);
+  const GBuffer g = resolve_gbuffer(ex, s, render_visibility(ex, s, cam, 96, 72), cam.eye);
+  const DistanceSearchOptions search;
+  DistanceReflectStats kept_stats, fresh_stats;
+  const ReflectorMaps kept = render_multi_reflection_maps(ex, s, shadows, env, 32, &g, 3, search, &kept_stats);
+  ReflectorMaps fresh = render_reflector_maps(ex, s, shadows, env, 32, &g);
+  for (int round = 1; round < 3; ++round)
+    fresh = rerender_reflector_maps(ex, s, shadows, env, fresh, search, &fresh_stats);
+  ASSERT_EQ(kept.cubes.size(), fresh.cubes.size());
+  ASSERT_GE(kept.cubes.size(), 2u);
+  int left_out = 0;
+  for (std::size_t m = 0; m < kept.cubes.size(); ++m)
+    for (int f = 0; f < kCubeFaces; ++f) {
+      if ((kept.faces[m] >> f) & 1u) EXPECT_TRUE(same_bytes(kept.cubes[m].colour[f], fresh.cubes[m].colour[f])) << m << " " << f;
+      else ++left_out;
+      EXPECT_EQ(0, std::memcmp(kept.cubes[m].distance[f].pixels.data(), fresh.cubes[m].distance[f].pixels.data(),
+                               fresh.cubes[m].distance[f].pixels.size() * sizeof(float)));
+    }
+  EXPECT_GT(left_out, 0);
+  EXPECT_TRUE(same_bytes(distance_map_reflect(ex, g, env, kept, search), distance_map_reflect(ex, g, env, fresh, search)));
+  EXPECT_LT(kept_stats.searches, fresh_stats.searches);
+  EXPECT_GT(kept_stats.searches, 0u);
 }
 
 TEST(MultiReflection, SameBytesForOneAndTwoThreads) {

@@ -6,12 +6,14 @@
 #include "raster/reflector_maps.h"
 
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "core/sampling.h"
 #include "core/scene_loader.h"
 #include "raster/distance_map_reflect.h"
 #include "raster/envmap_reflect.h"
@@ -79,6 +81,74 @@ TEST(ReflectorMaps, UnreadFacesChangeNoSearchedOrLookedUpSample) {
   // The mirror ball reads every face; the floors and the wall mirror do not.
   EXPECT_GT(culled_searched, 0);
   EXPECT_GT(culled_looked_up, culled_searched);
+}
+
+// The tile bound (mark_tiles_near): every texel centre within the margin of a direction, on
+// every face and at every mip level, lies over a marked tile — brute force over all texels of
+// maps of side 32 and 64, for directions at face centres, edges, corners and at random —
+// while small margins mark only a small part of the map.
+TEST(ReflectorMaps, MarkedTilesHoldEveryTexelWithinTheMargin) {
+  std::vector<glm::vec3> directions = {{1, 0, 0}, {0, -1, 0}, {1, 1, 0}, {1, 1, 1}, {-1, 0.999f, 0.2f}, {0.3f, -0.2f, -1}};
+  for (std::uint32_t k = 0; k < 40; ++k) {
+    const glm::vec2 u = hamersley(k, 40);
+    directions.push_back(spherical_local(1.0f - 2.0f * u.x, u.y));
+  }
+  for (const int size : {32, 64}) {
+    long long marked_small = 0, total_small = 0;
+    for (glm::vec3 d : directions) {
+      d = glm::normalize(d);
+      for (const float margin : {0.001f, 0.02f, 0.1f, 0.3f, 0.49f, 0.6f}) {
+        CubeTileMask mask;
+        mask.size = size;
+        mark_tiles_near(mask, d, margin);
+        const int levels = static_cast<int>(std::log2(float(size))) + 1;
+        for (int level = 0; level < levels; ++level) {
+          const int s = size >> level;
+          for (int face = 0; face < kCubeFaces; ++face)
+            for (int y = 0; y < s; ++y)
+              for (int x = 0; x < s; ++x) {
+                const glm::vec3 t = cube_direction(face, {x + 0.5f, y + 0.5f}, s);
+                const float angle = std::acos(std::clamp(glm::dot(t, d), -1.0f, 1.0f));
+                if (angle <= margin)
+                  ASSERT_TRUE(mask.covers(face, level, x, y))
+                      << "size " << size << " level " << level << " face " << face << " texel " << x << "," << y
+                      << " margin " << margin << " d " << d.x << "," << d.y << "," << d.z;
+              }
+        }
+        if (margin <= 0.02f) {
+          marked_small += static_cast<long long>(mask.texel_count(0x3fu));
+          total_small += 6LL * size * size;
+        }
+      }
+    }
+    EXPECT_LT(marked_small * 10, total_small) << size;  // a narrow read marks under a tenth
+  }
+}
+
+// Lookups along R read only the tiles near their directions: maps rendered on those tiles
+// alone give the same specular layer, byte for byte, as complete maps, and fewer texels.
+TEST(ReflectorMaps, UnreadTilesChangeNoLookedUpSample) {
+  par::Executor ex(2);
+  for (const char* name : {"living-room", "glossy-plane", "glass-sphere"}) {
+    SCOPED_TRACE(name);
+    const View v = view_of(name, 128, 96, ex);
+    for (const int size : {64, 128}) {
+      const ReflectorMaps all = render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g);
+      MapSizing looked_up;
+      looked_up.reads = MapSizing::Reads::direction;
+      const ReflectorMaps tiled =
+          render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g, ReflectorSelection::all, {}, nullptr, looked_up);
+      ASSERT_EQ(tiled.tiles.size(), tiled.cubes.size());
+      double whole_faces = 0.0;
+      for (std::size_t m = 0; m < tiled.cubes.size(); ++m) {
+        EXPECT_TRUE(tiled.tiles[m].active());
+        whole_faces += double(std::popcount(tiled.faces[m])) * size * size;
+      }
+      if (std::string(name) == "living-room") EXPECT_LT(rendered_texels(tiled), 0.9 * whole_faces);
+      if (std::string(name) == "glass-sphere") EXPECT_GT(rendered_texels(tiled), 0.0);
+      EXPECT_TRUE(same_bytes(envmap_reflect(ex, v.g, v.env, &all), envmap_reflect(ex, v.g, v.env, &tiled)));
+    }
+  }
 }
 
 // A reflector with no sample in the camera's view gets no map under skip_unseen (nothing
