@@ -25,6 +25,7 @@ constexpr int kBlocksPerTile = kBlocksPerSide * kBlocksPerSide;
 // Interpolated 1/w = Σ λ_i/w_i may exceed the largest vertex 1/w by rounding (a few ulps of
 // three products and two sums); the rejection test widens the vertex maximum by far more.
 constexpr float kHizMargin = 1.0f + 1.0f / 4096.0f;
+constexpr std::uint32_t kRecordPrefetch = 16;  // list entries ahead
 
 // The winner so far of every sample of one tile (the early depth test's state). All 32-bit
 // so a row of W samples is tested and updated as W lanes.
@@ -475,11 +476,18 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
   if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
 
   const std::uint32_t begin = bins.tile_offsets[tile], end = bins.tile_offsets[tile + 1];
+  // The records are gathered from their chunks (whole 64-byte lines, mostly from memory):
+  // prefetched far enough ahead to cover a DRAM miss behind the small triangles' short work.
+  const std::uint32_t* refs = bins.refs.data();
+  for (std::uint32_t k = begin; k < std::min(end, begin + kRecordPrefetch); ++k)
+    _mm_prefetch(reinterpret_cast<const char*>(&bins.record(refs[k])), _MM_HINT_T0);
   for (std::uint32_t k = begin; k < end; ++k) {
-    const SetupTriangle& t = bins.binned[k];
+    if (k + kRecordPrefetch < end)
+      _mm_prefetch(reinterpret_cast<const char*>(&bins.record(refs[k + kRecordPrefetch])), _MM_HINT_T0);
+    const SetupTriangle& t = bins.record(refs[k]);
     const auto ref = static_cast<std::uint32_t>(s.setup.size());
     s.setup.push_back(&t);
-    s.clip_map.push_back(t.clip_map >= 0 ? &bins.clip_maps[t.clip_map] : nullptr);
+    s.clip_map.push_back(t.clip_map >= 0 ? &bins.clip_map(refs[k], t) : nullptr);
     s.flags.push_back((t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u));
     s.object.push_back(t.object);
     raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);

@@ -15,6 +15,8 @@ namespace {
 constexpr std::size_t kVertexChunk = 16384;
 constexpr std::size_t kTriangleChunk = 4096;
 constexpr std::size_t kTileChunk = 64;  // tiles per bin_offsets task
+// Clipping makes at most 7 records of a triangle: a chunk's records must fit a reference.
+static_assert(7 * kTriangleChunk <= std::size_t(1) << kRefIndexBits);
 }  // namespace
 
 namespace {
@@ -51,6 +53,9 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
     throw InputError("rasterizer", "fewer object ids (" + std::to_string(triangle_object.size()) +
                                        ") than triangles (" + std::to_string(triangles) + ")");
   const std::size_t chunks = (triangles + kTriangleChunk - 1) / kTriangleChunk;
+  if (chunks > kMaxChunks)
+    throw InputError("rasterizer", std::to_string(triangles) + " triangles exceed the " +
+                                       std::to_string(kMaxChunks * kTriangleChunk) + " one frame can bin");
   const std::size_t tiles = static_cast<std::size_t>(grid.count());
   bins.chunks.resize(chunks);
   bins.chunk_tile.resize(chunks * tiles);
