@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -26,6 +27,9 @@ constexpr int kBlocksPerTile = kBlocksPerSide * kBlocksPerSide;
 // three products and two sums); the rejection test widens the vertex maximum by far more.
 constexpr float kHizMargin = 1.0f + 1.0f / 4096.0f;
 constexpr std::uint32_t kRecordPrefetch = 16;  // list entries ahead
+// Frames at least this large (5 MB of visibility buffer) are written with streaming stores.
+// Smaller ones (cube-map faces, shadow maps) stay in cache for the pass that reads them.
+constexpr std::size_t kStreamingMinSamples = std::size_t(1) << 18;
 
 // The winner so far of every sample of one tile (the early depth test's state). All 32-bit
 // so a row of W samples is tested and updated as W lanes.
@@ -377,15 +381,23 @@ void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0
   }
 }
 
-// Writes sample `idx` of the tile (frame sample `o`): the winner's ids, depth and
+// One sample's visibility-buffer values.
+struct SampleOut {
+  std::uint32_t* triangle;
+  std::uint32_t* object;
+  float* depth;
+  glm::vec2* bary;
+};
+
+// Writes sample `idx` of the tile to slot o of `out`: the winner's ids, depth and
 // barycentrics in the original triangle, or the empty-sample values.
-inline void resolve_sample(const TileScratch& s, int idx, std::size_t o, VisibilityBuffer& out) {
+inline void resolve_sample(const TileScratch& s, int idx, std::size_t o, const SampleOut& out) {
   const std::uint32_t ref = s.ref[idx];
   if (ref == kNoRef) {
-    out.triangle.pixels[o] = kNoId;
-    out.object.pixels[o] = kNoId;
-    out.depth.pixels[o] = std::numeric_limits<float>::infinity();
-    out.bary.pixels[o] = glm::vec2(0.0f);
+    out.triangle[o] = kNoId;
+    out.object[o] = kNoId;
+    out.depth[o] = std::numeric_limits<float>::infinity();
+    out.bary[o] = glm::vec2(0.0f);
     return;
   }
   const SetupTriangle* t = s.setup[ref];
@@ -397,29 +409,64 @@ inline void resolve_sample(const TileScratch& s, int idx, std::size_t o, Visibil
     const glm::vec3 b = b0 * m->bary[0] + b1 * m->bary[1] + b2 * m->bary[2];
     b1 = b.y, b2 = b.z;
   }
-  out.triangle.pixels[o] = t->triangle;
-  out.object.pixels[o] = t->object;
-  out.depth.pixels[o] = 1.0f / inv_w;
-  out.bary.pixels[o] = glm::vec2(b1, b2);
+  out.triangle[o] = t->triangle;
+  out.object[o] = t->object;
+  out.depth[o] = 1.0f / inv_w;
+  out.bary[o] = glm::vec2(b1, b2);
+}
+
+SampleOut frame_out(VisibilityBuffer& out) {
+  return {out.triangle.pixels.data(), out.object.pixels.data(), out.depth.pixels.data(),
+          out.bary.pixels.data()};
+}
+
+// One resolved tile row, staged in L1 before it is copied out.
+struct RowStage {
+  alignas(32) std::uint32_t triangle[kTileSize];
+  alignas(32) std::uint32_t object[kTileSize];
+  alignas(32) float depth[kTileSize];
+  alignas(32) glm::vec2 bary[kTileSize];
+  SampleOut slots() { return {triangle, object, depth, bary}; }
+};
+
+// Copies `bytes` to dst: the whole 64-byte lines inside the range with streaming stores (they
+// skip reading each destination line first, and a large frame's planes cannot stay cached
+// until the G-buffer reads them anyway), the partial lines at the ends, which neighbouring
+// tiles share, with ordinary stores.
+inline void stream_copy(void* dst, const void* src, std::size_t bytes) {
+  auto* d = static_cast<unsigned char*>(dst);
+  const auto* s = static_cast<const unsigned char*>(src);
+  const std::size_t head = std::min(bytes, (64 - (reinterpret_cast<std::uintptr_t>(d) & 63)) & 63);
+  std::memcpy(d, s, head);
+  d += head, s += head, bytes -= head;
+  for (; bytes >= 64; d += 64, s += 64, bytes -= 64) {
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(d),
+                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s)));
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(d + 32),
+                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s + 32)));
+  }
+  std::memcpy(d, s, bytes);
 }
 
 // The resolve 8 samples at a time: the same IEEE divisions as resolve_sample (so the same
 // bits), the winners' object ids gathered from the tile's refs, clipped winners and the row
-// tail left to resolve_sample.
+// tail left to resolve_sample. Each row is resolved into a stage; `stream` copies it out with
+// streaming stores (large frames), otherwise with ordinary ones.
 void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
-                       const Viewport& vp, VisibilityBuffer& out) {
+                       const Viewport& vp, bool stream, VisibilityBuffer& out) {
   const __m256i no_ref = _mm256_set1_epi32(-1);
   const __m256 one = _mm256_set1_ps(1.0f);
   const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   const int* flags = reinterpret_cast<const int*>(s.flags.data());
   const int* objects = reinterpret_cast<const int*>(s.object.data());
-  const int full = (tx1 - tx0 + 1) / 8 * 8;
+  const int n = tx1 - tx0 + 1;
+  const int full = n / 8 * 8;
+  RowStage stage;
+  const SampleOut slots = stage.slots();
   for (int y = ty0; y <= ty1; ++y) {
     const int row = (y - ty0) * kTileSize;
-    const std::size_t orow = static_cast<std::size_t>(y) * vp.width + tx0;
     for (int x = 0; x < full; x += 8) {
       const int idx = row + x;
-      const std::size_t o = orow + x;
       const __m256i ref = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.ref[idx]));
       const __m256i valid = _mm256_xor_si256(_mm256_cmpeq_epi32(ref, no_ref), no_ref);
       const __m256i flag =
@@ -440,19 +487,33 @@ void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
       const __m256 b2 = _mm256_and_ps(validf, _mm256_blendv_ps(q2, q1, swapped));
       const __m256 depth = _mm256_blendv_ps(inf, _mm256_div_ps(one, inv_w), validf);
       // Empty samples keep kNoId in s.triangle (never won).
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&out.triangle.pixels[o]), tri);
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&out.object.pixels[o]), object);
-      _mm256_storeu_ps(&out.depth.pixels[o], depth);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(&stage.triangle[x]), tri);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(&stage.object[x]), object);
+      _mm256_store_ps(&stage.depth[x], depth);
       const __m256 lo = _mm256_unpacklo_ps(b1, b2), hi = _mm256_unpackhi_ps(b1, b2);
-      float* bary = &out.bary.pixels[o].x;
-      _mm256_storeu_ps(bary, _mm256_permute2f128_ps(lo, hi, 0x20));
-      _mm256_storeu_ps(bary + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
+      float* bary = &stage.bary[x].x;
+      _mm256_store_ps(bary, _mm256_permute2f128_ps(lo, hi, 0x20));
+      _mm256_store_ps(bary + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
       if (const int c = _mm256_movemask_ps(_mm256_castsi256_ps(clipped)); c != 0)
         for (int l = 0; l < 8; ++l)
-          if (c & (1 << l)) resolve_sample(s, idx + l, o + l, out);
+          if (c & (1 << l)) resolve_sample(s, idx + l, std::size_t(x + l), slots);
     }
-    for (int x = full; x <= tx1 - tx0; ++x) resolve_sample(s, row + x, orow + x, out);
+    for (int x = full; x < n; ++x) resolve_sample(s, row + x, std::size_t(x), slots);
+    const std::size_t o = static_cast<std::size_t>(y) * vp.width + tx0;
+    const std::size_t u = static_cast<std::size_t>(n);
+    if (stream) {
+      stream_copy(&out.triangle.pixels[o], stage.triangle, u * sizeof(std::uint32_t));
+      stream_copy(&out.object.pixels[o], stage.object, u * sizeof(std::uint32_t));
+      stream_copy(&out.depth.pixels[o], stage.depth, u * sizeof(float));
+      stream_copy(&out.bary.pixels[o], stage.bary, u * sizeof(glm::vec2));
+    } else {
+      std::memcpy(&out.triangle.pixels[o], stage.triangle, u * sizeof(std::uint32_t));
+      std::memcpy(&out.object.pixels[o], stage.object, u * sizeof(std::uint32_t));
+      std::memcpy(&out.depth.pixels[o], stage.depth, u * sizeof(float));
+      std::memcpy(&out.bary.pixels[o], stage.bary, u * sizeof(glm::vec2));
+    }
   }
+  if (stream) _mm_sfence();  // weakly ordered: fence before another thread reads the frame
 }
 
 template <int W>
@@ -495,15 +556,17 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
 
   // Resolve: barycentrics only for the winners (deferred, like a visibility buffer).
   if (W == 8 && !s.count_coverage) {
-    resolve_tile_avx2(s, tx0, ty0, tx1, ty1, vp, out);
+    const bool stream = std::size_t(vp.width) * std::size_t(vp.height) >= kStreamingMinSamples;
+    resolve_tile_avx2(s, tx0, ty0, tx1, ty1, vp, stream, out);
     return;
   }
+  const SampleOut frame = frame_out(out);
   for (int y = ty0; y <= ty1; ++y) {
     for (int x = tx0; x <= tx1; ++x) {
       const int idx = (y - ty0) * kTileSize + (x - tx0);
       const std::size_t o = static_cast<std::size_t>(y) * vp.width + x;
       if (s.count_coverage) out.coverage.pixels[o] = s.coverage[idx];
-      resolve_sample(s, idx, o, out);
+      resolve_sample(s, idx, o, frame);
     }
   }
 }
