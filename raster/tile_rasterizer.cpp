@@ -221,12 +221,54 @@ bool raster_rect_lanes(const Edges& e, const SetupTriangle& t, std::uint32_t ref
   return won;
 }
 
+// The depth test and update of 8 samples of one tile row for the AVX2 paths below: given
+// the covered lanes and the float edge values, the same float operations as
+// raster_rect_lanes in the same order (same bits). The stores write back the loaded value
+// where a lane did not win (lanes past the row end stay inside the padded arrays, and one
+// thread owns the tile), so a row needs no branch.
+struct DepthTest8 {
+  __m256 ia, iw0, iw1, iw2;
+  __m256i flip, tri, tri_flipped, refs;
+  __m256i won = _mm256_setzero_si256();
+
+  DepthTest8(const Edges& e, const SetupTriangle& t, std::uint32_t ref)
+      : ia(_mm256_set1_ps(e.inv_area)), iw0(_mm256_set1_ps(e.inv_w[0])),
+        iw1(_mm256_set1_ps(e.inv_w[1])), iw2(_mm256_set1_ps(e.inv_w[2])),
+        // Unsigned triangle-index order through a signed compare of sign-flipped values.
+        flip(_mm256_set1_epi32(std::int32_t(0x80000000u))),
+        tri(_mm256_set1_epi32(std::int32_t(t.triangle))),
+        tri_flipped(_mm256_xor_si256(tri, flip)), refs(_mm256_set1_epi32(std::int32_t(ref))) {}
+
+  inline void operator()(__m256i inside, __m256 f0, __m256 f1, __m256 f2, int idx, TileScratch& s) {
+    const __m256 p0 = _mm256_mul_ps(_mm256_mul_ps(f0, ia), iw0);
+    const __m256 p1 = _mm256_mul_ps(_mm256_mul_ps(f1, ia), iw1);
+    const __m256 p2 = _mm256_mul_ps(_mm256_mul_ps(f2, ia), iw2);
+    const __m256 inv_w = _mm256_add_ps(_mm256_add_ps(p0, p1), p2);
+    const __m256 best = _mm256_loadu_ps(&s.inv_w[idx]);
+    const __m256i best_tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.triangle[idx]));
+    const __m256 nearer = _mm256_cmp_ps(inv_w, best, _CMP_GT_OQ);
+    const __m256 tie = _mm256_and_ps(
+        _mm256_cmp_ps(inv_w, best, _CMP_EQ_OQ),
+        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_xor_si256(best_tri, flip), tri_flipped)));
+    const __m256 win = _mm256_and_ps(_mm256_castsi256_ps(inside), _mm256_or_ps(nearer, tie));
+    won = _mm256_or_si256(won, _mm256_castps_si256(win));
+    _mm256_storeu_ps(&s.inv_w[idx], _mm256_blendv_ps(best, inv_w, win));
+    _mm256_storeu_ps(&s.p1[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p1[idx]), p1, win));
+    _mm256_storeu_ps(&s.p2[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p2[idx]), p2, win));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(&s.triangle[idx]),
+                        _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(best_tri),
+                                                             _mm256_castsi256_ps(tri), win)));
+    __m256i* ref_at = reinterpret_cast<__m256i*>(&s.ref[idx]);
+    _mm256_storeu_si256(ref_at, _mm256_castps_si256(_mm256_blendv_ps(
+                                    _mm256_castsi256_ps(_mm256_loadu_si256(ref_at)),
+                                    _mm256_castsi256_ps(refs), win)));
+  }
+  bool any_won() const { return !_mm256_testz_si256(won, won); }
+};
+
 // The 32-bit path for 8 lanes in AVX2 intrinsics, branch-free inside a row: random small
 // triangles made the "any lane covered / any lane won" branches of raster_rect_lanes
-// mispredict about half the time. The stores write back the loaded value where a lane did
-// not win (lanes past the row end stay inside the padded arrays, and one thread owns the
-// tile), so the samples see exactly the comparisons and float operations of
-// raster_rect_lanes, in the same order: same bits. Not used when counting coverage.
+// mispredict about half the time. Not used when counting coverage.
 bool raster_rect_avx2(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
                       int x1, int y1, int ox, int oy, TileScratch& s) {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -243,14 +285,7 @@ bool raster_rect_avx2(const Edges& e, const SetupTriangle& t, std::uint32_t ref,
   const __m256i t0 = _mm256_set1_epi32(std::int32_t(e.threshold[0]) - 1),
                 t1 = _mm256_set1_epi32(std::int32_t(e.threshold[1]) - 1),
                 t2 = _mm256_set1_epi32(std::int32_t(e.threshold[2]) - 1);
-  const __m256 ia = _mm256_set1_ps(e.inv_area), iw0 = _mm256_set1_ps(e.inv_w[0]),
-               iw1 = _mm256_set1_ps(e.inv_w[1]), iw2 = _mm256_set1_ps(e.inv_w[2]);
-  // Unsigned triangle-index order through a signed compare of sign-flipped values.
-  const __m256i flip = _mm256_set1_epi32(std::int32_t(0x80000000u));
-  const __m256i tri = _mm256_set1_epi32(std::int32_t(t.triangle));
-  const __m256i tri_flipped = _mm256_xor_si256(tri, flip);
-  const __m256i refs = _mm256_set1_epi32(std::int32_t(ref));
-  __m256i won = _mm256_setzero_si256();
+  DepthTest8 test(e, t, ref);
   std::int32_t start0 = std::int32_t(edge_at(e, 0, x0, y0)),
                start1 = std::int32_t(edge_at(e, 1, x0, y0)),
                start2 = std::int32_t(edge_at(e, 2, x0, y0));
@@ -264,32 +299,67 @@ bool raster_rect_avx2(const Edges& e, const SetupTriangle& t, std::uint32_t ref,
       const __m256i inside = _mm256_and_si256(
           _mm256_and_si256(_mm256_cmpgt_epi32(v0, t0), _mm256_cmpgt_epi32(v1, t1)),
           _mm256_and_si256(_mm256_cmpgt_epi32(v2, t2), in_row));
-      const __m256 p0 = _mm256_mul_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(v0), ia), iw0);
-      const __m256 p1 = _mm256_mul_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(v1), ia), iw1);
-      const __m256 p2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(v2), ia), iw2);
-      const __m256 inv_w = _mm256_add_ps(_mm256_add_ps(p0, p1), p2);
-      const int idx = (y - oy) * kTileSize + (x - ox);
-      const __m256 best = _mm256_loadu_ps(&s.inv_w[idx]);
-      const __m256i best_tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.triangle[idx]));
-      const __m256 nearer = _mm256_cmp_ps(inv_w, best, _CMP_GT_OQ);
-      const __m256 tie = _mm256_and_ps(
-          _mm256_cmp_ps(inv_w, best, _CMP_EQ_OQ),
-          _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_xor_si256(best_tri, flip), tri_flipped)));
-      const __m256 win = _mm256_and_ps(_mm256_castsi256_ps(inside), _mm256_or_ps(nearer, tie));
-      won = _mm256_or_si256(won, _mm256_castps_si256(win));
-      _mm256_storeu_ps(&s.inv_w[idx], _mm256_blendv_ps(best, inv_w, win));
-      _mm256_storeu_ps(&s.p1[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p1[idx]), p1, win));
-      _mm256_storeu_ps(&s.p2[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p2[idx]), p2, win));
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&s.triangle[idx]),
-                          _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(best_tri),
-                                                               _mm256_castsi256_ps(tri), win)));
-      __m256i* ref_at = reinterpret_cast<__m256i*>(&s.ref[idx]);
-      _mm256_storeu_si256(ref_at, _mm256_castps_si256(_mm256_blendv_ps(
-                                      _mm256_castsi256_ps(_mm256_loadu_si256(ref_at)),
-                                      _mm256_castsi256_ps(refs), win)));
+      test(inside, _mm256_cvtepi32_ps(v0), _mm256_cvtepi32_ps(v1), _mm256_cvtepi32_ps(v2),
+           (y - oy) * kTileSize + (x - ox), s);
     }
   }
-  return !_mm256_testz_si256(won, won);
+  return test.any_won();
+}
+
+// The wide path for 8 lanes in AVX2: edge values beyond int32 (large triangles, e.g. walls
+// reaching into the guard band) held in doubles, two registers of 4 per edge. Every value is
+// an integer below 2^50 in magnitude (the guard band keeps fixed-point coordinates below
+// 2^23, so |A|, |B| < 2^24 and |C| < 2^47), so the
+// doubles hold the int64 values of raster_rect_wide exactly, their sums are exact, the
+// threshold compares are exact, and converting to float rounds once to nearest, as the
+// int64 → float conversion does: the same bits. Not used when counting coverage.
+bool raster_rect_avx2_wide(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0,
+                           int y0, int x1, int y1, int ox, int oy, TileScratch& s) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256d lo_lane = _mm256_setr_pd(0, 1, 2, 3), hi_lane = _mm256_setr_pd(4, 5, 6, 7);
+  __m256d off_lo[3], off_hi[3], thr[3];
+  double row[3], down[3], start[3];
+  for (int i = 0; i < 3; ++i) {
+    const __m256d step = _mm256_set1_pd(double(e.a[i] * kSubpixelOne));
+    off_lo[i] = _mm256_mul_pd(lo_lane, step);  // exact: small integers times an integer < 2^32
+    off_hi[i] = _mm256_mul_pd(hi_lane, step);
+    row[i] = double(e.a[i] * kSubpixelOne * 8);
+    down[i] = double(e.b[i] * kSubpixelOne);
+    start[i] = double(edge_at(e, i, x0, y0));
+    thr[i] = _mm256_set1_pd(double(e.threshold[i]));
+  }
+  DepthTest8 test(e, t, ref);
+  auto covered = [](__m256d lo, __m256d hi, __m256d threshold) {
+    const __m256i l = _mm256_castpd_si256(_mm256_cmp_pd(lo, threshold, _CMP_GE_OQ));
+    const __m256i h = _mm256_castpd_si256(_mm256_cmp_pd(hi, threshold, _CMP_GE_OQ));
+    // 64-bit masks → 32-bit lanes in order: take the low halves of each 64-bit lane.
+    const __m256i idx = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+    return _mm256_blend_epi32(_mm256_permutevar8x32_epi32(l, idx),
+                              _mm256_permutevar8x32_epi32(h, idx), 0xf0);
+  };
+  auto to_float = [](__m256d lo, __m256d hi) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(lo)), _mm256_cvtpd_ps(hi), 1);
+  };
+  for (int y = y0; y <= y1; ++y) {
+    double r[3] = {start[0], start[1], start[2]};
+    for (int x = x0; x <= x1; x += 8) {
+      __m256d lo[3], hi[3];
+      for (int i = 0; i < 3; ++i) {
+        const __m256d base = _mm256_set1_pd(r[i]);
+        lo[i] = _mm256_add_pd(base, off_lo[i]);
+        hi[i] = _mm256_add_pd(base, off_hi[i]);
+        r[i] += row[i];
+      }
+      const __m256i in_row = _mm256_cmpgt_epi32(_mm256_set1_epi32(x1 - x + 1), lane);
+      const __m256i inside = _mm256_and_si256(
+          _mm256_and_si256(covered(lo[0], hi[0], thr[0]), covered(lo[1], hi[1], thr[1])),
+          _mm256_and_si256(covered(lo[2], hi[2], thr[2]), in_row));
+      test(inside, to_float(lo[0], hi[0]), to_float(lo[1], hi[1]), to_float(lo[2], hi[2]),
+           (y - oy) * kTileSize + (x - ox), s);
+    }
+    for (int i = 0; i < 3; ++i) start[i] += down[i];
+  }
+  return test.any_won();
 }
 
 // Picks the 32-bit lane path for small triangles (see make_edges) or when |E| stays below
@@ -308,6 +378,8 @@ bool raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int 
     }
   if (narrow && W == 8 && !s.count_coverage)
     return raster_rect_avx2(e, t, ref, x0, y0, x1, y1, ox, oy, s);
+  if (W == 8 && !s.count_coverage)
+    return raster_rect_avx2_wide(e, t, ref, x0, y0, x1, y1, ox, oy, s);
   if (narrow && W > 1) return raster_rect_lanes<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
   return raster_rect_wide<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
 }
