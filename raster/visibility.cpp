@@ -6,6 +6,7 @@
 
 #include "core/camera_rays.h"
 #include "core/error.h"
+#include "parallel/page_buffer.h"
 #include "raster/tile_binning.h"
 #include "raster/tile_rasterizer.h"
 #include "raster/triangle_setup.h"
@@ -34,7 +35,13 @@ int cull_sign(CullMode mode) {
 
 template <class T>
 void ensure_size(Buffer2D<T>& b, int width, int height) {
-  if (b.width != width || b.height != height) b = Buffer2D<T>(width, height);
+  // On 2 MiB pages where the kernel allows: a 1080p frame's planes span thousands of 4 KiB
+  // pages, and the tile-row writes and record gathers would miss the TLB on most of them.
+  if (b.width != width || b.height != height) {
+    b.width = width;
+    b.height = height;
+    par::resize_on_huge_pages(b.pixels, static_cast<std::size_t>(width) * height);
+  }
 }
 
 }  // namespace
