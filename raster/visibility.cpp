@@ -35,8 +35,8 @@ int cull_sign(CullMode mode) {
 
 template <class T>
 void ensure_size(Buffer2D<T>& b, int width, int height) {
-  // On 2 MiB pages where the kernel allows: a 1080p frame's planes span thousands of 4 KiB
-  // pages, and the tile-row writes and record gathers would miss the TLB on most of them.
+  // On 2 MiB pages where the kernel allows: each tile row lands on another 4 KiB page of
+  // every plane, so on small pages nearly every row write of the tile pass missed the TLB.
   if (b.width != width || b.height != height) {
     b.width = width;
     b.height = height;
