@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/normal_mapping.h"
+#include "parallel/page_buffer.h"
 #include "raster/gbuffer_normals.h"
 #include "raster/gbuffer_stream.h"
 
@@ -24,7 +25,13 @@ constexpr std::size_t kPixelChunk = 4096;
 
 template <class T>
 void ensure_size(Buffer2D<T>& b, int width, int height) {
-  if (b.width != width || b.height != height) b = Buffer2D<T>(width, height);
+  // On 2 MiB pages where the kernel allows: a 1080p frame's six planes span over 40 000 4 KiB
+  // pages, and the resolve's streaming writes would keep missing the TLB.
+  if (b.width != width || b.height != height) {
+    b.width = width;
+    b.height = height;
+    par::resize_on_huge_pages(b.pixels, static_cast<std::size_t>(width) * height);
+  }
 }
 
 // Samples resolved per staging block: 64 makes every plane's share of a block a whole

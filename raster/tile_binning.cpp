@@ -3,15 +3,19 @@
 
 #include <algorithm>
 
-#include <immintrin.h>
-
 namespace speculum::raster {
 namespace {
 
+inline std::uint32_t tile_box(const SetupTriangle& t) {
+  const std::uint32_t tx0 = std::uint32_t(t.px0) >> kTileShift, tx1 = std::uint32_t(t.px1) >> kTileShift;
+  const std::uint32_t ty0 = std::uint32_t(t.py0) >> kTileShift, ty1 = std::uint32_t(t.py1) >> kTileShift;
+  return tx0 | ty0 << 8 | tx1 << 16 | ty1 << 24;
+}
+
 template <class Visit>
-inline void for_each_tile(const SetupTriangle& t, const TileGrid& grid, Visit&& visit) {
-  const int tx0 = t.px0 >> kTileShift, tx1 = t.px1 >> kTileShift;
-  const int ty0 = t.py0 >> kTileShift, ty1 = t.py1 >> kTileShift;
+inline void for_each_tile(std::uint32_t box, const TileGrid& grid, Visit&& visit) {
+  const int tx0 = int(box & 0xff), ty0 = int(box >> 8 & 0xff);
+  const int tx1 = int(box >> 16 & 0xff), ty1 = int(box >> 24);
   for (int ty = ty0; ty <= ty1; ++ty)
     for (int tx = tx0; tx <= tx1; ++tx) visit(ty * grid.tiles_x + tx);
 }
@@ -22,9 +26,14 @@ void count_chunk(TileBins& bins, std::size_t chunk, const TileGrid& grid) {
   const std::size_t tiles = static_cast<std::size_t>(grid.count());
   std::uint32_t* counts = &bins.chunk_tile[chunk * tiles];
   std::fill(counts, counts + tiles, 0u);
-  const BinnedChunk& c = bins.chunks[chunk];
-  for (std::size_t i = 0; i < c.count; ++i)
-    for_each_tile(c.triangles[i], grid, [&](int tile) { ++counts[tile]; });
+  BinnedChunk& c = bins.chunks[chunk];
+  if (c.tile_box.size() < c.count) c.tile_box.resize(c.count);
+  for (std::size_t i = 0; i < c.count; ++i) {
+    const std::uint32_t box = tile_box(c.triangles[i]);
+    c.tile_box[i] = box;
+    if ((box & 0xffff) == box >> 16) ++counts[(box >> 8 & 0xff) * std::uint32_t(grid.tiles_x) + (box & 0xff)];
+    else for_each_tile(box, grid, [&](int tile) { ++counts[tile]; });
+  }
 }
 
 void bin_offsets(TileBins& bins, std::size_t begin, std::size_t end, const TileGrid& grid) {
@@ -46,15 +55,8 @@ void finish_offsets(TileBins& bins, const TileGrid& grid) {
   const std::size_t tiles = static_cast<std::size_t>(grid.count());
   bins.tile_offsets[0] = 0;
   for (std::size_t t = 0; t < tiles; ++t) bins.tile_offsets[t + 1] += bins.tile_offsets[t];
-  bins.clip_base.resize(bins.chunks.size());
-  std::uint32_t clips = 0;
-  for (std::size_t c = 0; c < bins.chunks.size(); ++c) {
-    bins.clip_base[c] = clips;
-    clips += static_cast<std::uint32_t>(bins.chunks[c].clip_maps.size());
-  }
-  bins.clip_maps.resize(clips);
   // Grows only: keeps last frame's pages when the size is unchanged.
-  if (bins.binned.size() < bins.tile_offsets[tiles]) bins.binned.resize(bins.tile_offsets[tiles]);
+  if (bins.refs.size() < bins.tile_offsets[tiles]) bins.refs.resize(bins.tile_offsets[tiles]);
 }
 
 void scatter_chunk(TileBins& bins, std::size_t chunk, const TileGrid& grid) {
@@ -62,23 +64,18 @@ void scatter_chunk(TileBins& bins, std::size_t chunk, const TileGrid& grid) {
   std::uint32_t* cursor = &bins.chunk_tile[chunk * tiles];  // this chunk's row only
   const std::uint32_t* start = bins.tile_offsets.data();
   const BinnedChunk& c = bins.chunks[chunk];
-  const std::int32_t clip_base = static_cast<std::int32_t>(bins.clip_base[chunk]);
-  std::copy(c.clip_maps.begin(), c.clip_maps.end(), bins.clip_maps.begin() + clip_base);
-  SetupTriangle* out = bins.binned.data();
+  std::uint32_t* out = bins.refs.data();
+  const std::uint32_t base = static_cast<std::uint32_t>(chunk) << kRefIndexBits;
   for (std::size_t i = 0; i < c.count; ++i) {
-    SetupTriangle t = c.triangles[i];
-    if (t.clip_map >= 0) t.clip_map += clip_base;
-    // Whole, aligned cache lines that the tile pass reads much later: streaming stores
-    // skip reading the destination lines first.
-    const __m256i lo = _mm256_load_si256(reinterpret_cast<const __m256i*>(&t));
-    const __m256i hi = _mm256_load_si256(reinterpret_cast<const __m256i*>(&t) + 1);
-    for_each_tile(t, grid, [&](int tile) {
-      __m256i* dst = reinterpret_cast<__m256i*>(&out[start[tile] + cursor[tile]++]);
-      _mm256_stream_si256(dst, lo);
-      _mm256_stream_si256(dst + 1, hi);
-    });
+    const std::uint32_t ref = base | static_cast<std::uint32_t>(i);
+    const std::uint32_t box = c.tile_box[i];
+    if ((box & 0xffff) == box >> 16) {  // one tile: most triangles of a detailed mesh
+      const std::uint32_t tile = (box >> 8 & 0xff) * std::uint32_t(grid.tiles_x) + (box & 0xff);
+      out[start[tile] + cursor[tile]++] = ref;
+    } else {
+      for_each_tile(box, grid, [&](int tile) { out[start[tile] + cursor[tile]++] = ref; });
+    }
   }
-  _mm_sfence();
 }
 
 }  // namespace speculum::raster

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -25,6 +26,10 @@ constexpr int kBlocksPerTile = kBlocksPerSide * kBlocksPerSide;
 // Interpolated 1/w = Σ λ_i/w_i may exceed the largest vertex 1/w by rounding (a few ulps of
 // three products and two sums); the rejection test widens the vertex maximum by far more.
 constexpr float kHizMargin = 1.0f + 1.0f / 4096.0f;
+constexpr std::uint32_t kRecordPrefetch = 16;  // list entries ahead
+// Frames at least this large (5 MB of visibility buffer) are written with streaming stores.
+// Smaller ones (cube-map faces, shadow maps) stay in cache for the pass that reads them.
+constexpr std::size_t kStreamingMinSamples = std::size_t(1) << 18;
 
 // The winner so far of every sample of one tile (the early depth test's state). All 32-bit
 // so a row of W samples is tested and updated as W lanes.
@@ -216,12 +221,54 @@ bool raster_rect_lanes(const Edges& e, const SetupTriangle& t, std::uint32_t ref
   return won;
 }
 
+// The depth test and update of 8 samples of one tile row for the AVX2 paths below: given
+// the covered lanes and the float edge values, the same float operations as
+// raster_rect_lanes in the same order (same bits). The stores write back the loaded value
+// where a lane did not win (lanes past the row end stay inside the padded arrays, and one
+// thread owns the tile), so a row needs no branch.
+struct DepthTest8 {
+  __m256 ia, iw0, iw1, iw2;
+  __m256i flip, tri, tri_flipped, refs;
+  __m256i won = _mm256_setzero_si256();
+
+  DepthTest8(const Edges& e, const SetupTriangle& t, std::uint32_t ref)
+      : ia(_mm256_set1_ps(e.inv_area)), iw0(_mm256_set1_ps(e.inv_w[0])),
+        iw1(_mm256_set1_ps(e.inv_w[1])), iw2(_mm256_set1_ps(e.inv_w[2])),
+        // Unsigned triangle-index order through a signed compare of sign-flipped values.
+        flip(_mm256_set1_epi32(std::int32_t(0x80000000u))),
+        tri(_mm256_set1_epi32(std::int32_t(t.triangle))),
+        tri_flipped(_mm256_xor_si256(tri, flip)), refs(_mm256_set1_epi32(std::int32_t(ref))) {}
+
+  inline void operator()(__m256i inside, __m256 f0, __m256 f1, __m256 f2, int idx, TileScratch& s) {
+    const __m256 p0 = _mm256_mul_ps(_mm256_mul_ps(f0, ia), iw0);
+    const __m256 p1 = _mm256_mul_ps(_mm256_mul_ps(f1, ia), iw1);
+    const __m256 p2 = _mm256_mul_ps(_mm256_mul_ps(f2, ia), iw2);
+    const __m256 inv_w = _mm256_add_ps(_mm256_add_ps(p0, p1), p2);
+    const __m256 best = _mm256_loadu_ps(&s.inv_w[idx]);
+    const __m256i best_tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.triangle[idx]));
+    const __m256 nearer = _mm256_cmp_ps(inv_w, best, _CMP_GT_OQ);
+    const __m256 tie = _mm256_and_ps(
+        _mm256_cmp_ps(inv_w, best, _CMP_EQ_OQ),
+        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_xor_si256(best_tri, flip), tri_flipped)));
+    const __m256 win = _mm256_and_ps(_mm256_castsi256_ps(inside), _mm256_or_ps(nearer, tie));
+    won = _mm256_or_si256(won, _mm256_castps_si256(win));
+    _mm256_storeu_ps(&s.inv_w[idx], _mm256_blendv_ps(best, inv_w, win));
+    _mm256_storeu_ps(&s.p1[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p1[idx]), p1, win));
+    _mm256_storeu_ps(&s.p2[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p2[idx]), p2, win));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(&s.triangle[idx]),
+                        _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(best_tri),
+                                                             _mm256_castsi256_ps(tri), win)));
+    __m256i* ref_at = reinterpret_cast<__m256i*>(&s.ref[idx]);
+    _mm256_storeu_si256(ref_at, _mm256_castps_si256(_mm256_blendv_ps(
+                                    _mm256_castsi256_ps(_mm256_loadu_si256(ref_at)),
+                                    _mm256_castsi256_ps(refs), win)));
+  }
+  bool any_won() const { return !_mm256_testz_si256(won, won); }
+};
+
 // The 32-bit path for 8 lanes in AVX2 intrinsics, branch-free inside a row: random small
 // triangles made the "any lane covered / any lane won" branches of raster_rect_lanes
-// mispredict about half the time. The stores write back the loaded value where a lane did
-// not win (lanes past the row end stay inside the padded arrays, and one thread owns the
-// tile), so the samples see exactly the comparisons and float operations of
-// raster_rect_lanes, in the same order: same bits. Not used when counting coverage.
+// mispredict about half the time. Not used when counting coverage.
 bool raster_rect_avx2(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0, int y0,
                       int x1, int y1, int ox, int oy, TileScratch& s) {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -238,14 +285,7 @@ bool raster_rect_avx2(const Edges& e, const SetupTriangle& t, std::uint32_t ref,
   const __m256i t0 = _mm256_set1_epi32(std::int32_t(e.threshold[0]) - 1),
                 t1 = _mm256_set1_epi32(std::int32_t(e.threshold[1]) - 1),
                 t2 = _mm256_set1_epi32(std::int32_t(e.threshold[2]) - 1);
-  const __m256 ia = _mm256_set1_ps(e.inv_area), iw0 = _mm256_set1_ps(e.inv_w[0]),
-               iw1 = _mm256_set1_ps(e.inv_w[1]), iw2 = _mm256_set1_ps(e.inv_w[2]);
-  // Unsigned triangle-index order through a signed compare of sign-flipped values.
-  const __m256i flip = _mm256_set1_epi32(std::int32_t(0x80000000u));
-  const __m256i tri = _mm256_set1_epi32(std::int32_t(t.triangle));
-  const __m256i tri_flipped = _mm256_xor_si256(tri, flip);
-  const __m256i refs = _mm256_set1_epi32(std::int32_t(ref));
-  __m256i won = _mm256_setzero_si256();
+  DepthTest8 test(e, t, ref);
   std::int32_t start0 = std::int32_t(edge_at(e, 0, x0, y0)),
                start1 = std::int32_t(edge_at(e, 1, x0, y0)),
                start2 = std::int32_t(edge_at(e, 2, x0, y0));
@@ -259,32 +299,67 @@ bool raster_rect_avx2(const Edges& e, const SetupTriangle& t, std::uint32_t ref,
       const __m256i inside = _mm256_and_si256(
           _mm256_and_si256(_mm256_cmpgt_epi32(v0, t0), _mm256_cmpgt_epi32(v1, t1)),
           _mm256_and_si256(_mm256_cmpgt_epi32(v2, t2), in_row));
-      const __m256 p0 = _mm256_mul_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(v0), ia), iw0);
-      const __m256 p1 = _mm256_mul_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(v1), ia), iw1);
-      const __m256 p2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(v2), ia), iw2);
-      const __m256 inv_w = _mm256_add_ps(_mm256_add_ps(p0, p1), p2);
-      const int idx = (y - oy) * kTileSize + (x - ox);
-      const __m256 best = _mm256_loadu_ps(&s.inv_w[idx]);
-      const __m256i best_tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.triangle[idx]));
-      const __m256 nearer = _mm256_cmp_ps(inv_w, best, _CMP_GT_OQ);
-      const __m256 tie = _mm256_and_ps(
-          _mm256_cmp_ps(inv_w, best, _CMP_EQ_OQ),
-          _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_xor_si256(best_tri, flip), tri_flipped)));
-      const __m256 win = _mm256_and_ps(_mm256_castsi256_ps(inside), _mm256_or_ps(nearer, tie));
-      won = _mm256_or_si256(won, _mm256_castps_si256(win));
-      _mm256_storeu_ps(&s.inv_w[idx], _mm256_blendv_ps(best, inv_w, win));
-      _mm256_storeu_ps(&s.p1[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p1[idx]), p1, win));
-      _mm256_storeu_ps(&s.p2[idx], _mm256_blendv_ps(_mm256_loadu_ps(&s.p2[idx]), p2, win));
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&s.triangle[idx]),
-                          _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(best_tri),
-                                                               _mm256_castsi256_ps(tri), win)));
-      __m256i* ref_at = reinterpret_cast<__m256i*>(&s.ref[idx]);
-      _mm256_storeu_si256(ref_at, _mm256_castps_si256(_mm256_blendv_ps(
-                                      _mm256_castsi256_ps(_mm256_loadu_si256(ref_at)),
-                                      _mm256_castsi256_ps(refs), win)));
+      test(inside, _mm256_cvtepi32_ps(v0), _mm256_cvtepi32_ps(v1), _mm256_cvtepi32_ps(v2),
+           (y - oy) * kTileSize + (x - ox), s);
     }
   }
-  return !_mm256_testz_si256(won, won);
+  return test.any_won();
+}
+
+// The wide path for 8 lanes in AVX2: edge values beyond int32 (large triangles, e.g. walls
+// reaching into the guard band) held in doubles, two registers of 4 per edge. Every value is
+// an integer below 2^50 in magnitude (the guard band keeps fixed-point coordinates below
+// 2^23, so |A|, |B| < 2^24 and |C| < 2^47), so the
+// doubles hold the int64 values of raster_rect_wide exactly, their sums are exact, the
+// threshold compares are exact, and converting to float rounds once to nearest, as the
+// int64 → float conversion does: the same bits. Not used when counting coverage.
+bool raster_rect_avx2_wide(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int x0,
+                           int y0, int x1, int y1, int ox, int oy, TileScratch& s) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256d lo_lane = _mm256_setr_pd(0, 1, 2, 3), hi_lane = _mm256_setr_pd(4, 5, 6, 7);
+  __m256d off_lo[3], off_hi[3], thr[3];
+  double row[3], down[3], start[3];
+  for (int i = 0; i < 3; ++i) {
+    const __m256d step = _mm256_set1_pd(double(e.a[i] * kSubpixelOne));
+    off_lo[i] = _mm256_mul_pd(lo_lane, step);  // exact: small integers times an integer < 2^32
+    off_hi[i] = _mm256_mul_pd(hi_lane, step);
+    row[i] = double(e.a[i] * kSubpixelOne * 8);
+    down[i] = double(e.b[i] * kSubpixelOne);
+    start[i] = double(edge_at(e, i, x0, y0));
+    thr[i] = _mm256_set1_pd(double(e.threshold[i]));
+  }
+  DepthTest8 test(e, t, ref);
+  auto covered = [](__m256d lo, __m256d hi, __m256d threshold) {
+    const __m256i l = _mm256_castpd_si256(_mm256_cmp_pd(lo, threshold, _CMP_GE_OQ));
+    const __m256i h = _mm256_castpd_si256(_mm256_cmp_pd(hi, threshold, _CMP_GE_OQ));
+    // 64-bit masks → 32-bit lanes in order: take the low halves of each 64-bit lane.
+    const __m256i idx = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+    return _mm256_blend_epi32(_mm256_permutevar8x32_epi32(l, idx),
+                              _mm256_permutevar8x32_epi32(h, idx), 0xf0);
+  };
+  auto to_float = [](__m256d lo, __m256d hi) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(lo)), _mm256_cvtpd_ps(hi), 1);
+  };
+  for (int y = y0; y <= y1; ++y) {
+    double r[3] = {start[0], start[1], start[2]};
+    for (int x = x0; x <= x1; x += 8) {
+      __m256d lo[3], hi[3];
+      for (int i = 0; i < 3; ++i) {
+        const __m256d base = _mm256_set1_pd(r[i]);
+        lo[i] = _mm256_add_pd(base, off_lo[i]);
+        hi[i] = _mm256_add_pd(base, off_hi[i]);
+        r[i] += row[i];
+      }
+      const __m256i in_row = _mm256_cmpgt_epi32(_mm256_set1_epi32(x1 - x + 1), lane);
+      const __m256i inside = _mm256_and_si256(
+          _mm256_and_si256(covered(lo[0], hi[0], thr[0]), covered(lo[1], hi[1], thr[1])),
+          _mm256_and_si256(covered(lo[2], hi[2], thr[2]), in_row));
+      test(inside, to_float(lo[0], hi[0]), to_float(lo[1], hi[1]), to_float(lo[2], hi[2]),
+           (y - oy) * kTileSize + (x - ox), s);
+    }
+    for (int i = 0; i < 3; ++i) start[i] += down[i];
+  }
+  return test.any_won();
 }
 
 // Picks the 32-bit lane path for small triangles (see make_edges) or when |E| stays below
@@ -303,6 +378,8 @@ bool raster_rect(const Edges& e, const SetupTriangle& t, std::uint32_t ref, int 
     }
   if (narrow && W == 8 && !s.count_coverage)
     return raster_rect_avx2(e, t, ref, x0, y0, x1, y1, ox, oy, s);
+  if (W == 8 && !s.count_coverage)
+    return raster_rect_avx2_wide(e, t, ref, x0, y0, x1, y1, ox, oy, s);
   if (narrow && W > 1) return raster_rect_lanes<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
   return raster_rect_wide<W>(e, t, ref, x0, y0, x1, y1, ox, oy, s);
 }
@@ -376,15 +453,23 @@ void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0
   }
 }
 
-// Writes sample `idx` of the tile (frame sample `o`): the winner's ids, depth and
+// One sample's visibility-buffer values.
+struct SampleOut {
+  std::uint32_t* triangle;
+  std::uint32_t* object;
+  float* depth;
+  glm::vec2* bary;
+};
+
+// Writes sample `idx` of the tile to slot o of `out`: the winner's ids, depth and
 // barycentrics in the original triangle, or the empty-sample values.
-inline void resolve_sample(const TileScratch& s, int idx, std::size_t o, VisibilityBuffer& out) {
+inline void resolve_sample(const TileScratch& s, int idx, std::size_t o, const SampleOut& out) {
   const std::uint32_t ref = s.ref[idx];
   if (ref == kNoRef) {
-    out.triangle.pixels[o] = kNoId;
-    out.object.pixels[o] = kNoId;
-    out.depth.pixels[o] = std::numeric_limits<float>::infinity();
-    out.bary.pixels[o] = glm::vec2(0.0f);
+    out.triangle[o] = kNoId;
+    out.object[o] = kNoId;
+    out.depth[o] = std::numeric_limits<float>::infinity();
+    out.bary[o] = glm::vec2(0.0f);
     return;
   }
   const SetupTriangle* t = s.setup[ref];
@@ -396,29 +481,64 @@ inline void resolve_sample(const TileScratch& s, int idx, std::size_t o, Visibil
     const glm::vec3 b = b0 * m->bary[0] + b1 * m->bary[1] + b2 * m->bary[2];
     b1 = b.y, b2 = b.z;
   }
-  out.triangle.pixels[o] = t->triangle;
-  out.object.pixels[o] = t->object;
-  out.depth.pixels[o] = 1.0f / inv_w;
-  out.bary.pixels[o] = glm::vec2(b1, b2);
+  out.triangle[o] = t->triangle;
+  out.object[o] = t->object;
+  out.depth[o] = 1.0f / inv_w;
+  out.bary[o] = glm::vec2(b1, b2);
+}
+
+SampleOut frame_out(VisibilityBuffer& out) {
+  return {out.triangle.pixels.data(), out.object.pixels.data(), out.depth.pixels.data(),
+          out.bary.pixels.data()};
+}
+
+// One resolved tile row, staged in L1 before it is copied out.
+struct RowStage {
+  alignas(32) std::uint32_t triangle[kTileSize];
+  alignas(32) std::uint32_t object[kTileSize];
+  alignas(32) float depth[kTileSize];
+  alignas(32) glm::vec2 bary[kTileSize];
+  SampleOut slots() { return {triangle, object, depth, bary}; }
+};
+
+// Copies `bytes` to dst: the whole 64-byte lines inside the range with streaming stores (they
+// skip reading each destination line first, and a large frame's planes cannot stay cached
+// until the G-buffer reads them anyway), the partial lines at the ends, which neighbouring
+// tiles share, with ordinary stores.
+inline void stream_copy(void* dst, const void* src, std::size_t bytes) {
+  auto* d = static_cast<unsigned char*>(dst);
+  const auto* s = static_cast<const unsigned char*>(src);
+  const std::size_t head = std::min(bytes, (64 - (reinterpret_cast<std::uintptr_t>(d) & 63)) & 63);
+  std::memcpy(d, s, head);
+  d += head, s += head, bytes -= head;
+  for (; bytes >= 64; d += 64, s += 64, bytes -= 64) {
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(d),
+                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s)));
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(d + 32),
+                        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s + 32)));
+  }
+  std::memcpy(d, s, bytes);
 }
 
 // The resolve 8 samples at a time: the same IEEE divisions as resolve_sample (so the same
 // bits), the winners' object ids gathered from the tile's refs, clipped winners and the row
-// tail left to resolve_sample.
+// tail left to resolve_sample. Each row is resolved into a stage; `stream` copies it out with
+// streaming stores (large frames), otherwise with ordinary ones.
 void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
-                       const Viewport& vp, VisibilityBuffer& out) {
+                       const Viewport& vp, bool stream, VisibilityBuffer& out) {
   const __m256i no_ref = _mm256_set1_epi32(-1);
   const __m256 one = _mm256_set1_ps(1.0f);
   const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   const int* flags = reinterpret_cast<const int*>(s.flags.data());
   const int* objects = reinterpret_cast<const int*>(s.object.data());
-  const int full = (tx1 - tx0 + 1) / 8 * 8;
+  const int n = tx1 - tx0 + 1;
+  const int full = n / 8 * 8;
+  RowStage stage;
+  const SampleOut slots = stage.slots();
   for (int y = ty0; y <= ty1; ++y) {
     const int row = (y - ty0) * kTileSize;
-    const std::size_t orow = static_cast<std::size_t>(y) * vp.width + tx0;
     for (int x = 0; x < full; x += 8) {
       const int idx = row + x;
-      const std::size_t o = orow + x;
       const __m256i ref = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&s.ref[idx]));
       const __m256i valid = _mm256_xor_si256(_mm256_cmpeq_epi32(ref, no_ref), no_ref);
       const __m256i flag =
@@ -439,19 +559,33 @@ void resolve_tile_avx2(const TileScratch& s, int tx0, int ty0, int tx1, int ty1,
       const __m256 b2 = _mm256_and_ps(validf, _mm256_blendv_ps(q2, q1, swapped));
       const __m256 depth = _mm256_blendv_ps(inf, _mm256_div_ps(one, inv_w), validf);
       // Empty samples keep kNoId in s.triangle (never won).
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&out.triangle.pixels[o]), tri);
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(&out.object.pixels[o]), object);
-      _mm256_storeu_ps(&out.depth.pixels[o], depth);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(&stage.triangle[x]), tri);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(&stage.object[x]), object);
+      _mm256_store_ps(&stage.depth[x], depth);
       const __m256 lo = _mm256_unpacklo_ps(b1, b2), hi = _mm256_unpackhi_ps(b1, b2);
-      float* bary = &out.bary.pixels[o].x;
-      _mm256_storeu_ps(bary, _mm256_permute2f128_ps(lo, hi, 0x20));
-      _mm256_storeu_ps(bary + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
+      float* bary = &stage.bary[x].x;
+      _mm256_store_ps(bary, _mm256_permute2f128_ps(lo, hi, 0x20));
+      _mm256_store_ps(bary + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
       if (const int c = _mm256_movemask_ps(_mm256_castsi256_ps(clipped)); c != 0)
         for (int l = 0; l < 8; ++l)
-          if (c & (1 << l)) resolve_sample(s, idx + l, o + l, out);
+          if (c & (1 << l)) resolve_sample(s, idx + l, std::size_t(x + l), slots);
     }
-    for (int x = full; x <= tx1 - tx0; ++x) resolve_sample(s, row + x, orow + x, out);
+    for (int x = full; x < n; ++x) resolve_sample(s, row + x, std::size_t(x), slots);
+    const std::size_t o = static_cast<std::size_t>(y) * vp.width + tx0;
+    const std::size_t u = static_cast<std::size_t>(n);
+    if (stream) {
+      stream_copy(&out.triangle.pixels[o], stage.triangle, u * sizeof(std::uint32_t));
+      stream_copy(&out.object.pixels[o], stage.object, u * sizeof(std::uint32_t));
+      stream_copy(&out.depth.pixels[o], stage.depth, u * sizeof(float));
+      stream_copy(&out.bary.pixels[o], stage.bary, u * sizeof(glm::vec2));
+    } else {
+      std::memcpy(&out.triangle.pixels[o], stage.triangle, u * sizeof(std::uint32_t));
+      std::memcpy(&out.object.pixels[o], stage.object, u * sizeof(std::uint32_t));
+      std::memcpy(&out.depth.pixels[o], stage.depth, u * sizeof(float));
+      std::memcpy(&out.bary.pixels[o], stage.bary, u * sizeof(glm::vec2));
+    }
   }
+  if (stream) _mm_sfence();  // weakly ordered: fence before another thread reads the frame
 }
 
 template <int W>
@@ -475,11 +609,18 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
   if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
 
   const std::uint32_t begin = bins.tile_offsets[tile], end = bins.tile_offsets[tile + 1];
+  // The records are gathered from their chunks (whole 64-byte lines, mostly from memory):
+  // prefetched far enough ahead to cover a DRAM miss behind the small triangles' short work.
+  const std::uint32_t* refs = bins.refs.data();
+  for (std::uint32_t k = begin; k < std::min(end, begin + kRecordPrefetch); ++k)
+    _mm_prefetch(reinterpret_cast<const char*>(&bins.record(refs[k])), _MM_HINT_T0);
   for (std::uint32_t k = begin; k < end; ++k) {
-    const SetupTriangle& t = bins.binned[k];
+    if (k + kRecordPrefetch < end)
+      _mm_prefetch(reinterpret_cast<const char*>(&bins.record(refs[k + kRecordPrefetch])), _MM_HINT_T0);
+    const SetupTriangle& t = bins.record(refs[k]);
     const auto ref = static_cast<std::uint32_t>(s.setup.size());
     s.setup.push_back(&t);
-    s.clip_map.push_back(t.clip_map >= 0 ? &bins.clip_maps[t.clip_map] : nullptr);
+    s.clip_map.push_back(t.clip_map >= 0 ? &bins.clip_map(refs[k], t) : nullptr);
     s.flags.push_back((t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u));
     s.object.push_back(t.object);
     raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);
@@ -487,15 +628,17 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
 
   // Resolve: barycentrics only for the winners (deferred, like a visibility buffer).
   if (W == 8 && !s.count_coverage) {
-    resolve_tile_avx2(s, tx0, ty0, tx1, ty1, vp, out);
+    const bool stream = std::size_t(vp.width) * std::size_t(vp.height) >= kStreamingMinSamples;
+    resolve_tile_avx2(s, tx0, ty0, tx1, ty1, vp, stream, out);
     return;
   }
+  const SampleOut frame = frame_out(out);
   for (int y = ty0; y <= ty1; ++y) {
     for (int x = tx0; x <= tx1; ++x) {
       const int idx = (y - ty0) * kTileSize + (x - tx0);
       const std::size_t o = static_cast<std::size_t>(y) * vp.width + x;
       if (s.count_coverage) out.coverage.pixels[o] = s.coverage[idx];
-      resolve_sample(s, idx, o, out);
+      resolve_sample(s, idx, o, frame);
     }
   }
 }

@@ -63,7 +63,9 @@ void make_screen_vertices(const glm::mat4& view_projection, const glm::vec3* pos
                           std::size_t count, const Viewport& viewport, ScreenVertex* out);
 
 // Sets up triangle `triangle` from its three screen vertices and appends 0..7 triangles to
-// `out` (more than one only when it was clipped; those also append a ClipMap).
+// `out` (more than one only when it was clipped; those also append a ClipMap). Triangles
+// that cannot change a sample are dropped: zero area, culled, no sample centre in the
+// bounding box, or at most 2×2 centres in it and none of them covered.
 // cull_sign: 0 keeps both faces, +1 drops back faces, -1 drops front faces.
 void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const ScreenVertex& v2,
                     std::uint32_t triangle, std::uint32_t object, const Viewport& viewport,

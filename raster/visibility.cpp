@@ -6,6 +6,7 @@
 
 #include "core/camera_rays.h"
 #include "core/error.h"
+#include "parallel/page_buffer.h"
 #include "raster/tile_binning.h"
 #include "raster/tile_rasterizer.h"
 #include "raster/triangle_setup.h"
@@ -15,6 +16,8 @@ namespace {
 constexpr std::size_t kVertexChunk = 16384;
 constexpr std::size_t kTriangleChunk = 4096;
 constexpr std::size_t kTileChunk = 64;  // tiles per bin_offsets task
+// Clipping makes at most 7 records of a triangle: a chunk's records must fit a reference.
+static_assert(7 * kTriangleChunk <= std::size_t(1) << kRefIndexBits);
 }  // namespace
 
 namespace {
@@ -32,7 +35,13 @@ int cull_sign(CullMode mode) {
 
 template <class T>
 void ensure_size(Buffer2D<T>& b, int width, int height) {
-  if (b.width != width || b.height != height) b = Buffer2D<T>(width, height);
+  // On 2 MiB pages where the kernel allows: each tile row lands on another 4 KiB page of
+  // every plane, so on small pages nearly every row write of the tile pass missed the TLB.
+  if (b.width != width || b.height != height) {
+    b.width = width;
+    b.height = height;
+    par::resize_on_huge_pages(b.pixels, static_cast<std::size_t>(width) * height);
+  }
 }
 
 }  // namespace
@@ -51,6 +60,9 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
     throw InputError("rasterizer", "fewer object ids (" + std::to_string(triangle_object.size()) +
                                        ") than triangles (" + std::to_string(triangles) + ")");
   const std::size_t chunks = (triangles + kTriangleChunk - 1) / kTriangleChunk;
+  if (chunks > kMaxChunks)
+    throw InputError("rasterizer", std::to_string(triangles) + " triangles exceed the " +
+                                       std::to_string(kMaxChunks * kTriangleChunk) + " one frame can bin");
   const std::size_t tiles = static_cast<std::size_t>(grid.count());
   bins.chunks.resize(chunks);
   bins.chunk_tile.resize(chunks * tiles);

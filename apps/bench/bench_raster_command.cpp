@@ -67,6 +67,10 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   std::vector<double> frame_ms;
   std::map<std::string, std::vector<double>> kernel_ms;
   std::size_t covered = 0;
+  // What reaches the tile pass (from the warm-up frame's bins): set-up triangles kept for
+  // binning (after off-screen, back-face, zero-area and no-sample rejection) and their
+  // references in the tiles' lists.
+  std::size_t binned = 0, tile_refs = 0, max_tile_refs = 0;
   // Render targets and bins persist across frames, as a GPU application's would.
   raster::RasterWorkspace workspace;
   raster::VisibilityBuffer vis;
@@ -90,6 +94,11 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
     const auto t1 = executor.now_ns();
     if (run == 0) {
       for (std::size_t i = 0; i < g.object.size(); ++i) covered += g.covered(i);
+      const raster::TileBins& bins = workspace.bins;
+      for (const raster::BinnedChunk& c : bins.chunks) binned += c.count;
+      for (std::size_t t = 0; t + 1 < bins.tile_offsets.size(); ++t)
+        max_tile_refs = std::max<std::size_t>(max_tile_refs, bins.tile_offsets[t + 1] - bins.tile_offsets[t]);
+      tile_refs = bins.tile_offsets.empty() ? 0 : bins.tile_offsets.back();
       if (!o.write_ids.empty()) write_triangle_ids(o.write_ids, vis);
       continue;
     }
@@ -111,6 +120,8 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
                         {"ms_min", rounded(lo, 3)}, {"ms_max", rounded(hi, 3)},
                         {"mtris_per_s", rounded(triangles / (med * 1e-3) / 1e6, 3)},
                         {"covered_fraction", rounded(double(covered) / (double(o.width) * o.height), 4)},
+                        {"binned_triangles", binned}, {"tile_refs", tile_refs},
+                        {"tile_refs_max", max_tile_refs},
                         {"gbuffer_source", o.gbuffer_source}, {"gbuffer_prepare_ms", rounded(prepare_ms, 3)},
                         {"kernels_ms_median", kernels}};
     std::printf("%s\n", json_line(j).c_str());
@@ -119,6 +130,8 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
                 "%.1f Mtris/s\n",
                 scene.name.c_str(), triangles, o.width, o.height, executor.threads(), med, lo, hi,
                 triangles / (med * 1e-3) / 1e6);
+    std::printf("  %zu triangles binned, %zu tile references (at most %zu in one 64x64 tile)\n",
+                binned, tile_refs, max_tile_refs);
     for (const auto& [name, v] : kernel_ms) std::printf("  %-22s %8.2f ms\n", name.c_str(), median(v));
     if (use_records) std::printf("  (scene-static gbuffer.prepare, once: %.2f ms)\n", prepare_ms);
   }

@@ -2,6 +2,8 @@
 // all-triangles ray oracle, perspective-correct interpolation and determinism.
 #include "raster/visibility.h"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -94,6 +96,84 @@ TEST(RasterFillRule, GridOnSampleCentresCoversEverySampleOnce) {
       const bool inside = x >= 1 && y >= 1 && x < 1 + cells_x * step && y < 1 + cells_y * step;
       ASSERT_EQ(vis.coverage.at(x, y), inside ? 1u : 0u) << x << "," << y;
     }
+}
+
+// Setup drops the triangles whose box holds at most 2×2 sample centres when they cover none
+// of them. Against a brute-force edge test on every centre: a dropped triangle covers no
+// sample, every triangle covering a sample is kept, and the per-sample coverage counts of
+// the whole soup (tiny, sliver, degenerate and larger triangles at random sub-pixel
+// positions, both windings) equal the brute-force counts.
+TEST(RasterSetup, DropsOnlyTrianglesThatCoverNoSample) {
+  std::mt19937 rng(29);
+  const int width = 70, height = 50;
+  std::uniform_int_distribution<std::int32_t> px(0, width * kSubpixelOne - 1),
+      py(0, height * kSubpixelOne - 1), tiny(-1 * kSubpixelOne, 1 * kSubpixelOne),
+      sliver(-3 * kSubpixelOne, 3 * kSubpixelOne);
+  std::vector<ScreenVertex> v;
+  std::vector<std::uint32_t> idx, objects;
+  for (int t = 0; t < 20000; ++t) {
+    const std::int32_t cx = px(rng), cy = py(rng);
+    auto& d = t % 3 == 0 ? sliver : tiny;
+    for (int k = 0; k < 3; ++k) {
+      idx.push_back(static_cast<std::uint32_t>(v.size()));
+      v.push_back(t % 11 == 0 && k == 2 ? v.back() : fixed_vertex(cx + d(rng), cy + d(rng)));
+    }
+    objects.push_back(0);
+  }
+  // Brute force: a centre is covered when every edge function, with the vertices in
+  // positive-area order, is positive or zero on a top or left edge.
+  auto covers = [](const ScreenVertex& a, ScreenVertex b, ScreenVertex c, int x, int y) {
+    const std::int64_t area = (std::int64_t(b.x) - a.x) * (std::int64_t(c.y) - a.y) -
+                              (std::int64_t(b.y) - a.y) * (std::int64_t(c.x) - a.x);
+    if (area == 0) return false;
+    if (area < 0) std::swap(b, c);
+    const ScreenVertex* p[3] = {&a, &b, &c};
+    for (int i = 0; i < 3; ++i) {
+      const ScreenVertex& u = *p[(i + 1) % 3];
+      const ScreenVertex& w = *p[(i + 2) % 3];
+      const std::int64_t ea = std::int64_t(u.y) - w.y, eb = std::int64_t(w.x) - u.x;
+      const std::int64_t e = ea * (centre_of(x) - u.x) + eb * (centre_of(y) - u.y);
+      if (e < ((ea > 0 || (ea == 0 && eb > 0)) ? 0 : 1)) return false;
+    }
+    return true;
+  };
+  const Viewport viewport{width, height};
+  std::vector<SetupTriangle> kept;
+  std::vector<ClipMap> maps;
+  const std::size_t n = setup_triangles(v.data(), idx.data(), 0, objects.size(), objects.data(),
+                                        {}, viewport, 0, 0, kept, maps);
+  std::vector<std::uint8_t> is_kept(objects.size(), 0);
+  for (std::size_t k = 0; k < n; ++k) is_kept[kept[k].triangle] = 1;
+  std::vector<std::uint32_t> expected(std::size_t(width) * height, 0);
+  std::size_t dropped_small = 0;
+  for (std::size_t t = 0; t < objects.size(); ++t) {
+    int covered = 0;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        if (covers(v[idx[3 * t]], v[idx[3 * t + 1]], v[idx[3 * t + 2]], x, y)) {
+          ++covered;
+          ++expected[std::size_t(y) * width + x];
+        }
+    if (covered > 0) EXPECT_TRUE(is_kept[t]) << "triangle " << t << " covers " << covered;
+    // Dropped although a sample centre lies inside its vertex box: only the coverage test
+    // drops these (the box test alone keeps them).
+    std::int32_t lo_x = INT32_MAX, hi_x = INT32_MIN, lo_y = INT32_MAX, hi_y = INT32_MIN;
+    for (int k = 0; k < 3; ++k) {
+      lo_x = std::min(lo_x, v[idx[3 * t + k]].x), hi_x = std::max(hi_x, v[idx[3 * t + k]].x);
+      lo_y = std::min(lo_y, v[idx[3 * t + k]].y), hi_y = std::max(hi_y, v[idx[3 * t + k]].y);
+    }
+    const bool centre_in_box = (lo_x - kSubpixelOne / 2 + kSubpixelOne - 1) / kSubpixelOne <=
+                                   (hi_x - kSubpixelOne / 2) / kSubpixelOne &&
+                               (lo_y - kSubpixelOne / 2 + kSubpixelOne - 1) / kSubpixelOne <=
+                                   (hi_y - kSubpixelOne / 2) / kSubpixelOne;
+    dropped_small += !is_kept[t] && centre_in_box;
+  }
+  EXPECT_GT(dropped_small, 2000u);  // the coverage test is exercised
+  par::Executor ex(2);
+  RasterOptions opt;
+  opt.count_coverage = true;
+  const auto vis = rasterize_screen_vertices(ex, v, idx, objects, width, height, opt);
+  EXPECT_EQ(expected, vis.coverage.pixels);
 }
 
 Camera look(const glm::vec3& eye, const glm::vec3& target, float fov = 45.0f) {
@@ -319,6 +399,47 @@ TEST(RasterDeterminism, BitIdenticalAcrossThreadsAndLanes) {
     par::Executor ex_at_width(2, lanes);
     EXPECT_TRUE(same_bits(ref, render_visibility(ex_at_width, scene, cam, 333, 250, {}))) << lanes;
   }
+}
+
+// A frame large enough for the tile pass's streaming row writes, with a floor reaching far
+// into the guard band (edge values beyond int32, the 8-lane path's exact doubles against the
+// scalar int64 loop), a torus cut by the near plane and small triangles: the same bits at
+// every lane width and thread count.
+TEST(RasterDeterminism, LargeFrameWithGuardBandFloorSameBitsAtEveryWidth) {
+  Scene scene;
+  scene.name = "floor";
+  add_triangles(scene, {{-90.0f, -1.0f, -90.0f}, {90.0f, -1.0f, -90.0f},
+                        {90.0f, -1.0f, 90.0f}, {-90.0f, -1.0f, 90.0f}},
+                {0, 1, 2, 0, 2, 3});
+  add_torus(scene, glm::vec3(0, 0, 1.5f), 1.0f, 0.3f, 64, 32);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<glm::vec3> p;
+  std::vector<std::uint32_t> idx;
+  for (std::uint32_t k = 0; k < 3000; ++k) {
+    const glm::vec3 c(u(rng) * 2, u(rng) * 0.8f, u(rng) * 2 - 1.0f);
+    for (int i = 0; i < 3; ++i) p.push_back(c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)));
+    idx.insert(idx.end(), {3 * k, 3 * k + 1, 3 * k + 2});
+  }
+  add_triangles(scene, p, idx);
+  const Camera cam = look({0.0f, 0.4f, 2.6f}, {0.0f, -0.6f, 0.0f}, 60.0f);
+  const int width = 720, height = 480;  // 345 600 samples: above the streaming threshold
+  RasterOptions scalar;
+  scalar.lanes = 1;
+  par::Executor ex1(1);
+  const auto ref = render_visibility(ex1, scene, cam, width, height, scalar);
+  std::size_t floor_samples = 0;
+  for (const std::uint32_t t : ref.triangle.pixels)
+    floor_samples += t < 2;
+  EXPECT_GT(floor_samples, std::size_t(width) * height / 10);  // the floor is drawn
+  for (int lanes : {4, 8, 16})
+    for (int threads : {1, 2}) {
+      RasterOptions opt;
+      opt.lanes = lanes;
+      par::Executor ex(threads);
+      EXPECT_TRUE(same_bits(ref, render_visibility(ex, scene, cam, width, height, opt)))
+          << lanes << " lanes, " << threads << " threads";
+    }
 }
 
 // Counting coverage rasterizes every covering triangle; without it, triangles and blocks
