@@ -14,7 +14,7 @@
 
 #include "core/error.h"
 #include "core/normal_mapping.h"
-#include "parallel/page_buffer.h"
+#include "raster/frame_plane.h"
 #include "raster/gbuffer_normals.h"
 #include "raster/gbuffer_stream.h"
 
@@ -22,17 +22,6 @@ namespace speculum::raster {
 namespace {
 
 constexpr std::size_t kPixelChunk = 4096;
-
-template <class T>
-void ensure_size(Buffer2D<T>& b, int width, int height) {
-  // On 2 MiB pages where the kernel allows: a 1080p frame's six planes span over 40 000 4 KiB
-  // pages, and the resolve's streaming writes would keep missing the TLB.
-  if (b.width != width || b.height != height) {
-    b.width = width;
-    b.height = height;
-    par::resize_on_huge_pages(b.pixels, static_cast<std::size_t>(width) * height);
-  }
-}
 
 // Samples resolved per staging block: 64 makes every plane's share of a block a whole
 // number of cache lines (4, 8, 12 and 44 bytes per sample).
@@ -302,13 +291,13 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
   const int w = vis.width, h = vis.height;
   g.width = w;
   g.height = h;
-  ensure_size(g.object, w, h);
-  ensure_size(g.position, w, h);
-  ensure_size(g.normal, w, h);
+  ensure_plane_size(g.object, w, h);
+  ensure_plane_size(g.position, w, h);
+  ensure_plane_size(g.normal, w, h);
   g.eye = eye;
-  ensure_size(g.uv, w, h);
-  ensure_size(g.surface, w, h);
-  ensure_size(g.reflector, w, h);
+  ensure_plane_size(g.uv, w, h);
+  ensure_plane_size(g.surface, w, h);
+  ensure_plane_size(g.reflector, w, h);
   const TriangleMesh& m = scene.mesh;
   // Untextured materials have the same parameters everywhere: evaluate them once.
   std::vector<MaterialInfo> materials;

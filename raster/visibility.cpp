@@ -6,7 +6,7 @@
 
 #include "core/camera_rays.h"
 #include "core/error.h"
-#include "parallel/page_buffer.h"
+#include "raster/frame_plane.h"
 #include "raster/tile_binning.h"
 #include "raster/tile_rasterizer.h"
 #include "raster/triangle_setup.h"
@@ -31,17 +31,6 @@ void check_target_size(int width, int height) {
 
 int cull_sign(CullMode mode) {
   return mode == CullMode::Back ? 1 : mode == CullMode::Front ? -1 : 0;
-}
-
-template <class T>
-void ensure_size(Buffer2D<T>& b, int width, int height) {
-  // On 2 MiB pages where the kernel allows: each tile row lands on another 4 KiB page of
-  // every plane, so on small pages nearly every row write of the tile pass missed the TLB.
-  if (b.width != width || b.height != height) {
-    b.width = width;
-    b.height = height;
-    par::resize_on_huge_pages(b.pixels, static_cast<std::size_t>(width) * height);
-  }
 }
 
 }  // namespace
@@ -90,11 +79,11 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
 
   out.width = width;
   out.height = height;
-  ensure_size(out.triangle, width, height);
-  ensure_size(out.object, width, height);
-  ensure_size(out.depth, width, height);
-  ensure_size(out.bary, width, height);
-  if (options.count_coverage) ensure_size(out.coverage, width, height);
+  ensure_plane_size(out.triangle, width, height);
+  ensure_plane_size(out.object, width, height);
+  ensure_plane_size(out.depth, width, height);
+  ensure_plane_size(out.bary, width, height);
+  if (options.count_coverage) ensure_plane_size(out.coverage, width, height);
   else out.coverage = IdBuffer();
   executor.parallel_for("raster.tiles", static_cast<std::size_t>(grid.count()), 1,
                         [&](std::size_t begin, std::size_t end) {

@@ -1,0 +1,24 @@
+// Sizing the per-frame planes of the visibility buffer and the G-buffer.
+#pragma once
+
+#include <cstddef>
+
+#include "core/image.h"
+#include "parallel/page_buffer.h"
+
+namespace speculum::raster {
+
+// Sizes `plane` to width × height value-initialized pixels unless it has that size already
+// (its pixels are then kept for the pass to overwrite), on 2 MiB pages where the kernel allows:
+// the tile pass writes each tile row onto another 4 KiB page of every plane, and a 1080p
+// frame's planes span tens of thousands of small pages, so on them nearly every row write and
+// the resolve's streaming writes missed the TLB.
+template <class Pixel>
+void ensure_plane_size(Buffer2D<Pixel>& plane, int width, int height) {
+  if (plane.width == width && plane.height == height) return;
+  plane.width = width;
+  plane.height = height;
+  par::resize_on_huge_pages(plane.pixels, static_cast<std::size_t>(width) * height);
+}
+
+}  // namespace speculum::raster
