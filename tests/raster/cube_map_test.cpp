@@ -129,6 +129,18 @@ TEST(Environment, SkyIrradianceMatchesDirectIntegration) {
   }
 }
 
+// Six size² faces of uniform random radiance in [0, 4) drawn from `rng` (every level of their
+// prefiltered cascade differs).
+std::array<ImageRGBA, kCubeFaces> random_cube_faces(int size, std::mt19937& rng) {
+  std::array<ImageRGBA, kCubeFaces> faces;
+  std::uniform_real_distribution<float> u(0.0f, 4.0f);
+  for (ImageRGBA& f : faces) {
+    f = ImageRGBA(size, size);
+    for (glm::vec4& p : f.pixels) p = glm::vec4(u(rng), u(rng), u(rng), 1.0f);
+  }
+  return faces;
+}
+
 // The prefiltering cascade, computed eight texels at a time, against its definition looked up
 // one direction at a time: level l's texel is the mean of 48 Hamersley directions of the
 // Phong lobe whose variance is the difference of levels l and l−1's (half-power angle one
@@ -136,13 +148,8 @@ TEST(Environment, SkyIrradianceMatchesDirectIntegration) {
 // read as a mirror) — bit for bit, on every face, with a random texture and tile masks off.
 TEST(Environment, PrefilteredTexelsAreTheMeanOfTheirLobesLookups) {
   for (const int size : {16, 64}) {
-    std::array<ImageRGBA, kCubeFaces> faces;
     std::mt19937 rng(11);
-    std::uniform_real_distribution<float> u(0.0f, 4.0f);
-    for (ImageRGBA& f : faces) {
-      f = ImageRGBA(size, size);
-      for (glm::vec4& p : f.pixels) p = glm::vec4(u(rng), u(rng), u(rng), 1.0f);
-    }
+    const std::array<ImageRGBA, kCubeFaces> faces = random_cube_faces(size, rng);
     par::Executor ex(2);
     const EnvironmentMap map = environment_from_faces(ex, faces, false, 4);
     const auto texel_angle = [](int s) { return 0.5f * kPi / static_cast<float>(s); };
@@ -175,13 +182,8 @@ TEST(Environment, TruncatedLevelsGiveTheSameRadianceForTheLobesTheyServe) {
   // levels_for_lobes says exponents ≥ n need: radiance() must agree bit for bit for every
   // exponent ≥ n, and a mirror-only map keeps level 0 alone.
   const int size = 64;
-  std::array<ImageRGBA, kCubeFaces> faces;
   std::mt19937 rng(5);
-  std::uniform_real_distribution<float> u(0.0f, 4.0f);
-  for (ImageRGBA& f : faces) {
-    f = ImageRGBA(size, size);
-    for (glm::vec4& p : f.pixels) p = glm::vec4(u(rng), u(rng), u(rng), 1.0f);
-  }
+  const std::array<ImageRGBA, kCubeFaces> faces = random_cube_faces(size, rng);
   par::Executor ex(2);
   const EnvironmentMap full = environment_from_faces(ex, faces, false);
   EXPECT_EQ(levels_for_lobes(size, 1e6f), 1);
