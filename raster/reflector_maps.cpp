@@ -421,36 +421,31 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     opt.set_depth_range(depth_range);
     opt.raster.excluded_objects.assign(scene.objects.size(), 0);
     opt.raster.excluded_objects[o] = 1;  // a reflector does not see itself in its own map
-    if (!sizing.colour_read) {
-      out.map_of_object[o] = static_cast<int>(out.cubes.size());
-      out.cubes.push_back(render_cube_map(executor, scene, centre, opt));
-      out.maps.emplace_back();
-      out.centres.push_back(centre);
-      out.faces.push_back(opt.face_mask);
-      out.tiles.emplace_back();
-      if (layers) layers->emplace_back();
-      continue;
-    }
+    // Maps read for distances alone (MapSizing::colour_read false) get no shader: no face is
+    // shaded or prefiltered, and they keep no tiles or layers.
     MapFaceLayers kept;
-    CubeMap cube = render_cube_map(
-        executor, scene, centre, opt, [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* read) {
-          // Other reflectors seen in this map show the environment along their own R (and
-          // T): the first-order fallback, so a mirror seen in a mirror is never black.
-          ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env, read);
-          if (add_light) direct = add_light(g, direct);
-          if (layers) {
-            kept.specular[face] = specular_texels(g, kept.specular_texel[face]);
-            kept.direct[face] = direct;
-          }
-          return composite(executor, direct, envmap_reflect(executor, g, env));
-        });
+    CubeFaceShader shade;
+    if (sizing.colour_read)
+      shade = [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* read) {
+        // Other reflectors seen in this map show the environment along their own R (and
+        // T): the first-order fallback, so a mirror seen in a mirror is never black.
+        ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env, read);
+        if (add_light) direct = add_light(g, direct);
+        if (layers) {
+          kept.specular[face] = specular_texels(g, kept.specular_texel[face]);
+          kept.direct[face] = direct;
+        }
+        return composite(executor, direct, envmap_reflect(executor, g, env));
+      };
+    CubeMap cube = render_cube_map(executor, scene, centre, opt, shade);
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
-    out.maps.push_back(environment_from_faces(executor, cube.colour, false, levels, opt.face_mask,
-                                              tiles.active() ? &tiles : nullptr));
+    out.maps.push_back(sizing.colour_read ? environment_from_faces(executor, cube.colour, false, levels, opt.face_mask,
+                                                                   tiles.active() ? &tiles : nullptr)
+                                          : EnvironmentMap{});
     out.cubes.push_back(std::move(cube));
     out.centres.push_back(centre);
     out.faces.push_back(opt.face_mask);
-    out.tiles.push_back(std::move(tiles));
+    out.tiles.push_back(sizing.colour_read ? std::move(tiles) : CubeTileMask{});
     if (layers) layers->push_back(std::move(kept));
   }
   return out;
