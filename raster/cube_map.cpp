@@ -63,7 +63,9 @@ CubeDepthRange scene_cube_depth_range(const Scene& scene) {
   return cube_depth_range(all.valid() ? glm::length(all.extent()) : 1.0f);
 }
 
-CubeFaceAxes cube_face_axes(int face) {
+namespace {
+
+CubeFaceAxes face_axes(int face) {
   const FaceFrame& f = frame(face);
   const auto axis = [](const glm::vec3& v, int& index, float& sign) {
     index = -1;
@@ -81,11 +83,12 @@ CubeFaceAxes cube_face_axes(int face) {
   return a;
 }
 
-namespace {
 // Initialized after kFrames (same translation unit, in order).
-const std::array<CubeFaceAxes, kCubeFaces> kAxes = {cube_face_axes(0), cube_face_axes(1), cube_face_axes(2),
-                                                    cube_face_axes(3), cube_face_axes(4), cube_face_axes(5)};
+const std::array<CubeFaceAxes, kCubeFaces> kAxes = {face_axes(0), face_axes(1), face_axes(2),
+                                                    face_axes(3), face_axes(4), face_axes(5)};
 }  // namespace
+
+const CubeFaceAxes& cube_face_axes(int face) { return kAxes[face]; }
 
 CubeCoord cube_coord(const glm::vec3& d, int size) {
   const glm::vec3 a = glm::abs(d);

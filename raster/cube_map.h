@@ -39,7 +39,7 @@ struct CubeFaceAxes {
   int forward = 0, right = 0, up = 0;                       // axis index 0..2
   float forward_sign = 1.0f, right_sign = 1.0f, up_sign = 1.0f;
 };
-CubeFaceAxes cube_face_axes(int face);
+const CubeFaceAxes& cube_face_axes(int face);
 
 // Continuous pixel coordinates of direction d on the plane of face `face` (any face whose axis
 // d makes an acute angle with: not clamped to the face, no face chosen), so that a
