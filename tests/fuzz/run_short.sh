@@ -6,12 +6,15 @@
 # where the ordinary test suite replays it). New inputs found go to BUILD/new-corpus/<target>/,
 # never into the source tree.
 #
-#   tests/fuzz/run_short.sh [--seconds N | --runs N] [--targets a,b] [--build DIR] [--nice N]
+#   tests/fuzz/run_short.sh [--seconds N | --runs N] [--targets a,b] [--build DIR] [--nice N] [--timeout S]
 #   tests/fuzz/run_short.sh --merge SEEDS   # minimize SEEDS/<target> + the corpus into the corpus
 #
 # --seconds: per target (default 30; FUZZ_SECONDS too). --runs N: instead, exactly N inputs per
 # target from a fixed seed (-seed=1), so a run gives the same result on any machine: what CI
 # uses, since a time-limited run explores further on a faster machine. --targets: default all nine.
+# --timeout: seconds (wall clock) after which one input counts as a hang: 1 with --seconds, 5
+# with --runs; raise it for a long run at a low priority on a busy machine, where an input
+# waits for the CPU, and replay the summary's slowest inputs on an idle one.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds="${FUZZ_SECONDS:-30}"
@@ -20,6 +23,7 @@ targets="gltf,glb,obj,ply,off,stl,ray_file,image,scene_spec"
 merge=""
 runs=""
 nice_level=0
+timeout=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
@@ -28,15 +32,17 @@ while [ $# -gt 0 ]; do
     --build) build="$2"; shift 2 ;;
     --merge) merge="$2"; shift 2 ;;
     --nice) nice_level="$2"; shift 2 ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    --timeout) timeout="$2"; shift 2 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "run_short.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 case "$seconds" in ''|*[!0-9]*) echo "run_short.sh: --seconds expects a whole number, got '$seconds'" >&2; exit 2 ;; esac
 case "$runs" in *[!0-9]*) echo "run_short.sh: --runs expects a whole number, got '$runs'" >&2; exit 2 ;; esac
+case "$timeout" in *[!0-9]*) echo "run_short.sh: --timeout expects a whole number, got '$timeout'" >&2; exit 2 ;; esac
 # A fixed run also allows 5 s per input instead of 1 s: the same inputs on a slower or busier
 # machine must not turn into a false "hang".
-if [ -n "$runs" ]; then limit=(-seed=1 -runs="$runs" -timeout=5); else limit=(-max_total_time="$seconds" -timeout=1); fi
+if [ -n "$runs" ]; then limit=(-seed=1 -runs="$runs" -timeout="${timeout:-5}"); else limit=(-max_total_time="$seconds" -timeout="${timeout:-1}"); fi
 
 export CC="${FUZZ_CC:-clang-14}" CXX="${FUZZ_CXX:-clang++-14}"
 IFS=, read -r -a list <<< "$targets"
@@ -50,7 +56,7 @@ export LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0
 # Inputs are small files; 64 KiB keeps each run fast while reaching every header path.
 common=(-rss_limit_mb=2048 -max_len=65536 -print_final_stats=1)
 status=0
-printf '%-11s %12s %8s %s\n' target executions seconds result > "$build/fuzz-summary.txt"
+printf '%-11s %12s %8s %8s %s\n' target executions seconds slowest result > "$build/fuzz-summary.txt"
 for t in "${list[@]}"; do
   bin="$build/tests/fuzz/fuzz_$t"
   if [ -n "$merge" ]; then
@@ -70,12 +76,13 @@ for t in "${list[@]}"; do
   rc=$?
   set -e
   executed=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  slowest=$(sed -n 's/^stat::slowest_unit_time_sec: *//p' "$log" | tail -n 1)
   result=ok
   if [ "$rc" != 0 ]; then
     result="FAILED (exit $rc): $(grep -m1 -E '==[0-9]+== ?ERROR|runtime error|terminate called' "$log" || tail -n 1 "$log")"
     status=1
   fi
-  printf '%-11s %12s %8s %s\n' "$t" "${executed:-?}" "$(( $(date +%s) - start ))" "$result" | tee -a "$build/fuzz-summary.txt"
+  printf '%-11s %12s %8s %8s %s\n' "$t" "${executed:-?}" "$(( $(date +%s) - start ))" "${slowest:-?}" "$result" | tee -a "$build/fuzz-summary.txt"
 done
 [ -n "$merge" ] && exit 0
 if [ "$status" != 0 ]; then
