@@ -165,15 +165,15 @@ std::vector<std::uint8_t> CubeTileMask::texels(int face) const {
 }
 
 double CubeTileMask::texel_count(unsigned face_mask) const {
+  const int n = tiles_per_side();
   double count = 0.0;
   for (int f = 0; f < kCubeFaces; ++f) {
-    if (!((face_mask >> f) & 1u)) continue;
-    if (!active()) {
-      count += double(size) * size;
-      continue;
-    }
-    const std::vector<std::uint8_t> t = texels(f);
-    for (const std::uint8_t v : t) count += v;
+    if (!((face_mask >> f) & 1u) || tiles[f].empty()) continue;
+    // Tiles on the last row or column hold only the texels left of a side not divisible by kTile.
+    for (int ty = 0; ty < n; ++ty)
+      for (int tx = 0; tx < n; ++tx)
+        if (tiles[f][static_cast<std::size_t>(ty) * n + tx])
+          count += double(std::min(kTile, size - tx * kTile)) * std::min(kTile, size - ty * kTile);
   }
   return count;
 }

@@ -78,7 +78,7 @@ struct CubeTileMask {
   bool covers(int face, int level, int x, int y) const;
   // The level-0 texels of `face` in read tiles, one byte each (1: read), row-major.
   std::vector<std::uint8_t> texels(int face) const;
-  // Level-0 texels in read tiles, over the faces in `face_mask`.
+  // Level-0 texels in read tiles, over the faces in `face_mask` (0 for an inactive mask).
   double texel_count(unsigned face_mask) const;
 };
 

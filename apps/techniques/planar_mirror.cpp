@@ -18,7 +18,7 @@ FrameOutputs add_planar_mirror_passes(par::Graph& g, const Scene* scene, const F
   // Curved and glossy reflectors are not planar mirrors: they get the distance-map search in
   // cube maps of their own (SURVEY §4.2), in the camera's view and in every mirrored one.
   auto curved = g.add("reflector_cube_maps",
-                      ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors},
+                      ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors, MapSizing{}},
                       s.shadow_maps, s.environment, s.gbuffer);
   auto specular = g.add("planar_mirror_reflect",
                         PlanarMirrorReflectPass{scene, f.camera, static_cast<int>(f.param("depth"))},

@@ -43,7 +43,7 @@ FrameOutputs add_yu_lod_passes_cached(par::Graph& g, const Scene* scene, const F
   // YU traces reflections only; refractors fall back to cube maps of their own, which see the
   // room around them (SURVEY §3.1), so glass is never black.
   auto refractor_maps = g.add("refractor_cube_maps",
-                              raster::ReflectorCubeMapsPass{scene, f.cube_map_size, raster::ReflectorSelection::refractors},
+                              raster::ReflectorCubeMapsPass{scene, f.cube_map_size, raster::ReflectorSelection::refractors, raster::MapSizing{}},
                               s.shadow_maps, s.environment, s.gbuffer);
   auto refractors = g.add("refractor_environment", raster::RefractorEnvironmentPass{}, s.gbuffer, s.environment,
                           refractor_maps);

@@ -80,7 +80,7 @@ TEST(LightingOptions, EachEnvironmentLightsABareModelDeterministically) {
   const fs::path dir = test::scratch_dir();
   const std::string exr = write_equirect(dir, "env.exr").string();
   const std::string hdr = write_equirect(dir, "env.hdr").string();
-  for (const std::string env : {exr, hdr, std::string("sky"), std::string("0.5,0.6,0.7"),
+  for (const std::string& env : {exr, hdr, std::string("sky"), std::string("0.5,0.6,0.7"),
                                 std::string("0.4"), std::string()}) {
     SCOPED_TRACE(env.empty() ? "default light" : env);
     pipeline::FrameOptions o;

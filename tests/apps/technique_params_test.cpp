@@ -63,8 +63,9 @@ TEST(TechniqueParams, OutOfRangeFractionalAndUnknownAreInputErrors) {
         EXPECT_NE(e.find("--param " + p.name + ":"), std::string::npos) << e;
         EXPECT_NE(e.find(p.range_text()), std::string::npos) << e;
       }
-      if (p.integer && p.max > p.min)
+      if (p.integer && p.max > p.min) {
         EXPECT_NE(input_error(t, p.name, p.min + 0.5), "(accepted)") << t.name << " " << p.name;
+      }
     }
     const std::string unknown = input_error(t, "no_such_param", 1);
     EXPECT_NE(unknown.find("unknown parameter 'no_such_param' for technique '" + t.name + "'"),

@@ -141,7 +141,9 @@ TEST(MeshProcessing, TorusMeanCurvatureMatchesTheAnalyticFormula) {
     const Errors e = curvature_errors(om.mesh, exact);
     EXPECT_LT(e.mean_rel, previous) << rings;
     previous = e.mean_rel;
-    if (rings == 96) EXPECT_LT(e.mean_rel, 1e-2);
+    if (rings == 96) {
+      EXPECT_LT(e.mean_rel, 1e-2);
+    }
   }
 }
 

@@ -99,7 +99,9 @@ TEST(ExecutorProgress, AnInterruptSkipsTheRemainingChunksAndThrows) {
                                    if (b / 10 > 5) ++after;
                                  }),
                  Interrupted);
-    if (threads == 1) EXPECT_EQ(after.load(), 0);
+    if (threads == 1) {
+      EXPECT_EQ(after.load(), 0);
+    }
     interrupt_requested.store(false);
     // Cleared: the executor works as before.
     std::atomic<int> all{0};

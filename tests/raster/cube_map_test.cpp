@@ -36,6 +36,28 @@ TEST(CubeMapFaces, DirectionAndCoordinateRoundTrip) {
       }
 }
 
+// A tile mask's texel count is the number of level-0 texels its read tiles hold, on sides that
+// are and are not whole numbers of tiles (the last row and column of tiles are then partial).
+TEST(CubeTileMask, TexelCountEqualsTheTexelsOfItsReadTiles) {
+  std::mt19937 rng(7);
+  for (const int size : {8, 20, 37, 64}) {
+    CubeTileMask mask;
+    mask.size = size;
+    const int n = mask.tiles_per_side();
+    for (int face = 1; face < kCubeFaces; ++face) {  // face 0 keeps no tile array: nothing read
+      mask.tiles[face].resize(static_cast<std::size_t>(n) * n);
+      for (std::uint8_t& t : mask.tiles[face]) t = rng() % 3 == 0;
+    }
+    for (const unsigned faces : {0x3fu, 0x15u, 0x01u}) {
+      double expected = 0.0;
+      for (int face = 0; face < kCubeFaces; ++face)
+        if ((faces >> face) & 1u)
+          for (const std::uint8_t v : mask.texels(face)) expected += v;
+      EXPECT_EQ(mask.texel_count(faces), expected) << "size " << size << " faces " << faces;
+    }
+  }
+}
+
 TEST(CubeMapDistance, EqualsOracleHitDistanceInEveryFace) {
   // A closed room around o with a torus and loose triangles in it: every texel hits.
   Scene scene;

@@ -109,10 +109,11 @@ TEST(ReflectorMaps, MarkedTilesHoldEveryTexelWithinTheMargin) {
               for (int x = 0; x < s; ++x) {
                 const glm::vec3 t = cube_direction(face, {x + 0.5f, y + 0.5f}, s);
                 const float angle = std::acos(std::clamp(glm::dot(t, d), -1.0f, 1.0f));
-                if (angle <= margin)
+                if (angle <= margin) {
                   ASSERT_TRUE(mask.covers(face, level, x, y))
                       << "size " << size << " level " << level << " face " << face << " texel " << x << "," << y
                       << " margin " << margin << " d " << d.x << "," << d.y << "," << d.z;
+                }
               }
         }
         if (margin <= 0.02f) {
@@ -144,8 +145,12 @@ TEST(ReflectorMaps, UnreadTilesChangeNoLookedUpSample) {
         EXPECT_TRUE(tiled.tiles[m].active());
         whole_faces += double(std::popcount(tiled.faces[m])) * size * size;
       }
-      if (std::string(name) == "living-room") EXPECT_LT(rendered_texels(tiled), 0.9 * whole_faces);
-      if (std::string(name) == "glass-sphere") EXPECT_GT(rendered_texels(tiled), 0.0);
+      if (std::string(name) == "living-room") {
+        EXPECT_LT(rendered_texels(tiled), 0.9 * whole_faces);
+      }
+      if (std::string(name) == "glass-sphere") {
+        EXPECT_GT(rendered_texels(tiled), 0.0);
+      }
       EXPECT_TRUE(same_bytes(envmap_reflect(ex, v.g, v.env, &all), envmap_reflect(ex, v.g, v.env, &tiled)));
     }
   }

@@ -154,7 +154,9 @@ TEST(RasterSetup, DropsOnlyTrianglesThatCoverNoSample) {
           ++covered;
           ++expected[std::size_t(y) * width + x];
         }
-    if (covered > 0) EXPECT_TRUE(is_kept[t]) << "triangle " << t << " covers " << covered;
+    if (covered > 0) {
+      EXPECT_TRUE(is_kept[t]) << "triangle " << t << " covers " << covered;
+    }
     // Dropped although a sample centre lies inside its vertex box: only the coverage test
     // drops these (the box test alone keeps them).
     std::int32_t lo_x = INT32_MAX, hi_x = INT32_MIN, lo_y = INT32_MAX, hi_y = INT32_MIN;

@@ -180,7 +180,9 @@ TEST(RayHierarchyScenesCandidates, SphereInRoomAtMostFourAndAHalfPerRay) {
     if (!rays.active[i]) continue;
     const Hit o = closest_hit_oracle(scene.mesh.positions, scene.mesh.indices, rays.rays.get(i));
     ASSERT_EQ(hits.triangle[i], o.triangle) << "pixel " << i;
-    if (o.hit()) EXPECT_EQ(std::memcmp(&hits.t[i], &o.t, 4), 0) << "pixel " << i;
+    if (o.hit()) {
+      EXPECT_EQ(std::memcmp(&hits.t[i], &o.t, 4), 0) << "pixel " << i;
+    }
   }
 }
 
