@@ -716,6 +716,34 @@ void check_schema_shapes(const std::string& path, const nlohmann::json& doc) {
     }
 }
 
+// tinygltf hands an image's bufferView to the image decoder while it parses, before any
+// check of ours on the parsed model, and without checking that the view lies inside its
+// buffer (glTF 2.0 §3.6.2: a bufferView is a range of its buffer's bytes): a view past
+// the buffer's byteLength made the decoder read past the end of tinygltf's copy of it.
+void check_image_buffer_views(const std::string& path, const nlohmann::json& doc) {
+  const auto images = doc.find("images"), views = doc.find("bufferViews"), buffers = doc.find("buffers");
+  if (images == doc.end() || views == doc.end() || buffers == doc.end()) return;
+  auto whole = [](const nlohmann::json& o, const char* key, double fallback) {
+    const auto v = o.find(key);
+    return v != o.end() && v->is_number() ? v->get<double>() : fallback;
+  };
+  for (std::size_t i = 0; i < images->size(); ++i) {
+    const double view = whole((*images)[i], "bufferView", -1.0);
+    if (view < 0 || view >= double(views->size()) || view != std::floor(view)) continue;
+    const nlohmann::json& v = (*views)[static_cast<std::size_t>(view)];
+    const double buffer = whole(v, "buffer", -1.0);
+    if (buffer < 0 || buffer >= double(buffers->size()) || buffer != std::floor(buffer)) continue;
+    const double length = whole((*buffers)[static_cast<std::size_t>(buffer)], "byteLength", -1.0);
+    const double end = whole(v, "byteOffset", 0.0) + whole(v, "byteLength", 0.0);
+    if (length >= 0 && end > length)
+      throw InputError(path, "images[" + std::to_string(i) + "] uses bufferView " +
+                                 std::to_string(static_cast<long long>(view)) + ", which runs past the end of buffer " +
+                                 std::to_string(static_cast<long long>(buffer)) + " (" +
+                                 std::to_string(static_cast<long long>(end)) + " > " +
+                                 std::to_string(static_cast<long long>(length)) + " bytes)");
+  }
+}
+
 // An absolute URI (a path from /, or a file: URL) names a file wherever it is; tinygltf
 // would append it to the scene's folder, which hides what the file asked for. Refused
 // unless external files are allowed; relative URIs are checked where they resolve
@@ -775,6 +803,7 @@ void check_before_parsing(const std::string& path, const char* json, std::size_t
     if (const auto c = doc.find(key); c != doc.end() && c->is_object() && !c->empty()) version1 = true;
   if (version1) throw InputError(path, "glTF 1.0 is not supported, 2.0 is");
   check_schema_shapes(path, doc);
+  check_image_buffer_views(path, doc);
   const auto required = doc.find("extensionsRequired");
   if (required == doc.end() || !required->is_array()) return;
   std::string missing;

@@ -338,6 +338,19 @@ std::string glb(std::string json, const std::vector<std::pair<std::uint32_t, std
   return std::string(b.begin(), b.end());
 }
 
+// An image's bufferView is decoded while tinygltf parses: it must lie inside its buffer's
+// declared byteLength before then (found by fuzzing: the decoder read past tinygltf's copy).
+TEST(GltfSpecRules, ImageBufferViewMustLieInsideItsBuffer) {
+  Asset inside;
+  inside.buffer_views += R"(,{"buffer":0,"byteOffset":44,"byteLength":8})";
+  inside.top_extra = R"(,"images":[{"bufferView":3,"mimeType":"image/png"}])";
+  EXPECT_EQ(load_error("image_view_inside.gltf", inside.json()), "") << "not a PNG: left out, the scene loads";
+  Asset past = inside;
+  past.buffer_views = inside.buffer_views.substr(0, inside.buffer_views.rfind(",{")) +
+                      R"(,{"buffer":0,"byteOffset":44,"byteLength":4096})";
+  EXPECT_REJECTED("image_view_past.gltf", past, "images[0] uses bufferView 3, which runs past the end of buffer 0");
+}
+
 TEST(GltfSpecRules, GlbChunkLayoutIsChecked) {
   Asset a;
   std::string json = a.json();
