@@ -241,8 +241,11 @@ inline void store_vec3x8(glm::vec3* dst, __m256 x, __m256 y, __m256 z) {
 // interpolate_sample for 8 covered samples i .. i+7 of simple materials at once, the
 // triangles' corners gathered from their records in lanes: the same IEEE operations per
 // component in the same order (b0 = (1 − b1) − b2, then (b0·a0 + b1·a1) + b2·a2), so the
-// same bytes. Returns false, writing nothing, if a sample is background or not simple.
-inline bool interpolate_group8(const SampleContext& c, const TriangleRecord* records,
+// same bytes. Returns kGroupSkipped, writing nothing, if a sample is background or not
+// simple; kGroupNormalsPending when a normal is degenerate (the normals are then left in
+// `lanes` for the block's normal step).
+enum GroupResult { kGroupSkipped, kGroupDone, kGroupNormalsPending };
+inline GroupResult interpolate_group8(const SampleContext& c, const TriangleRecord* records,
                                const std::uint32_t* materials, std::size_t i,
                                const StagingBlock& out, detail::NormalLanes<kBlock>& lanes,
                                std::size_t j) {
@@ -251,14 +254,14 @@ inline bool interpolate_group8(const SampleContext& c, const TriangleRecord* rec
                 "the gathers below index the record as 24 dwords");
   const __m256i tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.triangle.pixels[i]));
   const __m256i none = _mm256_set1_epi32(static_cast<int>(kNoId));
-  if (!_mm256_testz_si256(_mm256_cmpeq_epi32(tri, none), _mm256_cmpeq_epi32(tri, none))) return false;
+  if (!_mm256_testz_si256(_mm256_cmpeq_epi32(tri, none), _mm256_cmpeq_epi32(tri, none))) return kGroupSkipped;
   const float* base = reinterpret_cast<const float*>(records);
   // Dword index of each record, 24·t (below 2^29: at most 2^24 triangles).
   const __m256i at = _mm256_add_epi32(_mm256_slli_epi32(tri, 4), _mm256_slli_epi32(tri, 3));
   const __m256i mat = _mm256_i32gather_epi32(reinterpret_cast<const int*>(materials), tri, 4);
   const __m256i simple =
       _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.simple.data()), mat, 4);
-  if (_mm256_movemask_ps(_mm256_castsi256_ps(simple)) != 0xff) return false;
+  if (_mm256_movemask_ps(_mm256_castsi256_ps(simple)) != 0xff) return kGroupSkipped;
   const __m256i keep =
       _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.keep_side.data()), mat, 4);
   const __m256i specular =
@@ -281,9 +284,28 @@ inline bool interpolate_group8(const SampleContext& c, const TriangleRecord* rec
   const __m256 px = lerp(0, 3), py = lerp(1, 3), pz = lerp(2, 3);
   const __m256 nx = lerp(9, 3), ny = lerp(10, 3), nz = lerp(11, 3);
   const __m256 u = lerp(18, 2), v = lerp(19, 2);
-  _mm256_storeu_ps(lanes.nx + j, nx), _mm256_storeu_ps(lanes.ny + j, ny), _mm256_storeu_ps(lanes.nz + j, nz);
-  _mm256_storeu_ps(lanes.px + j, px), _mm256_storeu_ps(lanes.py + j, py), _mm256_storeu_ps(lanes.pz + j, pz);
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(lanes.keep_side + j), keep);
+  // The normal step of normalize_and_face_eye in the same registers: the same operations.
+  const __m256 len = _mm256_sqrt_ps(_mm256_add_ps(
+      _mm256_add_ps(_mm256_mul_ps(nx, nx), _mm256_mul_ps(ny, ny)), _mm256_mul_ps(nz, nz)));
+  const bool all_valid =
+      _mm256_movemask_ps(_mm256_cmp_ps(len, _mm256_set1_ps(1e-12f), _CMP_GT_OQ)) == 0xff;
+  if (all_valid) {
+    const __m256 x = _mm256_div_ps(nx, len), y = _mm256_div_ps(ny, len), z = _mm256_div_ps(nz, len);
+    const __m256 facing = _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(x, _mm256_sub_ps(_mm256_set1_ps(c.eye.x), px)),
+                      _mm256_mul_ps(y, _mm256_sub_ps(_mm256_set1_ps(c.eye.y), py))),
+        _mm256_mul_ps(z, _mm256_sub_ps(_mm256_set1_ps(c.eye.z), pz)));
+    const __m256 flip = _mm256_and_ps(
+        _mm256_andnot_ps(_mm256_castsi256_ps(keep),
+                         _mm256_cmp_ps(facing, _mm256_setzero_ps(), _CMP_LT_OQ)),
+        _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(0x80000000u))));
+    store_vec3x8(out.normal + j, _mm256_xor_ps(x, flip), _mm256_xor_ps(y, flip),
+                 _mm256_xor_ps(z, flip));
+  } else {  // a degenerate normal: the block's normal step and face-normal fallback
+    _mm256_storeu_ps(lanes.nx + j, nx), _mm256_storeu_ps(lanes.ny + j, ny), _mm256_storeu_ps(lanes.nz + j, nz);
+    _mm256_storeu_ps(lanes.px + j, px), _mm256_storeu_ps(lanes.py + j, py), _mm256_storeu_ps(lanes.pz + j, pz);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(lanes.keep_side + j), keep);
+  }
   const __m256i object = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.object.pixels[i]));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.object + j), object);
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.reflector + j),
@@ -296,7 +318,7 @@ inline bool interpolate_group8(const SampleContext& c, const TriangleRecord* rec
   alignas(32) std::uint32_t m[8];
   _mm256_store_si256(reinterpret_cast<__m256i*>(m), mat);
   for (int l = 0; l < 8; ++l) out.surface[j + l] = c.materials[m[l]].constant;
-  return true;
+  return all_valid ? kGroupDone : kGroupNormalsPending;
 }
 
 // Background samples get the ids and the planes' default values, so every byte of the
@@ -316,7 +338,7 @@ template <class Corners>
 void resolve_range(const SampleContext& c, const Corners& corners, std::size_t begin,
                    std::size_t end, bool stream, GBuffer& g) {
   PlaneWriters writers(g, begin, stream);
-  detail::NormalLanes<kBlock> lanes;
+  detail::NormalLanes<kBlock> lanes{};
   bool simple[kBlock];
   const std::uint32_t* tri = c.vis.triangle.pixels.data();
   const std::size_t total = c.vis.triangle.size();
@@ -334,12 +356,18 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
   for (std::size_t b = begin; b < end; b += kBlock) {
     const std::size_t n = std::min(kBlock, end - b);
     const StagingBlock blk = writers.block();
+    bool normals_pending = false;  // a sample left its normal to the block's normal step
     for (std::size_t j = 0; j < n; ++j) {
       const std::size_t i = b + j;
       if constexpr (std::is_same_v<Corners, RecordCorners>) {
-        if (j + 8 <= n && interpolate_group8(c, corners.records, corners.materials, i, blk, lanes, j)) {
+        const GroupResult group =
+            j + 8 <= n ? interpolate_group8(c, corners.records, corners.materials, i, blk, lanes, j)
+                       : kGroupSkipped;
+        if (group != kGroupSkipped) {
           for (std::size_t k = i; k < i + 8; ++k) prefetch_at(k + kPrefetchAhead);
-          std::fill(simple + j, simple + j + 8, true);
+          const bool pending = group == kGroupNormalsPending;
+          std::fill(simple + j, simple + j + 8, pending);
+          normals_pending |= pending;
           j += 7;
           continue;
         }
@@ -360,10 +388,17 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
       if (info.simple) {
         interpolate_sample(c, i, r, info, blk, lanes, j);
         simple[j] = true;
+        normals_pending = true;
       } else {
         resolve_sample(c, i, t, r, mat, blk, j);
       }
     }
+    if (!normals_pending) {
+      writers.commit(n);
+      continue;
+    }
+    // Lanes of samples already done hold zeros or an earlier sample's values: their results
+    // are not read.
     for (std::size_t j = n; j < (n + 7) / 8 * 8; ++j) {  // tail lanes of a partial block
       lanes.nx[j] = lanes.ny[j] = lanes.nz[j] = lanes.px[j] = lanes.py[j] = lanes.pz[j] = 0.0f;
       lanes.keep_side[j] = 0;
