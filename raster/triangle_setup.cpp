@@ -12,6 +12,8 @@
 
 #include <immintrin.h>
 
+#include "raster/transpose8.h"
+
 namespace speculum::raster {
 namespace {
 
@@ -359,27 +361,6 @@ inline int greater(Wide a, Wide b) {
   return bits64(_mm256_cmpgt_epi64(a.lo, b.lo), _mm256_cmpgt_epi64(a.hi, b.hi));
 }
 
-// The 8×8 transpose of 32-bit lanes: row k of the result holds element k of every input.
-inline void transpose8(const __m256i (&in)[8], __m256i (&out)[8]) {
-  const __m256 r0 = _mm256_castsi256_ps(in[0]), r1 = _mm256_castsi256_ps(in[1]),
-               r2 = _mm256_castsi256_ps(in[2]), r3 = _mm256_castsi256_ps(in[3]),
-               r4 = _mm256_castsi256_ps(in[4]), r5 = _mm256_castsi256_ps(in[5]),
-               r6 = _mm256_castsi256_ps(in[6]), r7 = _mm256_castsi256_ps(in[7]);
-  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
-  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
-  const __m256 t4 = _mm256_unpacklo_ps(r4, r5), t5 = _mm256_unpackhi_ps(r4, r5);
-  const __m256 t6 = _mm256_unpacklo_ps(r6, r7), t7 = _mm256_unpackhi_ps(r6, r7);
-  const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xee);
-  const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xee);
-  const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xee);
-  const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xee);
-  const __m256 v[8] = {_mm256_permute2f128_ps(u0, u4, 0x20), _mm256_permute2f128_ps(u1, u5, 0x20),
-                       _mm256_permute2f128_ps(u2, u6, 0x20), _mm256_permute2f128_ps(u3, u7, 0x20),
-                       _mm256_permute2f128_ps(u0, u4, 0x31), _mm256_permute2f128_ps(u1, u5, 0x31),
-                       _mm256_permute2f128_ps(u2, u6, 0x31), _mm256_permute2f128_ps(u3, u7, 0x31)};
-  for (int k = 0; k < 8; ++k) out[k] = _mm256_castps_si256(v[k]);
-}
-
 static_assert(offsetof(ScreenVertex, y) == offsetof(ScreenVertex, x) + 4 &&
               offsetof(ScreenVertex, inv_w) == offsetof(ScreenVertex, x) + 8 &&
               offsetof(ScreenVertex, outcode) == offsetof(ScreenVertex, x) + 12,
@@ -533,8 +514,8 @@ inline bool setup_group8(const ScreenVertex* vertices, const std::uint32_t* indi
   const __m256i second[8] = {w[2],   box_lo, box_hi, tri, object, _mm256_set1_epi32(-1),
                              _mm256_srli_epi32(swap, 31), zero};
   __m256i a[8], b[8];
-  transpose8(first, a);
-  transpose8(second, b);
+  detail::transpose8(first, a);
+  detail::transpose8(second, b);
   for (int l = 0; l < 8; ++l) {
     __m256i* r = reinterpret_cast<__m256i*>(dst + n);
     _mm256_store_si256(r, a[l]);
