@@ -1,5 +1,5 @@
-// The 8×8 transpose of 32-bit lanes in AVX2, shared by the kernels that turn eight records
-// into lanes (triangle setup's records, the G-buffer's triangle corners) and back.
+// The 8×8 transpose of 32-bit lanes in AVX2: eight records of eight dwords to eight lanes of
+// each field and back (triangle setup assembles its records with it).
 #pragma once
 
 #include <immintrin.h>
