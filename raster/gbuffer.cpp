@@ -46,9 +46,11 @@ struct MaterialInfo {
   bool specular = false;       // is_specular(constant)
 };
 
-// Per material, all ones or zero, for the 8-lane path (gathered by material index).
+// Per material, for the 8-lane path: one word gathered by material index whose bits say
+// simple, keep_side (refractor) and specular.
+constexpr std::uint32_t kLaneSimple = 1, kLaneKeepSide = 2, kLaneSpecular = 4;
 struct MaterialLanes {
-  std::vector<std::uint32_t> simple, keep_side, specular;
+  std::vector<std::uint32_t> flags;
 };
 
 struct SampleContext {
@@ -259,13 +261,14 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   // Dword index of each record, 24·t (below 2^29: at most 2^24 triangles).
   const __m256i at = _mm256_add_epi32(_mm256_slli_epi32(tri, 4), _mm256_slli_epi32(tri, 3));
   const __m256i mat = _mm256_i32gather_epi32(reinterpret_cast<const int*>(materials), tri, 4);
-  const __m256i simple =
-      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.simple.data()), mat, 4);
-  if (_mm256_movemask_ps(_mm256_castsi256_ps(simple)) != 0xff) return kGroupSkipped;
-  const __m256i keep =
-      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.keep_side.data()), mat, 4);
-  const __m256i specular =
-      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.specular.data()), mat, 4);
+  const __m256i flags =
+      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.flags.data()), mat, 4);
+  auto has = [&](std::uint32_t bit) {
+    const __m256i b = _mm256_set1_epi32(static_cast<int>(bit));
+    return _mm256_cmpeq_epi32(_mm256_and_si256(flags, b), b);
+  };
+  if (_mm256_movemask_ps(_mm256_castsi256_ps(has(kLaneSimple))) != 0xff) return kGroupSkipped;
+  const __m256i keep = has(kLaneKeepSide), specular = has(kLaneSpecular);
   // Barycentrics (b1, b2) of 8 samples, de-interleaved.
   const float* bary = &c.vis.bary.pixels[i].x;
   const __m256 lo = _mm256_loadu_ps(bary), hi = _mm256_loadu_ps(bary + 8);
@@ -448,9 +451,9 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
     info.keep_side = info.constant.is_refractor() ? ~0u : 0u;
     info.specular = is_specular(info.constant);
     materials.push_back(info);
-    material_lanes.simple.push_back(info.simple ? ~0u : 0u);
-    material_lanes.keep_side.push_back(info.keep_side);
-    material_lanes.specular.push_back(info.specular ? ~0u : 0u);
+    material_lanes.flags.push_back((info.simple ? kLaneSimple : 0u) |
+                                   (info.keep_side ? kLaneKeepSide : 0u) |
+                                   (info.specular ? kLaneSpecular : 0u));
   }
   const SampleContext ctx{scene, m, vis, eye, materials, material_lanes};
   const bool stream = vis.triangle.size() >= kStreamingMinSamples;
