@@ -672,16 +672,17 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
   std::fill(std::begin(s.inv_w), std::end(s.inv_w), 0.0f);
   std::fill(std::begin(s.triangle), std::end(s.triangle), kNoId);
   std::fill(std::begin(s.ref), std::end(s.ref), kNoRef);
-  s.setup.clear();
-  s.clip_map.clear();
-  s.flags.clear();
-  s.object.clear();
   s.count_coverage = !out.coverage.empty();
   s.hiz = !s.count_coverage;
   std::fill(std::begin(s.block_min), std::end(s.block_min), 0.0f);
   if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
 
   const std::uint32_t begin = bins.tile_offsets[tile], end = bins.tile_offsets[tile + 1];
+  // Per-ref data in arrays sized once per tile (no growth check per reference).
+  s.setup.resize(end - begin);
+  s.clip_map.resize(end - begin);
+  s.flags.resize(end - begin);
+  s.object.resize(end - begin);
   // The records are gathered from their chunks (whole 64-byte lines, mostly from memory):
   // prefetched far enough ahead to cover a DRAM miss behind the small triangles' short work.
   const std::uint32_t* refs = bins.refs.data();
@@ -691,11 +692,11 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
     if (k + kRecordPrefetch < end)
       _mm_prefetch(reinterpret_cast<const char*>(&bins.record(refs[k + kRecordPrefetch])), _MM_HINT_T0);
     const SetupTriangle& t = bins.record(refs[k]);
-    const auto ref = static_cast<std::uint32_t>(s.setup.size());
-    s.setup.push_back(&t);
-    s.clip_map.push_back(t.clip_map >= 0 ? &bins.clip_map(refs[k], t) : nullptr);
-    s.flags.push_back((t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u));
-    s.object.push_back(t.object);
+    const std::uint32_t ref = k - begin;
+    s.setup[ref] = &t;
+    s.clip_map[ref] = t.clip_map >= 0 ? &bins.clip_map(refs[k], t) : nullptr;
+    s.flags[ref] = (t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u);
+    s.object[ref] = t.object;
     raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);
   }
 
