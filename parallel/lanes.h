@@ -35,9 +35,10 @@
 // lane ops (prefix sums, streaming stores, left-packing, ...) are in lanes_stream.h and
 // lanes_pack.h, with intrinsic paths where a width is one register. Scans and reductions with an
 // arbitrary operator fold element by element (their association must not depend on W).
-// Not width-generic: the G-buffer resolve and the BVH traversal kernels, written with fixed
-// 8-wide AVX2 for the 8-child BVH node layout; they do the same IEEE operations per element
-// as their scalar tests, so their bits do not depend on W either.
+// Not width-generic: the G-buffer resolve, triangle setup and the BVH traversal kernels,
+// written with fixed 8-wide AVX2 (the BVH for its 8-child node layout); they do the same IEEE
+// or exact integer operations per element as their scalar tests, so their bits do not depend
+// on W either.
 #pragma once
 
 #include <experimental/simd>

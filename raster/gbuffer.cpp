@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include <immintrin.h>
@@ -44,12 +46,20 @@ struct MaterialInfo {
   bool specular = false;       // is_specular(constant)
 };
 
+// Per material, for the 8-lane path: one word gathered by material index whose bits say
+// simple, keep_side (refractor) and specular.
+constexpr std::uint32_t kLaneSimple = 1, kLaneKeepSide = 2, kLaneSpecular = 4;
+struct MaterialLanes {
+  std::vector<std::uint32_t> flags;
+};
+
 struct SampleContext {
   const Scene& scene;
   const TriangleMesh& m;
   const VisibilityBuffer& vis;
   const glm::vec3& eye;
   const std::vector<MaterialInfo>& materials;
+  const MaterialLanes& lanes;
 };
 
 // One block's slots in the planes' staging buffers (see PlaneWriters).
@@ -112,6 +122,7 @@ struct PlaneWriters {
 struct MeshCorners {
   const TriangleMesh& m;
   TriangleRecord operator()(std::uint32_t t) const { return triangle_record(m, t); }
+  std::uint32_t material(std::uint32_t t) const { return m.triangle_material[t]; }
   // Two stages: the indices first, the corners once the indices have arrived.
   void prefetch_indices(std::uint32_t t) const {
     _mm_prefetch(reinterpret_cast<const char*>(m.indices.data() + 3 * std::size_t(t)), _MM_HINT_T0);
@@ -130,18 +141,23 @@ struct MeshCorners {
 // Triangle data from the scene-static records (gbuffer_triangles.h).
 struct RecordCorners {
   const TriangleRecord* records;
+  const std::uint32_t* materials;
   const TriangleRecord& operator()(std::uint32_t t) const { return records[t]; }
+  std::uint32_t material(std::uint32_t t) const { return materials[t]; }
   void prefetch_indices(std::uint32_t) const {}  // a record needs no indices
   void prefetch(std::uint32_t t) const {
+    // 96 bytes at a multiple of 32: the lines of its first and its 65th byte.
     const char* p = reinterpret_cast<const char*>(records + t);
     _mm_prefetch(p, _MM_HINT_T0);
     _mm_prefetch(p + 64, _MM_HINT_T0);
+    _mm_prefetch(reinterpret_cast<const char*>(materials + t), _MM_HINT_T0);
   }
 };
 
 // Resolves covered visibility sample i of triangle t (corners r) into slot j of the block.
 inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t t,
-                           const TriangleRecord& r, const StagingBlock& out, std::size_t j) {
+                           const TriangleRecord& r, std::uint32_t mat, const StagingBlock& out,
+                           std::size_t j) {
   const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
   const float b0 = 1.0f - b.x - b.y;
@@ -155,7 +171,6 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
     n = glm::normalize(glm::cross(r.position[1] - r.position[0], r.position[2] - r.position[0]));
   }
   const glm::vec2 uv = lerp3(r.uv);
-  const std::uint32_t mat = r.material;
   const MaterialInfo& info = c.materials[mat];
   SurfaceParams& sp = out.surface[j];
   const glm::vec3 unmapped = n;  // decides the side (below); the map tilts within it
@@ -207,6 +222,108 @@ inline void interpolate_sample(const SampleContext& c, std::size_t i, const Tria
   out.reflector[j] = info.specular ? object : kNoId;
 }
 
+// Stores 8 vec3 given as x, y, z lanes to dst[0..7] (array of structures).
+inline void store_vec3x8(glm::vec3* dst, __m256 x, __m256 y, __m256 z) {
+  float* d = &dst[0].x;
+  for (int h = 0; h < 2; ++h) {
+    __m128 r0 = h ? _mm256_extractf128_ps(x, 1) : _mm256_castps256_ps128(x);
+    __m128 r1 = h ? _mm256_extractf128_ps(y, 1) : _mm256_castps256_ps128(y);
+    __m128 r2 = h ? _mm256_extractf128_ps(z, 1) : _mm256_castps256_ps128(z);
+    __m128 r3 = _mm_setzero_ps();
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);  // r_k = (x_k, y_k, z_k, 0)
+    float* o = d + 12 * h;
+    _mm_storeu_ps(o, r0);  // each 16-byte store's last float is overwritten by the next
+    _mm_storeu_ps(o + 3, r1);
+    _mm_storeu_ps(o + 6, r2);
+    _mm_storel_pi(reinterpret_cast<__m64*>(o + 9), r3);
+    _mm_store_ss(o + 11, _mm_movehl_ps(r3, r3));
+  }
+}
+
+// interpolate_sample for 8 covered samples i .. i+7 of simple materials at once, the
+// triangles' corners gathered from their records in lanes: the same IEEE operations per
+// component in the same order (b0 = (1 − b1) − b2, then (b0·a0 + b1·a1) + b2·a2), so the
+// same bytes. Returns kGroupSkipped, writing nothing, if a sample is background or not
+// simple; kGroupNormalsPending when a normal is degenerate (the normals are then left in
+// `lanes` for the block's normal step).
+enum GroupResult { kGroupSkipped, kGroupDone, kGroupNormalsPending };
+inline GroupResult interpolate_group8(const SampleContext& c, const TriangleRecord* records,
+                               const std::uint32_t* materials, std::size_t i,
+                               const StagingBlock& out, detail::NormalLanes<kBlock>& lanes,
+                               std::size_t j) {
+  static_assert(sizeof(TriangleRecord) == 24 * sizeof(float) &&
+                offsetof(TriangleRecord, normal) == 36 && offsetof(TriangleRecord, uv) == 72,
+                "the gathers below index the record as 24 dwords");
+  const __m256i tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.triangle.pixels[i]));
+  const __m256i none = _mm256_set1_epi32(static_cast<int>(kNoId));
+  if (!_mm256_testz_si256(_mm256_cmpeq_epi32(tri, none), _mm256_cmpeq_epi32(tri, none))) return kGroupSkipped;
+  const float* base = reinterpret_cast<const float*>(records);
+  // Dword index of each record, 24·t (below 2^29: at most 2^24 triangles).
+  const __m256i at = _mm256_add_epi32(_mm256_slli_epi32(tri, 4), _mm256_slli_epi32(tri, 3));
+  const __m256i mat = _mm256_i32gather_epi32(reinterpret_cast<const int*>(materials), tri, 4);
+  const __m256i flags =
+      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.flags.data()), mat, 4);
+  auto has = [&](std::uint32_t bit) {
+    const __m256i b = _mm256_set1_epi32(static_cast<int>(bit));
+    return _mm256_cmpeq_epi32(_mm256_and_si256(flags, b), b);
+  };
+  if (_mm256_movemask_ps(_mm256_castsi256_ps(has(kLaneSimple))) != 0xff) return kGroupSkipped;
+  const __m256i keep = has(kLaneKeepSide), specular = has(kLaneSpecular);
+  // Barycentrics (b1, b2) of 8 samples, de-interleaved.
+  const float* bary = &c.vis.bary.pixels[i].x;
+  const __m256 lo = _mm256_loadu_ps(bary), hi = _mm256_loadu_ps(bary + 8);
+  const __m256 b1 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0x88)), 0xd8));
+  const __m256 b2 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0xdd)), 0xd8));
+  const __m256 b0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), b1), b2);
+  // Component `f` of corner 0 is dword f; corner k adds `stride`·k.
+  auto lerp = [&](int f, int stride) {
+    const __m256i k0 = _mm256_add_epi32(at, _mm256_set1_epi32(f));
+    const __m256 a0 = _mm256_i32gather_ps(base, k0, 4);
+    const __m256 a1 = _mm256_i32gather_ps(base, _mm256_add_epi32(k0, _mm256_set1_epi32(stride)), 4);
+    const __m256 a2 = _mm256_i32gather_ps(base, _mm256_add_epi32(k0, _mm256_set1_epi32(2 * stride)), 4);
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(b0, a0), _mm256_mul_ps(b1, a1)),
+                         _mm256_mul_ps(b2, a2));
+  };
+  const __m256 px = lerp(0, 3), py = lerp(1, 3), pz = lerp(2, 3);
+  const __m256 nx = lerp(9, 3), ny = lerp(10, 3), nz = lerp(11, 3);
+  const __m256 u = lerp(18, 2), v = lerp(19, 2);
+  // The normal step of normalize_and_face_eye in the same registers: the same operations.
+  const __m256 len = _mm256_sqrt_ps(_mm256_add_ps(
+      _mm256_add_ps(_mm256_mul_ps(nx, nx), _mm256_mul_ps(ny, ny)), _mm256_mul_ps(nz, nz)));
+  const bool all_valid =
+      _mm256_movemask_ps(_mm256_cmp_ps(len, _mm256_set1_ps(1e-12f), _CMP_GT_OQ)) == 0xff;
+  if (all_valid) {
+    const __m256 x = _mm256_div_ps(nx, len), y = _mm256_div_ps(ny, len), z = _mm256_div_ps(nz, len);
+    const __m256 facing = _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(x, _mm256_sub_ps(_mm256_set1_ps(c.eye.x), px)),
+                      _mm256_mul_ps(y, _mm256_sub_ps(_mm256_set1_ps(c.eye.y), py))),
+        _mm256_mul_ps(z, _mm256_sub_ps(_mm256_set1_ps(c.eye.z), pz)));
+    const __m256 flip = _mm256_and_ps(
+        _mm256_andnot_ps(_mm256_castsi256_ps(keep),
+                         _mm256_cmp_ps(facing, _mm256_setzero_ps(), _CMP_LT_OQ)),
+        _mm256_castsi256_ps(_mm256_set1_epi32(static_cast<int>(0x80000000u))));
+    store_vec3x8(out.normal + j, _mm256_xor_ps(x, flip), _mm256_xor_ps(y, flip),
+                 _mm256_xor_ps(z, flip));
+  } else {  // a degenerate normal: the block's normal step and face-normal fallback
+    _mm256_storeu_ps(lanes.nx + j, nx), _mm256_storeu_ps(lanes.ny + j, ny), _mm256_storeu_ps(lanes.nz + j, nz);
+    _mm256_storeu_ps(lanes.px + j, px), _mm256_storeu_ps(lanes.py + j, py), _mm256_storeu_ps(lanes.pz + j, pz);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(lanes.keep_side + j), keep);
+  }
+  const __m256i object = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.object.pixels[i]));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.object + j), object);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.reflector + j),
+                      _mm256_blendv_epi8(none, object, specular));
+  store_vec3x8(out.position + j, px, py, pz);
+  const __m256 uv_lo = _mm256_unpacklo_ps(u, v), uv_hi = _mm256_unpackhi_ps(u, v);
+  float* uv = &out.uv[j].x;
+  _mm256_storeu_ps(uv, _mm256_permute2f128_ps(uv_lo, uv_hi, 0x20));
+  _mm256_storeu_ps(uv + 8, _mm256_permute2f128_ps(uv_lo, uv_hi, 0x31));
+  alignas(32) std::uint32_t m[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(m), mat);
+  for (int l = 0; l < 8; ++l) out.surface[j + l] = c.materials[m[l]].constant;
+  return all_valid ? kGroupDone : kGroupNormalsPending;
+}
+
 // Background samples get the ids and the planes' default values, so every byte of the
 // G-buffer is defined (and the same for any thread count) whatever the buffer held before.
 inline void resolve_background(const SampleContext& c, std::size_t i, const StagingBlock& out,
@@ -224,7 +341,7 @@ template <class Corners>
 void resolve_range(const SampleContext& c, const Corners& corners, std::size_t begin,
                    std::size_t end, bool stream, GBuffer& g) {
   PlaneWriters writers(g, begin, stream);
-  detail::NormalLanes<kBlock> lanes;
+  detail::NormalLanes<kBlock> lanes{};
   bool simple[kBlock];
   const std::uint32_t* tri = c.vis.triangle.pixels.data();
   const std::size_t total = c.vis.triangle.size();
@@ -242,8 +359,22 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
   for (std::size_t b = begin; b < end; b += kBlock) {
     const std::size_t n = std::min(kBlock, end - b);
     const StagingBlock blk = writers.block();
+    bool normals_pending = false;  // a sample left its normal to the block's normal step
     for (std::size_t j = 0; j < n; ++j) {
       const std::size_t i = b + j;
+      if constexpr (std::is_same_v<Corners, RecordCorners>) {
+        const GroupResult group =
+            j + 8 <= n ? interpolate_group8(c, corners.records, corners.materials, i, blk, lanes, j)
+                       : kGroupSkipped;
+        if (group != kGroupSkipped) {
+          for (std::size_t k = i; k < i + 8; ++k) prefetch_at(k + kPrefetchAhead);
+          const bool pending = group == kGroupNormalsPending;
+          std::fill(simple + j, simple + j + 8, pending);
+          normals_pending |= pending;
+          j += 7;
+          continue;
+        }
+      }
       prefetch_indices_at(i + 2 * kPrefetchAhead);
       prefetch_at(i + kPrefetchAhead);
       const std::uint32_t t = tri[i];
@@ -255,14 +386,22 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
         continue;
       }
       decltype(auto) r = corners(t);
-      const MaterialInfo& info = c.materials[r.material];
+      const std::uint32_t mat = corners.material(t);
+      const MaterialInfo& info = c.materials[mat];
       if (info.simple) {
         interpolate_sample(c, i, r, info, blk, lanes, j);
         simple[j] = true;
+        normals_pending = true;
       } else {
-        resolve_sample(c, i, t, r, blk, j);
+        resolve_sample(c, i, t, r, mat, blk, j);
       }
     }
+    if (!normals_pending) {
+      writers.commit(n);
+      continue;
+    }
+    // Lanes of samples already done hold zeros or an earlier sample's values: their results
+    // are not read.
     for (std::size_t j = n; j < (n + 7) / 8 * 8; ++j) {  // tail lanes of a partial block
       lanes.nx[j] = lanes.ny[j] = lanes.nz[j] = lanes.px[j] = lanes.py[j] = lanes.pz[j] = 0.0f;
       lanes.keep_side[j] = 0;
@@ -301,6 +440,7 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
   const TriangleMesh& m = scene.mesh;
   // Untextured materials have the same parameters everywhere: evaluate them once.
   std::vector<MaterialInfo> materials;
+  MaterialLanes material_lanes;
   for (const Material& mat : scene.materials) {
     MaterialInfo info;
     info.constant = surface_params(mat);
@@ -311,11 +451,14 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
     info.keep_side = info.constant.is_refractor() ? ~0u : 0u;
     info.specular = is_specular(info.constant);
     materials.push_back(info);
+    material_lanes.flags.push_back((info.simple ? kLaneSimple : 0u) |
+                                   (info.keep_side ? kLaneKeepSide : 0u) |
+                                   (info.specular ? kLaneSpecular : 0u));
   }
-  const SampleContext ctx{scene, m, vis, eye, materials};
+  const SampleContext ctx{scene, m, vis, eye, materials, material_lanes};
   const bool stream = vis.triangle.size() >= kStreamingMinSamples;
   if (records) {
-    const RecordCorners corners{records->data()};
+    const RecordCorners corners{records->data(), records->materials()};
     executor.parallel_for("gbuffer.resolve", vis.triangle.size(), kPixelChunk,
                           [&](std::size_t begin, std::size_t end) {
       resolve_range(ctx, corners, begin, end, stream, g);

@@ -18,6 +18,7 @@ GBufferTriangles::GBufferTriangles(par::Executor& executor, const Scene& scene) 
   executor.parallel_for("gbuffer.prepare", n, kTriangleChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) out[t] = triangle_record(m, std::uint32_t(t));
   });
+  materials_ = m.triangle_material;
   records_ = out;
   count_ = n;
   vertices_ = m.vertex_count();

@@ -362,6 +362,70 @@ bool raster_rect_avx2_wide(const Edges& e, const SetupTriangle& t, std::uint32_t
   return test.any_won();
 }
 
+// Triangles whose box in the tile spans at most 4 × 2 pixels (most of a million-triangle view
+// at about a pixel per triangle) in one 8-lane pass: lane l is the sample (x0 + l % 4,
+// y0 + l / 4). The edge values are the integers of make_edges/edge_at (E_i written about
+// vertex p, which it vanishes at: the same integer), exact in int32 for a vertex extent of at
+// most 2^13 sub-pixels, and every float operation of DepthTest8 is the same in the same
+// order (area → float once, then (E·(1/area))·(1/w_i), (p0 + p1) + p2): the same bits as
+// raster_rect_avx2. Not used when counting coverage.
+bool raster_tiny_avx2(const SetupTriangle& t, std::uint32_t ref, int x0, int y0, int x1, int y1,
+                      int ox, int oy, TileScratch& s) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i dx = _mm256_and_si256(lane, _mm256_set1_epi32(3));
+  const __m256i dy = _mm256_srli_epi32(lane, 2);
+  const std::int32_t cx = x0 * kSubpixelOne + kSubpixelOne / 2, cy = y0 * kSubpixelOne + kSubpixelOne / 2;
+  __m256i inside = _mm256_and_si256(_mm256_cmpgt_epi32(_mm256_set1_epi32(x1 - x0 + 1), dx),
+                                    _mm256_cmpgt_epi32(_mm256_set1_epi32(y1 - y0 + 1), dy));
+  __m256 f[3];
+  std::int32_t area = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int p = (i + 1) % 3, q = (i + 2) % 3;
+    const std::int32_t a = t.y[p] - t.y[q], b = t.x[q] - t.x[p];
+    if (i == 0) area = a * (t.x[0] - t.x[p]) + b * (t.y[0] - t.y[p]);
+    const bool top_left = a > 0 || (a == 0 && b > 0);
+    const std::int32_t start = a * (cx - t.x[p]) + b * (cy - t.y[p]);
+    const __m256i v = _mm256_add_epi32(
+        _mm256_set1_epi32(start),
+        _mm256_add_epi32(_mm256_mullo_epi32(dx, _mm256_set1_epi32(a * kSubpixelOne)),
+                         _mm256_mullo_epi32(dy, _mm256_set1_epi32(b * kSubpixelOne))));
+    inside = _mm256_and_si256(inside, _mm256_cmpgt_epi32(v, _mm256_set1_epi32(top_left ? -1 : 0)));
+    f[i] = _mm256_cvtepi32_ps(v);
+  }
+  if (_mm256_testz_si256(inside, inside)) return false;
+  const __m256 ia = _mm256_set1_ps(1.0f / static_cast<float>(area));
+  const __m256 p0 = _mm256_mul_ps(_mm256_mul_ps(f[0], ia), _mm256_set1_ps(t.inv_w[0]));
+  const __m256 p1 = _mm256_mul_ps(_mm256_mul_ps(f[1], ia), _mm256_set1_ps(t.inv_w[1]));
+  const __m256 p2 = _mm256_mul_ps(_mm256_mul_ps(f[2], ia), _mm256_set1_ps(t.inv_w[2]));
+  const __m256 inv_w = _mm256_add_ps(_mm256_add_ps(p0, p1), p2);
+  // Rows y0 and y0 + 1 (a one-row box points its masked upper half at another row of the
+  // tile, so the two halves never store to the same samples).
+  const int lo = (y0 - oy) * kTileSize + (x0 - ox);
+  const int hi = y1 > y0 || y0 - oy < kTileSize - 1 ? lo + kTileSize : lo - kTileSize;
+  auto load = [&](const float* plane) { return _mm256_loadu2_m128(plane + hi, plane + lo); };
+  auto store = [&](float* plane, __m256 v) { _mm256_storeu2_m128(plane + hi, plane + lo, v); };
+  const __m256i flip = _mm256_set1_epi32(std::int32_t(0x80000000u));
+  const __m256i tri = _mm256_set1_epi32(std::int32_t(t.triangle));
+  const __m256 best = load(s.inv_w);
+  const __m256i best_tri = _mm256_castps_si256(load(reinterpret_cast<const float*>(s.triangle)));
+  const __m256 nearer = _mm256_cmp_ps(inv_w, best, _CMP_GT_OQ);
+  const __m256 tie = _mm256_and_ps(
+      _mm256_cmp_ps(inv_w, best, _CMP_EQ_OQ),
+      _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_xor_si256(best_tri, flip),
+                                             _mm256_xor_si256(tri, flip))));
+  const __m256 win = _mm256_and_ps(_mm256_castsi256_ps(inside), _mm256_or_ps(nearer, tie));
+  if (_mm256_testz_ps(win, win)) return false;
+  store(s.inv_w, _mm256_blendv_ps(best, inv_w, win));
+  store(s.p1, _mm256_blendv_ps(load(s.p1), p1, win));
+  store(s.p2, _mm256_blendv_ps(load(s.p2), p2, win));
+  store(reinterpret_cast<float*>(s.triangle), _mm256_blendv_ps(_mm256_castsi256_ps(best_tri),
+                                                                _mm256_castsi256_ps(tri), win));
+  store(reinterpret_cast<float*>(s.ref),
+        _mm256_blendv_ps(load(reinterpret_cast<const float*>(s.ref)),
+                         _mm256_castsi256_ps(_mm256_set1_epi32(std::int32_t(ref))), win));
+  return true;
+}
+
 // Picks the 32-bit lane path for small triangles (see make_edges) or when |E| stays below
 // 2^30 over the rectangle widened to whole groups of W lanes (E is linear: its extremes are
 // at the corners).
@@ -424,6 +488,15 @@ void raster_triangle(const SetupTriangle& t, std::uint32_t ref, int tx0, int ty0
     for (int by = by0; by <= by1 && !any_visible; ++by)
       for (int bx = bx0; bx <= bx1 && !any_visible; ++bx) any_visible = !hidden(bx, by);
     if (!any_visible) return;
+  }
+  if (W == 8 && !s.count_coverage && x1 - x0 < 4 && y1 - y0 < 2) {
+    const std::int32_t dx = std::max({t.x[0], t.x[1], t.x[2]}) - std::min({t.x[0], t.x[1], t.x[2]});
+    const std::int32_t dy = std::max({t.y[0], t.y[1], t.y[2]}) - std::min({t.y[0], t.y[1], t.y[2]});
+    if (dx <= (1 << 13) && dy <= (1 << 13)) {
+      if (raster_tiny_avx2(t, ref, x0, y0, x1, y1, tx0, ty0, s) && s.hiz)
+        update_block_mins(s, x0 - tx0, y0 - ty0, x1 - tx0, y1 - ty0);
+      return;
+    }
   }
   const Edges e = make_edges(t);
   // Up to 2×2 blocks: the 8-lane kernel walks the whole rectangle (its rows are cheaper
@@ -599,16 +672,17 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
   std::fill(std::begin(s.inv_w), std::end(s.inv_w), 0.0f);
   std::fill(std::begin(s.triangle), std::end(s.triangle), kNoId);
   std::fill(std::begin(s.ref), std::end(s.ref), kNoRef);
-  s.setup.clear();
-  s.clip_map.clear();
-  s.flags.clear();
-  s.object.clear();
   s.count_coverage = !out.coverage.empty();
   s.hiz = !s.count_coverage;
   std::fill(std::begin(s.block_min), std::end(s.block_min), 0.0f);
   if (s.count_coverage) std::fill(std::begin(s.coverage), std::end(s.coverage), 0u);
 
   const std::uint32_t begin = bins.tile_offsets[tile], end = bins.tile_offsets[tile + 1];
+  // Per-ref data in arrays sized once per tile (no growth check per reference).
+  s.setup.resize(end - begin);
+  s.clip_map.resize(end - begin);
+  s.flags.resize(end - begin);
+  s.object.resize(end - begin);
   // The records are gathered from their chunks (whole 64-byte lines, mostly from memory):
   // prefetched far enough ahead to cover a DRAM miss behind the small triangles' short work.
   const std::uint32_t* refs = bins.refs.data();
@@ -618,11 +692,11 @@ void rasterize_tile_w(int tile, const TileGrid& grid, const Viewport& vp, const 
     if (k + kRecordPrefetch < end)
       _mm_prefetch(reinterpret_cast<const char*>(&bins.record(refs[k + kRecordPrefetch])), _MM_HINT_T0);
     const SetupTriangle& t = bins.record(refs[k]);
-    const auto ref = static_cast<std::uint32_t>(s.setup.size());
-    s.setup.push_back(&t);
-    s.clip_map.push_back(t.clip_map >= 0 ? &bins.clip_map(refs[k], t) : nullptr);
-    s.flags.push_back((t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u));
-    s.object.push_back(t.object);
+    const std::uint32_t ref = k - begin;
+    s.setup[ref] = &t;
+    s.clip_map[ref] = t.clip_map >= 0 ? &bins.clip_map(refs[k], t) : nullptr;
+    s.flags[ref] = (t.swapped ? kRefSwapped : 0u) | (t.clip_map >= 0 ? kRefClipped : 0u);
+    s.object[ref] = t.object;
     raster_triangle<W>(t, ref, tx0, ty0, tx1, ty1, s);
   }
 

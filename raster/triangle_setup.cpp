@@ -6,10 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <utility>
 
 #include <immintrin.h>
+
+#include "raster/transpose8.h"
 
 namespace speculum::raster {
 namespace {
@@ -327,6 +330,203 @@ void setup_triangle(const ScreenVertex& v0, const ScreenVertex& v1, const Screen
        cull_sign, nullptr, out, clip_maps);
 }
 
+namespace {
+
+// Helpers of setup_group8: 32-bit lanes widened to two halves of four 64-bit lanes, and
+// 64-bit lane masks folded back to one bit per triangle.
+inline __m256i lo64(__m256i v) { return _mm256_cvtepi32_epi64(_mm256_castsi256_si128(v)); }
+inline __m256i hi64(__m256i v) { return _mm256_cvtepi32_epi64(_mm256_extracti128_si256(v, 1)); }
+inline int bits64(__m256i lo, __m256i hi) {
+  return _mm256_movemask_pd(_mm256_castsi256_pd(lo)) |
+         _mm256_movemask_pd(_mm256_castsi256_pd(hi)) << 4;
+}
+inline int bits32(__m256i m) { return _mm256_movemask_ps(_mm256_castsi256_ps(m)); }
+// Products of two int32 lanes (each |v| < 2^26, see setup_group8) exactly, as int64 halves.
+struct Wide {
+  __m256i lo, hi;
+};
+inline Wide mul_wide(__m256i a, __m256i b) {
+  return {_mm256_mul_epi32(lo64(a), lo64(b)), _mm256_mul_epi32(hi64(a), hi64(b))};
+}
+inline Wide add(Wide a, Wide b) {
+  return {_mm256_add_epi64(a.lo, b.lo), _mm256_add_epi64(a.hi, b.hi)};
+}
+inline Wide sub(Wide a, Wide b) {
+  return {_mm256_sub_epi64(a.lo, b.lo), _mm256_sub_epi64(a.hi, b.hi)};
+}
+inline Wide widen(__m256i a) { return {lo64(a), hi64(a)}; }
+inline Wide shl8(__m256i a) { return {_mm256_slli_epi64(lo64(a), 8), _mm256_slli_epi64(hi64(a), 8)}; }
+// Bit l set where lane l of a > b (signed 64-bit).
+inline int greater(Wide a, Wide b) {
+  return bits64(_mm256_cmpgt_epi64(a.lo, b.lo), _mm256_cmpgt_epi64(a.hi, b.hi));
+}
+
+static_assert(offsetof(ScreenVertex, y) == offsetof(ScreenVertex, x) + 4 &&
+              offsetof(ScreenVertex, inv_w) == offsetof(ScreenVertex, x) + 8 &&
+              offsetof(ScreenVertex, outcode) == offsetof(ScreenVertex, x) + 12,
+              "x, y, inv_w, outcode are loaded as one 16-byte row");
+static_assert(offsetof(SetupTriangle, y) == 12 && offsetof(SetupTriangle, inv_w) == 24 &&
+              offsetof(SetupTriangle, px0) == 36 && offsetof(SetupTriangle, triangle) == 44 &&
+              offsetof(SetupTriangle, object) == 48 && offsetof(SetupTriangle, clip_map) == 52 &&
+              offsetof(SetupTriangle, swapped) == 56 && offsetof(SetupTriangle, reserved) == 60,
+              "setup_group8 assembles records as 16 dwords in this order");
+
+// The setup of triangles t .. t+7 in 8 lanes (AVX2): the same tests and the same record bytes
+// as the scalar loop of setup_triangles, with the edge and area arithmetic in exact 64-bit
+// integer lanes. Every vertex of a group that reaches the arithmetic is snapped (no lane needs
+// clipping), so |x|, |y| < 2^25 (project_and_snap's limit) and every difference below fits
+// int32 and every product int64 exactly, as in the scalar code. Returns false, writing
+// nothing, when a lane needs the scalar path (clipping or an excluded object); otherwise
+// writes the 8 records to dst[n], dst[n+1], ... advancing n past the kept ones only (dst
+// must have room for 8).
+inline bool setup_group8(const ScreenVertex* vertices, const std::uint32_t* indices,
+                         std::size_t t, const std::uint32_t* triangle_object,
+                         const std::vector<std::uint8_t>& excluded, const Viewport& vp,
+                         int cull_sign, SetupTriangle* dst, std::size_t& n) {
+  const __m256i object = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(triangle_object + t));
+  if (!excluded.empty())
+    for (int l = 0; l < 8; ++l)
+      if (const std::uint32_t o = triangle_object[t + l]; o < excluded.size() && excluded[o])
+        return false;
+  // Corner k of the 8 triangles as four 8-lane rows (x, y, inv_w, outcode).
+  const std::uint32_t* idx = indices + 3 * t;
+  __m256i X[3], Y[3], W[3], oc[3];
+  for (int k = 0; k < 3; ++k) {
+    auto row = [&](int l) {
+      return _mm_loadu_ps(reinterpret_cast<const float*>(&vertices[idx[3 * l + k]].x));
+    };
+    const __m256 m0 = _mm256_set_m128(row(4), row(0)), m1 = _mm256_set_m128(row(5), row(1));
+    const __m256 m2 = _mm256_set_m128(row(6), row(2)), m3 = _mm256_set_m128(row(7), row(3));
+    const __m256 t0 = _mm256_unpacklo_ps(m0, m1), t1 = _mm256_unpackhi_ps(m0, m1);
+    const __m256 t2 = _mm256_unpacklo_ps(m2, m3), t3 = _mm256_unpackhi_ps(m2, m3);
+    X[k] = _mm256_castps_si256(_mm256_shuffle_ps(t0, t2, 0x44));
+    Y[k] = _mm256_castps_si256(_mm256_shuffle_ps(t0, t2, 0xee));
+    W[k] = _mm256_castps_si256(_mm256_shuffle_ps(t1, t3, 0x44));
+    oc[k] = _mm256_castps_si256(_mm256_shuffle_ps(t1, t3, 0xee));
+  }
+  const __m256i zero = _mm256_setzero_si256();
+  // Trivial reject (all three outside one viewport plane) comes first, as in the scalar loop.
+  const int rejected =
+      ~bits32(_mm256_cmpeq_epi32(
+          _mm256_and_si256(_mm256_and_si256(_mm256_and_si256(oc[0], oc[1]), oc[2]),
+                           _mm256_set1_epi32(0x3f)),
+          zero)) & 0xff;
+  const int needs_clip =
+      ~bits32(_mm256_cmpeq_epi32(
+          _mm256_and_si256(_mm256_or_si256(_mm256_or_si256(oc[0], oc[1]), oc[2]),
+                           _mm256_set1_epi32(int(kNeedsClip))),
+          zero)) & 0xff;
+  if (needs_clip & ~rejected) return false;
+
+  const __m256i minx = _mm256_min_epi32(_mm256_min_epi32(X[0], X[1]), X[2]);
+  const __m256i maxx = _mm256_max_epi32(_mm256_max_epi32(X[0], X[1]), X[2]);
+  const __m256i miny = _mm256_min_epi32(_mm256_min_epi32(Y[0], Y[1]), Y[2]);
+  const __m256i maxy = _mm256_max_epi32(_mm256_max_epi32(Y[0], Y[1]), Y[2]);
+  // Narrow group: every triangle spans at most 2^13 sub-pixels (32 pixels) a side. Then the
+  // area (written about vertex 0, the same integer) is below 2^27, and the edge values at
+  // the centres of a non-empty box, which lies within a pixel of the triangle's vertex box,
+  // below 2^28 (|A|, |B| ≤ 2^13, |c − x_p| ≤ 2^13 + 2^8): exact in 32-bit lanes.
+  const __m256i limit13 = _mm256_set1_epi32(1 << 13);
+  const __m256i too_wide =
+      _mm256_or_si256(_mm256_cmpgt_epi32(_mm256_sub_epi32(maxx, minx), limit13),
+                      _mm256_cmpgt_epi32(_mm256_sub_epi32(maxy, miny), limit13));
+  const bool narrow = _mm256_testz_si256(too_wide, too_wide);
+  int positive, negative;
+  if (narrow) {
+    // (x1 − x0)(y2 − y0) − (y1 − y0)(x2 − x0) = E_01(v2) − E_01(v0) = E_01(v2).
+    const __m256i area = _mm256_sub_epi32(
+        _mm256_mullo_epi32(_mm256_sub_epi32(X[1], X[0]), _mm256_sub_epi32(Y[2], Y[0])),
+        _mm256_mullo_epi32(_mm256_sub_epi32(Y[1], Y[0]), _mm256_sub_epi32(X[2], X[0])));
+    positive = bits32(_mm256_cmpgt_epi32(area, zero));
+    negative = bits32(_mm256_cmpgt_epi32(zero, area));
+  } else {
+    // area = E_01(v2) = (y0 − y1)·x2 + (x1 − x0)·y2 + (x0·y1 − y0·x1), exactly.
+    const Wide area = add(add(mul_wide(_mm256_sub_epi32(Y[0], Y[1]), X[2]),
+                              mul_wide(_mm256_sub_epi32(X[1], X[0]), Y[2])),
+                          sub(mul_wide(X[0], Y[1]), mul_wide(Y[0], X[1])));
+    const Wide zero64{zero, zero};
+    positive = greater(area, zero64), negative = greater(zero64, area);
+  }
+  const int culled = cull_sign > 0 ? positive : cull_sign < 0 ? negative : 0;
+
+  // The pixel box of sample_centre_box.
+  const int half = kSubpixelOne / 2;
+  const __m256i up = _mm256_set1_epi32(kSubpixelOne - 1 - half), down = _mm256_set1_epi32(half);
+  const __m256i bx0 = _mm256_max_epi32(zero, _mm256_srai_epi32(_mm256_add_epi32(minx, up), kSubpixelBits));
+  const __m256i by0 = _mm256_max_epi32(zero, _mm256_srai_epi32(_mm256_add_epi32(miny, up), kSubpixelBits));
+  const __m256i bx1 = _mm256_min_epi32(_mm256_set1_epi32(vp.width - 1),
+                                       _mm256_srai_epi32(_mm256_sub_epi32(maxx, down), kSubpixelBits));
+  const __m256i by1 = _mm256_min_epi32(_mm256_set1_epi32(vp.height - 1),
+                                       _mm256_srai_epi32(_mm256_sub_epi32(maxy, down), kSubpixelBits));
+  const int empty = bits32(_mm256_or_si256(_mm256_cmpgt_epi32(bx0, bx1), _mm256_cmpgt_epi32(by0, by1)));
+
+  // Vertices 1 and 2 exchanged where the area is negative (E_i ≥ 0 inside).
+  const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  const __m256i swap = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(negative), lane_bit), lane_bit);
+  auto pick = [&](__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, swap); };
+  const __m256i x[3] = {X[0], pick(X[1], X[2]), pick(X[2], X[1])};
+  const __m256i y[3] = {Y[0], pick(Y[1], Y[2]), pick(Y[2], Y[1])};
+  const __m256i w[3] = {W[0], pick(W[1], W[2]), pick(W[2], W[1])};
+
+  // may_cover_a_sample: the box's (up to) four centres against the exact edge test.
+  const __m256i one = _mm256_set1_epi32(kSubpixelOne);
+  const __m256i cx = _mm256_add_epi32(_mm256_mullo_epi32(bx0, one), down);
+  const __m256i cy = _mm256_add_epi32(_mm256_mullo_epi32(by0, one), down);
+  const int wide = bits32(_mm256_cmpgt_epi32(bx1, bx0)), tall = bits32(_mm256_cmpgt_epi32(by1, by0));
+  const __m256i two = _mm256_set1_epi32(2);
+  const int small = bits32(_mm256_and_si256(_mm256_cmpgt_epi32(two, _mm256_sub_epi32(bx1, bx0)),
+                                            _mm256_cmpgt_epi32(two, _mm256_sub_epi32(by1, by0))));
+  int c00 = 0xff, c10 = wide, c01 = tall, c11 = wide & tall;
+  for (int i = 0; i < 3; ++i) {
+    const int p = (i + 1) % 3, q = (i + 2) % 3;
+    const __m256i a = _mm256_sub_epi32(y[p], y[q]), b = _mm256_sub_epi32(x[q], x[p]);
+    // E ≥ threshold ⟺ E > threshold − 1, which is −1 (all ones) on a top or left edge, else 0.
+    const __m256i top_left = _mm256_or_si256(
+        _mm256_cmpgt_epi32(a, zero),
+        _mm256_and_si256(_mm256_cmpeq_epi32(a, zero), _mm256_cmpgt_epi32(b, zero)));
+    if (narrow) {  // lanes with an empty box may wrap around: they are dropped below
+      const __m256i e00 = _mm256_add_epi32(_mm256_mullo_epi32(a, _mm256_sub_epi32(cx, x[p])),
+                                           _mm256_mullo_epi32(b, _mm256_sub_epi32(cy, y[p])));
+      const __m256i a8 = _mm256_slli_epi32(a, kSubpixelBits), b8 = _mm256_slli_epi32(b, kSubpixelBits);
+      const __m256i e10 = _mm256_add_epi32(e00, a8), e01 = _mm256_add_epi32(e00, b8);
+      const __m256i e11 = _mm256_add_epi32(e10, b8);
+      c00 &= bits32(_mm256_cmpgt_epi32(e00, top_left)), c10 &= bits32(_mm256_cmpgt_epi32(e10, top_left));
+      c01 &= bits32(_mm256_cmpgt_epi32(e01, top_left)), c11 &= bits32(_mm256_cmpgt_epi32(e11, top_left));
+      continue;
+    }
+    const Wide limit = widen(top_left);
+    const Wide e00 = add(mul_wide(a, _mm256_sub_epi32(cx, x[p])), mul_wide(b, _mm256_sub_epi32(cy, y[p])));
+    const Wide a8 = shl8(a), b8 = shl8(b);
+    const Wide e10 = add(e00, a8), e01 = add(e00, b8), e11 = add(e10, b8);
+    c00 &= greater(e00, limit), c10 &= greater(e10, limit);
+    c01 &= greater(e01, limit), c11 &= greater(e11, limit);
+  }
+  const int may_cover = ~small | c00 | c10 | c01 | c11;
+  const int keep = ~rejected & (positive | negative) & ~culled & ~empty & may_cover & 0xff;
+
+  // The records, 16 dwords each (layout asserted above), transposed out of the lanes.
+  const __m256i mask16 = _mm256_set1_epi32(0xffff);
+  const __m256i box_lo = _mm256_or_si256(_mm256_and_si256(bx0, mask16), _mm256_slli_epi32(by0, 16));
+  const __m256i box_hi = _mm256_or_si256(_mm256_and_si256(bx1, mask16), _mm256_slli_epi32(by1, 16));
+  const __m256i tri = _mm256_add_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(t)),
+                                       _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  const __m256i first[8] = {x[0], x[1], x[2], y[0], y[1], y[2], w[0], w[1]};
+  const __m256i second[8] = {w[2],   box_lo, box_hi, tri, object, _mm256_set1_epi32(-1),
+                             _mm256_srli_epi32(swap, 31), zero};
+  __m256i a[8], b[8];
+  detail::transpose8(first, a);
+  detail::transpose8(second, b);
+  for (int l = 0; l < 8; ++l) {
+    __m256i* r = reinterpret_cast<__m256i*>(dst + n);
+    _mm256_store_si256(r, a[l]);
+    _mm256_store_si256(r + 1, b[l]);
+    n += (keep >> l) & 1;
+  }
+  return true;
+}
+
+}  // namespace
+
 std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* indices,
                             std::size_t begin, std::size_t end,
                             const std::uint32_t* triangle_object,
@@ -337,14 +537,16 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
   std::size_t n = first;
   if (out.size() < n + (end - begin)) out.resize(n + (end - begin));
   SetupTriangle* dst = out.data();
-  for (std::size_t t = begin; t < end; ++t) {
+  // One triangle in scalar code: the reference for setup_group8, and the path of groups with
+  // a clipped or excluded triangle and of the last few triangles.
+  auto one = [&](std::size_t t) {
     const std::uint32_t object = triangle_object[t];
-    if (!excluded.empty() && object < excluded.size() && excluded[object]) continue;
+    if (!excluded.empty() && object < excluded.size() && excluded[object]) return;
     const std::uint32_t* idx = &indices[3 * t];
     const ScreenVertex& v0 = vertices[idx[0]];
     const ScreenVertex& v1 = vertices[idx[1]];
     const ScreenVertex& v2 = vertices[idx[2]];
-    if ((v0.outcode & v1.outcode & v2.outcode) & 0x3fu) continue;
+    if ((v0.outcode & v1.outcode & v2.outcode) & 0x3fu) return;
     if ((v0.outcode | v1.outcode | v2.outcode) & kNeedsClip) {
       // Clipped pieces go through a small side buffer, so `out` only grows (never shrinks
       // and re-initializes its tail) and only when a triangle yields more than one piece.
@@ -359,7 +561,7 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
       }
       std::copy(pieces.begin(), pieces.end(), dst + n);
       n += pieces.size();
-      continue;
+      return;
     }
     // emit() without branches on the outcome: the record is always written at dst[n] and
     // kept by advancing n (random small triangles made those branches unpredictable).
@@ -384,7 +586,12 @@ std::size_t setup_triangles(const ScreenVertex* vertices, const std::uint32_t* i
     const bool keep = (area != 0) & !culled & (box.x0 <= box.x1) & (box.y0 <= box.y1) &
                       may_cover_a_sample(r.x, r.y, box);
     n += keep ? 1 : 0;
-  }
+  };
+  std::size_t t = begin;
+  for (; t + 8 <= end; t += 8)
+    if (!setup_group8(vertices, indices, t, triangle_object, excluded, vp, cull_sign, dst, n))
+      for (std::size_t k = t; k < t + 8; ++k) one(k);
+  for (; t < end; ++t) one(t);
   return n;
 }
 

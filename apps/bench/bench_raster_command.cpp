@@ -31,6 +31,7 @@ struct BenchRasterOptions {
   std::string write_ids;
   std::string cull = "none";
   std::string gbuffer_source = "records";
+  bool plane_hashes = false;
   pipeline::CameraOverrides camera;
 };
 
@@ -49,6 +50,17 @@ void write_triangle_ids(const std::string& path, const raster::VisibilityBuffer&
     ids[i] = vis.triangle.pixels[i] == kNoId ? 0u : vis.triangle.pixels[i] + 1u;
   const std::string bytes(reinterpret_cast<const char*>(ids.data()), ids.size() * sizeof(std::uint32_t));
   write_text_file(path, bytes);  // the host is little-endian (x86-64)
+}
+
+// FNV-1a 64 of a plane's bytes (every byte of both buffers is defined, background included).
+template <class Plane>
+std::string plane_hash(const Plane& p) {
+  std::uint64_t h = 1469598103934665603ull;
+  const auto* b = reinterpret_cast<const unsigned char*>(p.pixels.data());
+  for (std::size_t i = 0; i < p.pixels.size() * sizeof(p.pixels[0]); ++i) h = (h ^ b[i]) * 1099511628211ull;
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
 }
 
 void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) {
@@ -71,6 +83,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   // binning (after off-screen, back-face, zero-area and no-sample rejection) and their
   // references in the tiles' lists.
   std::size_t binned = 0, tile_refs = 0, max_tile_refs = 0;
+  OrderedJson hashes = OrderedJson::object();
   // Render targets and bins persist across frames, as a GPU application's would.
   raster::RasterWorkspace workspace;
   raster::VisibilityBuffer vis;
@@ -100,6 +113,13 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
         max_tile_refs = std::max<std::size_t>(max_tile_refs, bins.tile_offsets[t + 1] - bins.tile_offsets[t]);
       tile_refs = bins.tile_offsets.empty() ? 0 : bins.tile_offsets.back();
       if (!o.write_ids.empty()) write_triangle_ids(o.write_ids, vis);
+      if (o.plane_hashes) {
+        hashes["vis.triangle"] = plane_hash(vis.triangle), hashes["vis.object"] = plane_hash(vis.object);
+        hashes["vis.depth"] = plane_hash(vis.depth), hashes["vis.bary"] = plane_hash(vis.bary);
+        hashes["gbuffer.object"] = plane_hash(g.object), hashes["gbuffer.position"] = plane_hash(g.position);
+        hashes["gbuffer.normal"] = plane_hash(g.normal), hashes["gbuffer.uv"] = plane_hash(g.uv);
+        hashes["gbuffer.surface"] = plane_hash(g.surface), hashes["gbuffer.reflector"] = plane_hash(g.reflector);
+      }
       continue;
     }
     frame_ms.push_back((t1 - t0) * 1e-6);
@@ -114,7 +134,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
   if (o.json) {
     OrderedJson kernels = OrderedJson::object();
     for (const auto& [name, v] : kernel_ms) kernels[name] = rounded(median(v), 3);
-    const OrderedJson j{{"scene", scene.name}, {"triangles", triangles}, {"width", o.width},
+    OrderedJson j{{"scene", scene.name}, {"triangles", triangles}, {"width", o.width},
                         {"height", o.height}, {"threads", executor.threads()}, {"lanes", executor.lanes()},
                         {"cull", o.cull}, {"repeat", o.repeat}, {"ms_median", rounded(med, 3)},
                         {"ms_min", rounded(lo, 3)}, {"ms_max", rounded(hi, 3)},
@@ -124,6 +144,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
                         {"tile_refs_max", max_tile_refs},
                         {"gbuffer_source", o.gbuffer_source}, {"gbuffer_prepare_ms", rounded(prepare_ms, 3)},
                         {"kernels_ms_median", kernels}};
+    if (o.plane_hashes) j["plane_hashes"] = hashes;
     std::printf("%s\n", json_line(j).c_str());
   } else {
     std::printf("%s: %zu triangles at %dx%d, %d threads: median %.2f ms (min %.2f, max %.2f), "
@@ -161,6 +182,9 @@ void add_bench_raster_subcommand(CLI::App& bench, GlobalOptions& global) {
   cmd->add_option("--write-ids", o->write_ids,
                   "Also write the visible triangle per pixel (raw little-endian uint32, top row "
                   "first, triangle index + 1, 0 for nothing; as speculum_llvmpipe_bench --write-ids)");
+  cmd->add_flag("--plane-hashes", o->plane_hashes,
+               "Add the FNV-1a hash of every visibility and G-buffer plane to --json (to check "
+               "that two builds write the same bytes)");
   pipeline::add_camera_options(*cmd, o->camera);
   cmd->callback([o, &global] { run_bench_raster(*o, global); });
 }

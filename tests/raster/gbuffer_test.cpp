@@ -280,7 +280,7 @@ TEST(GBuffer, TriangleRecordsCopyTheMeshCorners) {
       EXPECT_TRUE(same_bytes(records[t].normal[k], m.normals[v]));
       EXPECT_TRUE(same_bytes(records[t].uv[k], m.uvs[v]));
     }
-    EXPECT_EQ(records[t].material, m.triangle_material[t]);
+    EXPECT_EQ(records.materials()[t], m.triangle_material[t]);
   }
 }
 

@@ -604,3 +604,164 @@ TEST(RasterSetup, ChunkedSetupEqualsPerTriangleSetup) {
 
 }  // namespace
 }  // namespace speculum::raster
+
+namespace speculum::raster {
+namespace {
+
+// setup_triangles sets up 8 triangles at a time in AVX2 lanes when none of them needs
+// clipping or is excluded. Its records must equal the scalar setup_triangle's byte for byte:
+// here on snapped vertices built directly in fixed point — slivers around sample centres
+// (vertices and edges exactly on centres: the top-left rule's ties), zero-area and collinear
+// triangles, triangles reaching the guard band (64-bit edge values), huge ones whose box is
+// clamped to a corner of the viewport, outcodes that reject trivially, and a few vertices that
+// need clipping (their groups take the scalar path) — for every cull mode, with excluded
+// objects, and from starts and ends that are not multiples of 8.
+TEST(RasterSetup, LaneSetupEqualsScalarSetupRecordForRecord) {
+  const int width = 96, height = 80;
+  const Viewport viewport{width, height};
+  std::mt19937 rng(29);
+  auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  const std::int32_t guard = static_cast<std::int32_t>(kGuardBandPixels) * kSubpixelOne;
+  auto snapped = [&](std::int32_t x, std::int32_t y) {
+    ScreenVertex v = fixed_vertex(x, y);
+    v.inv_w = std::uniform_real_distribution<float>(0.01f, 2.0f)(rng);
+    v.outcode = (x < 0 ? 1u : 0u) | (x > width * kSubpixelOne ? 2u : 0u) | (y < 0 ? 4u : 0u) |
+                (y > height * kSubpixelOne ? 8u : 0u);
+    return v;
+  };
+  // Offsets that land on sample centres and half-way between them as often as elsewhere.
+  auto jitter = [&](int range) {
+    return uniform(0, 1) ? uniform(-range, range) : uniform(-range / 128, range / 128) * 128;
+  };
+  std::vector<ScreenVertex> vertices;
+  std::vector<std::uint32_t> indices, objects;
+  const int count = 20000;
+  for (int t = 0; t < count; ++t) {
+    ScreenVertex v[3];
+    const int kind = (t / 8 + t % 3) % 10;  // runs of one kind: all-small groups too
+    if (kind <= 5) {  // slivers and small triangles around sample centres
+      const std::int32_t x = centre_of(uniform(-2, width + 1)) + jitter(256);
+      const std::int32_t y = centre_of(uniform(-2, height + 1)) + jitter(256);
+      const int reach = kind < 3 ? 300 : 1200;
+      for (int k = 0; k < 3; ++k) v[k] = snapped(x + (k ? jitter(reach) : 0), y + (k ? jitter(reach) : 0));
+    } else if (kind == 6) {  // zero area: a repeated vertex or three collinear ones
+      const std::int32_t x = centre_of(uniform(0, width - 1)), y = centre_of(uniform(0, height - 1));
+      const std::int32_t dx = jitter(2000), dy = jitter(2000);
+      v[0] = snapped(x, y), v[1] = snapped(x + dx, y + dy);
+      v[2] = uniform(0, 1) ? v[1] : snapped(x + 2 * dx, y + 2 * dy);
+    } else if (kind == 7) {  // reaching the guard band
+      for (auto& u : v)
+        u = snapped(uniform(-guard, width * kSubpixelOne + guard),
+                    uniform(-guard, height * kSubpixelOne + guard));
+    } else if (kind == 8) {  // huge, boxed into a corner of the viewport
+      const std::int32_t cx = uniform(0, 1) ? -guard + 5 : width * kSubpixelOne + guard - 5;
+      const std::int32_t cy = uniform(0, 1) ? -guard + 7 : height * kSubpixelOne + guard - 7;
+      v[0] = snapped(uniform(0, 1) ? centre_of(0) + jitter(200) : centre_of(width - 1) + jitter(200),
+                     uniform(0, 1) ? centre_of(0) + jitter(200) : centre_of(height - 1) + jitter(200));
+      v[1] = snapped(cx, v[0].y + jitter(300));
+      v[2] = snapped(v[0].x + jitter(300), cy);
+    } else {  // mostly small; one group in five has a vertex that needs clipping
+      const std::int32_t x = centre_of(uniform(0, width - 1)), y = centre_of(uniform(0, height - 1));
+      for (int k = 0; k < 3; ++k) v[k] = snapped(x + jitter(600), y + jitter(600));
+      if (t % 50 == 9) {  // a triangle through the near plane, in clip space
+        std::uniform_real_distribution<float> d(-0.5f, 0.5f);
+        v[0] = make_screen_vertex(glm::vec4(d(rng), d(rng), 0.5f, 1.0f), viewport);
+        v[1] = make_screen_vertex(glm::vec4(d(rng), d(rng), 0.5f, 1.0f), viewport);
+        v[2] = make_screen_vertex(glm::vec4(d(rng), d(rng), 0.2f, -0.5f), viewport);
+      }
+    }
+    for (const ScreenVertex& u : v) {
+      indices.push_back(static_cast<std::uint32_t>(vertices.size()));
+      vertices.push_back(u);
+    }
+    objects.push_back(static_cast<std::uint32_t>(t / 24 % 3));
+  }
+  const std::vector<std::uint8_t> excluded{0, 1};  // object 1 left out, 2 beyond the flags
+  std::size_t kept_total = 0, clipped_total = 0;
+  for (int cull : {-1, 0, 1}) {
+    for (const auto& skip : {std::vector<std::uint8_t>{}, excluded}) {
+      for (const auto& [begin, end] : {std::pair{0, count}, {3, count - 5}, {13, 13 + 8 * 37}}) {
+        std::vector<SetupTriangle> scalar, lanes(3);  // lanes writes after 3 existing records
+        std::vector<ClipMap> scalar_maps, lane_maps;
+        for (int t = begin; t < end; ++t) {
+          if (!skip.empty() && objects[t] < skip.size() && skip[objects[t]]) continue;
+          const std::uint32_t* idx = &indices[3 * std::size_t(t)];
+          setup_triangle(vertices[idx[0]], vertices[idx[1]], vertices[idx[2]],
+                         static_cast<std::uint32_t>(t), objects[t], viewport, cull, scalar,
+                         scalar_maps);
+        }
+        const std::size_t n = setup_triangles(vertices.data(), indices.data(), begin, end,
+                                              objects.data(), skip, viewport, cull, 3, lanes,
+                                              lane_maps);
+        ASSERT_EQ(scalar.size() + 3, n) << cull << " " << begin;
+        ASSERT_EQ(scalar_maps.size(), lane_maps.size());
+        EXPECT_EQ(0, std::memcmp(scalar.data(), lanes.data() + 3, scalar.size() * sizeof(SetupTriangle)))
+            << cull << " " << begin;
+        EXPECT_EQ(0, std::memcmp(scalar_maps.data(), lane_maps.data(),
+                                 scalar_maps.size() * sizeof(ClipMap)));
+        kept_total += scalar.size();
+        clipped_total += scalar_maps.size();
+      }
+    }
+  }
+  // Both outcomes and the clipping fallback are exercised.
+  EXPECT_GT(kept_total, 30000u);
+  EXPECT_LT(kept_total, 3u * 2u * 2u * count);
+  EXPECT_GT(clipped_total, 20u);
+}
+
+}  // namespace
+}  // namespace speculum::raster
+
+namespace speculum::raster {
+namespace {
+
+// Triangles whose box spans at most 4 × 2 pixels of a tile take a one-register 8-lane path
+// (two rows of four samples). It must give the bits of the scalar reference (lanes 1): here
+// thousands of such triangles over the last rows and columns of the tiles (the one-row case
+// on a tile's last row, lanes past the row end), vertices and edges on sample centres (the
+// top-left rule's ties) and equal depths (ties broken by the triangle index), with slivers
+// that cover no sample between them.
+TEST(RasterDeterminism, TinyTrianglesAtTileEdgesSameBitsAsScalar) {
+  const int width = 200, height = 140;  // partial tiles on the right and at the bottom
+  std::mt19937 rng(17);
+  auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  auto near_tile_edge = [&](int size) {
+    const int tile = uniform(0, (size - 1) / kTileSize) * kTileSize;
+    return std::clamp(tile + uniform(-3, 3) + (uniform(0, 1) ? kTileSize - 1 : 0), 0, size - 1);
+  };
+  std::vector<ScreenVertex> vertices;
+  std::vector<std::uint32_t> indices, objects;
+  for (std::uint32_t t = 0; t < 30000; ++t) {
+    const int px = uniform(0, 3) ? near_tile_edge(width) : uniform(0, width - 1);
+    const int py = uniform(0, 3) ? near_tile_edge(height) : uniform(0, height - 1);
+    const bool flat_depth = t % 3 == 0;  // equal 1/w everywhere: depth ties across triangles
+    for (int k = 0; k < 3; ++k) {
+      const int reach = t % 2 ? 384 : 900;
+      const int jx = uniform(0, 1) ? uniform(-reach, reach) : uniform(-reach / 128, reach / 128) * 128;
+      const int jy = uniform(0, 1) ? uniform(-reach, reach) : uniform(-reach / 128, reach / 128) * 128;
+      ScreenVertex v = fixed_vertex(centre_of(px) + jx, centre_of(py) + jy);
+      v.inv_w = flat_depth ? 0.5f : std::uniform_real_distribution<float>(0.2f, 1.0f)(rng);
+      indices.push_back(static_cast<std::uint32_t>(vertices.size()));
+      vertices.push_back(v);
+    }
+    objects.push_back(t % 7);
+  }
+  par::Executor ex(2);
+  RasterOptions scalar;
+  scalar.lanes = 1;
+  const auto ref = rasterize_screen_vertices(ex, vertices, indices, objects, width, height, scalar);
+  std::size_t covered = 0;
+  for (const std::uint32_t id : ref.triangle.pixels) covered += id != kNoId;
+  EXPECT_GT(covered, std::size_t(width) * height / 3);
+  for (int lanes : {4, 8, 16}) {
+    RasterOptions opt;
+    opt.lanes = lanes;
+    EXPECT_TRUE(same_bits(ref, rasterize_screen_vertices(ex, vertices, indices, objects, width,
+                                                         height, opt)))
+        << lanes;
+  }
+}
+
+}  // namespace
+}  // namespace speculum::raster
