@@ -478,11 +478,6 @@ TEST(RasterInput, AbsurdSizesAndCamerasThrowInputError) {
   EXPECT_THROW(render_visibility(ex, scene, look({0, 0, 3}, {0, 0, 3}), 10, 10), InputError);
 }
 
-}  // namespace
-}  // namespace speculum::raster
-
-namespace speculum::raster {
-namespace {
 
 TEST(RasterInput, OverflowingCoordinatesAreDroppedNotUndefined) {
   // Finite but huge vertices overflow clip space to inf/NaN: such triangles are dropped
@@ -503,11 +498,6 @@ TEST(RasterInput, OverflowingCoordinatesAreDroppedNotUndefined) {
     }
 }
 
-}  // namespace
-}  // namespace speculum::raster
-
-namespace speculum::raster {
-namespace {
 
 // The batched vertex stage (8 vertices per AVX2 step plus a scalar tail) must give every
 // vertex the bytes of the one-vertex function, including vertices behind the eye, outside
@@ -543,11 +533,6 @@ TEST(RasterVertexStage, BatchedEqualsOneVertexFunctionBitForBit) {
   EXPECT_GT(snapped, 300u);
 }
 
-}  // namespace
-}  // namespace speculum::raster
-
-namespace speculum::raster {
-namespace {
 
 // The chunked, branch-free setup equals setup_triangle called per triangle: same records
 // (bytes), same clip maps, for every cull mode and with excluded objects; the vertices
@@ -602,11 +587,6 @@ TEST(RasterSetup, ChunkedSetupEqualsPerTriangleSetup) {
   }
 }
 
-}  // namespace
-}  // namespace speculum::raster
-
-namespace speculum::raster {
-namespace {
 
 // setup_triangles sets up 8 triangles at a time in AVX2 lanes when none of them needs
 // clipping or is excluded. Its records must equal the scalar setup_triangle's byte for byte:
@@ -710,11 +690,6 @@ TEST(RasterSetup, LaneSetupEqualsScalarSetupRecordForRecord) {
   EXPECT_GT(clipped_total, 20u);
 }
 
-}  // namespace
-}  // namespace speculum::raster
-
-namespace speculum::raster {
-namespace {
 
 // Triangles whose box spans at most 4 × 2 pixels of a tile take a one-register 8-lane path
 // (two rows of four samples). It must give the bits of the scalar reference (lanes 1): here
