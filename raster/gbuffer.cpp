@@ -49,9 +49,6 @@ struct MaterialInfo {
 // Per material, for the 8-lane path: one word gathered by material index whose bits say
 // simple, keep_side (refractor) and specular.
 constexpr std::uint32_t kLaneSimple = 1, kLaneKeepSide = 2, kLaneSpecular = 4;
-struct MaterialLanes {
-  std::vector<std::uint32_t> flags;
-};
 
 struct SampleContext {
   const Scene& scene;
@@ -59,7 +56,7 @@ struct SampleContext {
   const VisibilityBuffer& vis;
   const glm::vec3& eye;
   const std::vector<MaterialInfo>& materials;
-  const MaterialLanes& lanes;
+  const std::vector<std::uint32_t>& material_flags;  // kLane* bits per material
 };
 
 // One block's slots in the planes' staging buffers (see PlaneWriters).
@@ -262,7 +259,7 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   const __m256i at = _mm256_add_epi32(_mm256_slli_epi32(tri, 4), _mm256_slli_epi32(tri, 3));
   const __m256i mat = _mm256_i32gather_epi32(reinterpret_cast<const int*>(materials), tri, 4);
   const __m256i flags =
-      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.lanes.flags.data()), mat, 4);
+      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.material_flags.data()), mat, 4);
   auto has = [&](std::uint32_t bit) {
     const __m256i b = _mm256_set1_epi32(static_cast<int>(bit));
     return _mm256_cmpeq_epi32(_mm256_and_si256(flags, b), b);
@@ -440,7 +437,7 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
   const TriangleMesh& m = scene.mesh;
   // Untextured materials have the same parameters everywhere: evaluate them once.
   std::vector<MaterialInfo> materials;
-  MaterialLanes material_lanes;
+  std::vector<std::uint32_t> material_flags;
   for (const Material& mat : scene.materials) {
     MaterialInfo info;
     info.constant = surface_params(mat);
@@ -451,11 +448,11 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
     info.keep_side = info.constant.is_refractor() ? ~0u : 0u;
     info.specular = is_specular(info.constant);
     materials.push_back(info);
-    material_lanes.flags.push_back((info.simple ? kLaneSimple : 0u) |
+    material_flags.push_back((info.simple ? kLaneSimple : 0u) |
                                    (info.keep_side ? kLaneKeepSide : 0u) |
                                    (info.specular ? kLaneSpecular : 0u));
   }
-  const SampleContext ctx{scene, m, vis, eye, materials, material_lanes};
+  const SampleContext ctx{scene, m, vis, eye, materials, material_flags};
   const bool stream = vis.triangle.size() >= kStreamingMinSamples;
   if (records) {
     const RecordCorners corners{records->data(), records->materials()};
