@@ -723,18 +723,18 @@ void check_schema_shapes(const std::string& path, const nlohmann::json& doc) {
 void check_image_buffer_views(const std::string& path, const nlohmann::json& doc) {
   const auto images = doc.find("images"), views = doc.find("bufferViews"), buffers = doc.find("buffers");
   if (images == doc.end() || views == doc.end() || buffers == doc.end()) return;
-  auto whole = [](const nlohmann::json& o, const char* key, double fallback) {
+  auto number = [](const nlohmann::json& o, const char* key, double fallback) {
     const auto v = o.find(key);
     return v != o.end() && v->is_number() ? v->get<double>() : fallback;
   };
   for (std::size_t i = 0; i < images->size(); ++i) {
-    const double view = whole((*images)[i], "bufferView", -1.0);
+    const double view = number((*images)[i], "bufferView", -1.0);
     if (view < 0 || view >= double(views->size()) || view != std::floor(view)) continue;
     const nlohmann::json& v = (*views)[static_cast<std::size_t>(view)];
-    const double buffer = whole(v, "buffer", -1.0);
+    const double buffer = number(v, "buffer", -1.0);
     if (buffer < 0 || buffer >= double(buffers->size()) || buffer != std::floor(buffer)) continue;
-    const double length = whole((*buffers)[static_cast<std::size_t>(buffer)], "byteLength", -1.0);
-    const double end = whole(v, "byteOffset", 0.0) + whole(v, "byteLength", 0.0);
+    const double length = number((*buffers)[static_cast<std::size_t>(buffer)], "byteLength", -1.0);
+    const double end = number(v, "byteOffset", 0.0) + number(v, "byteLength", 0.0);
     if (length >= 0 && end > length)
       throw InputError(path, "images[" + std::to_string(i) + "] uses bufferView " +
                                  std::to_string(static_cast<long long>(view)) + ", which runs past the end of buffer " +
