@@ -108,6 +108,20 @@ CubeCoord cube_coord(const glm::vec3& d, int size) {
                  std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
 }
 
+unsigned cube_faces_near(const glm::vec3& p, float margin) {
+  const float slack = 1.4142136f * margin;
+  unsigned mask = 0;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const int k = f / 2;
+    const float along = (f % 2 == 0 ? 1.0f : -1.0f) * p[k];
+    bool near = true;
+    for (int j = 0; j < 3 && near; ++j)
+      if (j != k) near = along - std::fabs(p[j]) >= -slack;
+    if (near) mask |= 1u << f;
+  }
+  return mask;
+}
+
 glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size) {
   const FaceFrame& f = frame(face);
   const float depth = glm::dot(d, f.forward);

@@ -39,6 +39,18 @@ float normal_offset(float footprint, const glm::vec3& n, const glm::vec3& l) {
   return kNormalOffset * footprint * std::sqrt(1.0f - c * c);
 }
 
+// The faces of a spot light's shadow cube that a shadow test can read: visibility runs only
+// where sample_light gives the light (every caller skips a zero irradiance), i.e. at points
+// within the outer cone, and it looks up p + q n with q at most kNormalOffset footprints
+// (2 kNormalOffset |p − light| / size), at most asin(2 kNormalOffset / size) off p's
+// direction; its 3×3 taps stay on the face that lookup lands on. The cone is widened by that
+// and 1e-3 rad for the rounding of the cone test.
+unsigned spot_cone_faces(const Light& light, int size) {
+  const float shift = 2.0f * kNormalOffset / static_cast<float>(size);
+  if (!(shift < 0.5f) || !(light.outer_cone < 1.5f)) return 0x3fu;
+  return cube_faces_near(glm::normalize(light.direction), light.outer_cone + std::asin(shift) + 1e-3f);
+}
+
 }  // namespace
 
 std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& scene, int size) {
@@ -75,6 +87,7 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
       opt.size = size;
       opt.znear = 1e-3f * radius;
       opt.zfar = 4.0f * radius + glm::length(light.position - centre);
+      if (light.type == LightType::Spot) opt.face_mask = spot_cone_faces(light, size);
       m.cube = render_cube_map(executor, scene, light.position, opt);
     }
     maps.push_back(std::move(m));

@@ -18,7 +18,8 @@ namespace speculum::raster {
 struct ShadowMap {
   LightType type = LightType::Point;
   int size = 0;
-  CubeMap cube;               // point and spot lights: distance from the light position
+  CubeMap cube;               // point and spot lights: distance from the light position (a
+                              // spot light's: only the faces its cone reaches, the others +inf)
   Camera camera;              // directional lights: the far camera along the light
   glm::mat4 view_projection{1.0f};
   ImageF distance;            // directional: |y − camera.eye|
@@ -28,6 +29,7 @@ struct ShadowMap {
   // 2·sin θ texel footprints (θ between n and l; the footprint is one texel's world width
   // at p), and the depth test allows one footprint: a plane is lit at every incidence,
   // and light leaks at most about one footprint under an occluder touching the receiver.
+  // Asked only where the light reaches p (sample_light's irradiance is not zero).
   float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
 };
 
