@@ -109,7 +109,10 @@ CubeCoord cube_coord(const glm::vec3& d, int size) {
 }
 
 unsigned cube_faces_near(const glm::vec3& p, float margin) {
-  const float slack = 1.4142136f * margin;
+  // Over the directions within angle θ of p the largest q·m is sin(asin(p·m) + θ) (up to
+  // θ ≤ π/2), so one of them is on m's side when p·m ≥ −sin θ: σ p_k − |p_j| ≥ −√2 sin θ.
+  // Beyond π/2 every face passes (the sum is at least −√2).
+  const float slack = margin < 1.5707963f ? 1.4142136f * std::sin(margin) : 2.0f;
   unsigned mask = 0;
   for (int f = 0; f < kCubeFaces; ++f) {
     const int k = f / 2;
