@@ -200,6 +200,9 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
   CubeMap cube;
   cube.size = options.size;
   cube.centre = centre;
+  // One G-buffer for every face: its planes (about 90 bytes a texel) are allocated and
+  // cleared once, not once per face on the thread that launches the face's passes.
+  GBuffer g;
   for (int face = 0; face < kCubeFaces; ++face) {
     if (!((options.face_mask >> face) & 1u)) {
       cube.distance[face] = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
@@ -227,7 +230,9 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
                                     visible_position(scene.mesh, vis, i) - centre);
                           });
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
-    if (shade) cube.colour[face] = shade(resolve_gbuffer(executor, scene, vis, centre), cam, face, read.empty() ? nullptr : &read);
+    if (!shade) continue;
+    resolve_gbuffer(executor, scene, vis, centre, g);
+    cube.colour[face] = shade(g, cam, face, read.empty() ? nullptr : &read);
   }
   return cube;
 }
