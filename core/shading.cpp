@@ -33,7 +33,12 @@ glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
   if (!std::isfinite(fx) || !std::isfinite(fy)) return image.pixels[0];
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   const float ax = fx - x0f, ay = fy - y0f;
-  auto wrap = [](long long i, int n) { long long r = i % n; return static_cast<int>(r < 0 ? r + n : r); };
+  // Most lookups land inside the image: no 64-bit division for those (the same index).
+  auto wrap = [](long long i, int n) {
+    if (i >= 0 && i < n) return static_cast<int>(i);
+    const long long r = i % n;
+    return static_cast<int>(r < 0 ? r + n : r);
+  };
   const long long x0 = static_cast<long long>(x0f), y0 = static_cast<long long>(y0f);
   const int xa = wrap(x0, image.width), xb = wrap(x0 + 1, image.width);
   const int ya = wrap(y0, image.height), yb = wrap(y0 + 1, image.height);
