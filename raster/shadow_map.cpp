@@ -11,6 +11,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "core/camera_rays.h"
+#include "parallel/lanes.h"
 
 namespace speculum::raster {
 namespace {
@@ -127,6 +128,11 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
   const float biased = dist - kDepthBias * footprint;
   const int cx = std::min(static_cast<int>(pixel.x), size - 1);
   const int cy = std::min(static_cast<int>(pixel.y), size - 1);
+  return filtered(*img, cx, cy, biased);
+}
+
+float ShadowMap::filtered(const ImageF& image, int cx, int cy, float biased) const {
+  const ImageF* img = &image;
   int lit = 0;
   if (cx >= 1 && cy >= 1 && cx + 1 < size && cy + 1 < size) {  // no tap clamped: three rows
     for (int dy = -1; dy <= 1; ++dy) {
@@ -141,6 +147,60 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
       lit += img->at(x, y) >= biased;
     }
   return lit / 9.0f;
+}
+
+void ShadowMap::visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const {
+  if (type == LightType::Directional) {
+    for (int j = 0; j < count; ++j) out[j] = visibility(p[j], n[j], l[j]);
+    return;
+  }
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
+  using i32 = L::i32;
+  // Lanes past `count` repeat point 0: valid inputs, their results dropped.
+  alignas(32) float in[9][8];
+  for (int j = 0; j < 8; ++j) {
+    const int k = j < count ? j : 0;
+    for (int c = 0; c < 3; ++c) in[c][j] = p[k][c], in[3 + c][j] = n[k][c], in[6 + c][j] = l[k][c];
+  }
+  f32 pv[3], nv[3], lv[3];
+  for (int c = 0; c < 3; ++c) pv[c] = L::load(in[c]), nv[c] = L::load(in[3 + c]), lv[c] = L::load(in[6 + c]);
+  // glm's dot of two vec3 is (x·x' + y·y') + z·z', and length is the root of the dot.
+  const auto dot = [](const f32* a, const f32* b) { return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]; };
+  const auto clamp = [](f32 v, f32 lo, f32 hi) { return L::select(v < lo, lo, L::select(hi < v, hi, v)); };
+  const glm::vec3 eye = cube.centre;
+  const float texel_angle = 2.0f / static_cast<float>(cube.size);
+  f32 from_eye[3];
+  for (int c = 0; c < 3; ++c) from_eye[c] = pv[c] - eye[c];
+  const f32 footprint = L::sqrt(dot(from_eye, from_eye)) * texel_angle;
+  // normal_offset
+  const f32 cos_nl = clamp(dot(nv, lv), f32(0.0f), f32(1.0f));
+  const f32 q = kNormalOffset * footprint * L::sqrt(1.0f - cos_nl * cos_nl);
+  f32 d[3];
+  for (int c = 0; c < 3; ++c) d[c] = (pv[c] + nv[c] * q) - eye[c];
+  const f32 dist = L::sqrt(dot(d, d));
+  // cube_coord: the face of the largest component (ties as there), then its projection.
+  const f32 ax = L::abs(d[0]), ay = L::abs(d[1]), az = L::abs(d[2]);
+  const auto is_x = (ax >= ay) && (ax >= az);
+  const auto is_y = !is_x && (ay >= az);
+  const f32 major = L::select(is_x, d[0], L::select(is_y, d[1], d[2]));
+  i32 face = L::select(is_x, i32(0), L::select(is_y, i32(2), i32(4)));
+  face = L::select(!(major >= 0.0f), face + 1, face);
+  f32 depth(0.0f), along_right(0.0f), along_up(0.0f);
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const L::mask here = face == f;
+    const CubeFaceAxes& a = cube_face_axes(f);
+    depth = L::select(here, a.forward_sign * d[a.forward], depth);
+    along_right = L::select(here, a.right_sign * d[a.right], along_right);
+    along_up = L::select(here, a.up_sign * d[a.up], along_up);
+  }
+  const float s = static_cast<float>(cube.size);
+  const f32 px = clamp((along_right / depth + 1.0f) * 0.5f * s, f32(0.0f), f32(s));
+  const f32 py = clamp((1.0f - along_up / depth) * 0.5f * s, f32(0.0f), f32(s));
+  const f32 biased = dist - kDepthBias * footprint;
+  const i32 cx = L::min(L::to_int(px), i32(size - 1)), cy = L::min(L::to_int(py), i32(size - 1));
+  for (int j = 0; j < count; ++j)
+    out[j] = dist[j] <= 0.0f ? 1.0f : filtered(cube.distance[face[j]], cx[j], cy[j], biased[j]);
 }
 
 ShadowMaps ShadowMapPass::operator()(par::NodeContext& c) const {

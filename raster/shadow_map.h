@@ -31,6 +31,14 @@ struct ShadowMap {
   // and light leaks at most about one footprint under an occluder touching the receiver.
   // Asked only where the light reaches p (sample_light's irradiance is not zero).
   float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
+  // The same for `count` (1..8) points at once, out[j] for p[j], n[j], l[j]: a cube map's
+  // (point and spot lights) eight tests share their arithmetic in lanes, with per lane the
+  // operations of visibility in its order (the same bits); a directional map's run one by one.
+  void visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const;
+
+ private:
+  // The 3×3 PCF around texel (cx, cy) of `img`: the fraction of taps at least `biased` away.
+  float filtered(const ImageF& img, int cx, int cy, float biased) const;
 };
 
 using ShadowMaps = std::vector<ShadowMap>;

@@ -3,7 +3,8 @@
 // and unshadowed direct light equal to the shared shading model; a spot light's cone,
 // falloff and shadow in direct_light, and its SH ambient term; a spot light's cube, which
 // holds only the faces its cone reaches, against a point light's whole cube; and the pass's
-// SurfaceShader against shade_surface's per-call form, bit for bit.
+// SurfaceShader (one point and eight at a time) against shade_surface's per-call form, and
+// eight shadow tests at once against one at a time, bit for bit.
 #include "raster/shadow_map.h"
 
 #include <algorithm>
@@ -344,6 +345,9 @@ TEST(DirectLight, SurfaceShaderGivesTheBitsOfPerCallShading) {
   const EnvironmentMap env = build_environment(ex, sky, 16);
   const SurfaceShader shader(scene, maps, env);
   std::size_t shaded = 0;
+  SurfaceParams batch_s[8];
+  glm::vec3 batch_p[8], batch_n[8], batch_v[8], batch_expected[8];
+  int filled = 0, batch_size = 1;
   for (std::uint32_t i = 0; i < 20000; ++i) {
     SurfaceParams s;
     const glm::vec2 a = random_float2(i, 0, 0, 9);
@@ -374,8 +378,58 @@ TEST(DirectLight, SurfaceShaderGivesTheBitsOfPerCallShading) {
     ASSERT_EQ(shader(s, p, n, v), expected) << i;
     ASSERT_EQ(shade_surface(scene, s, p, n, v, maps, env), expected) << i;
     shaded += expected != s.emissive;
+    // Batches of 1 to 8 points, this one last: each point's radiance is its own.
+    batch_s[filled] = s, batch_p[filled] = p, batch_n[filled] = n, batch_v[filled] = v, batch_expected[filled] = expected;
+    if (++filled == batch_size) {
+      const SurfaceParams* sp[8];
+      for (int j = 0; j < filled; ++j) sp[j] = &batch_s[j];
+      glm::vec3 got[8];
+      shader.shade8(sp, batch_p, batch_n, batch_v, filled, got);
+      for (int j = 0; j < filled; ++j) ASSERT_EQ(got[j], batch_expected[j]) << i << " lane " << j;
+      filled = 0;
+      batch_size = batch_size % 8 + 1;
+    }
   }
   EXPECT_GT(shaded, 15000u);
+}
+
+TEST(ShadowMap, EightTestsAtOnceGiveTheBitsOfOneAtATime) {
+  // Point, spot and directional maps; points anywhere around the lights (on face edges and
+  // corners of the cubes too), normals at every angle to the light, 1 to 8 points a call.
+  Scene scene = floor_and_occluder(overhead_spot());
+  Light point;
+  point.type = LightType::Point;
+  point.position = {-1.0f, 2.0f, 1.5f};
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = {0.3f, -1.0f, 0.2f};
+  scene.lights.push_back(point);
+  scene.lights.push_back(sun);
+  par::Executor ex(2);
+  const auto maps = render_shadow_maps(ex, scene, 64);
+  std::size_t partly_lit = 0;
+  for (std::size_t k = 0; k < maps.size(); ++k) {
+    const Light& light = scene.lights[k];
+    for (std::uint32_t i = 0; i < 4000; ++i) {
+      const int count = static_cast<int>(i % 8) + 1;
+      glm::vec3 p[8], n[8], l[8];
+      float expected[8], got[8];
+      for (int j = 0; j < count; ++j) {
+        const std::uint32_t key = i * 8 + std::uint32_t(j);
+        glm::vec3 d = spherical_local(1.0f - 2.0f * random_float(key, 0, 0, 21), random_float(key, 0, 1, 21));
+        if (key % 5 == 0) d = glm::normalize(glm::vec3(1.0f, key % 2 ? 1.0f : -1.0f, key % 3 ? 0.5f : 1.0f));  // face edges
+        p[j] = (light.type == LightType::Directional ? glm::vec3(0.0f) : light.position) +
+               d * (0.05f + 5.0f * random_float(key, 0, 2, 21));
+        l[j] = light.type == LightType::Directional ? -glm::normalize(light.direction) : glm::normalize(light.position - p[j]);
+        n[j] = Onb(l[j]).to_world(spherical_local(random_float(key, 0, 3, 21), random_float(key, 0, 4, 21)));
+        expected[j] = maps[k].visibility(p[j], n[j], l[j]);
+        partly_lit += expected[j] > 0.0f && expected[j] < 1.0f;
+      }
+      maps[k].visibility8(p, n, l, count, got);
+      for (int j = 0; j < count; ++j) ASSERT_EQ(got[j], expected[j]) << "light " << k << " call " << i << " lane " << j;
+    }
+  }
+  EXPECT_GT(partly_lit, 100u);
 }
 
 }  // namespace
