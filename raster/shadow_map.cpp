@@ -97,6 +97,10 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
 }
 
 float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const {
+  return filtered(taps(p, n, l));
+}
+
+ShadowMap::Taps ShadowMap::taps(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const {
   // The receiver's footprint: world width of one map texel at p, across the light's rays.
   // A cube texel subtends at most 2/size radians (its width on the unit-distance face
   // plane, at the face centre); a directional texel is one slice of the far camera's frustum.
@@ -110,15 +114,15 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
   const glm::vec3 lookup = p + n * q;
   const glm::vec3 d = lookup - eye;
   const float dist = glm::length(d);
-  if (dist <= 0.0f) return 1.0f;
+  if (dist <= 0.0f) return {};
 
   const ImageF* img;
   glm::vec2 pixel;
   if (type == LightType::Directional) {
     const glm::vec4 clip = view_projection * glm::vec4(lookup, 1.0f);
-    if (clip.w <= 0.0f) return 1.0f;
+    if (clip.w <= 0.0f) return {};
     pixel = {(clip.x / clip.w * 0.5f + 0.5f) * size, (0.5f - clip.y / clip.w * 0.5f) * size};
-    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= size || pixel.y >= size) return 1.0f;
+    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= size || pixel.y >= size) return {};
     img = &distance;
   } else {
     const CubeCoord c = cube_coord(d, cube.size);
@@ -128,11 +132,14 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
   const float biased = dist - kDepthBias * footprint;
   const int cx = std::min(static_cast<int>(pixel.x), size - 1);
   const int cy = std::min(static_cast<int>(pixel.y), size - 1);
-  return filtered(*img, cx, cy, biased);
+  return {img, cx, cy, biased};
 }
 
-float ShadowMap::filtered(const ImageF& image, int cx, int cy, float biased) const {
-  const ImageF* img = &image;
+float ShadowMap::filtered(const Taps& t) const {
+  if (!t.img) return 1.0f;
+  const ImageF* img = t.img;
+  const int cx = t.cx, cy = t.cy;
+  const float biased = t.biased;
   int lit = 0;
   if (cx >= 1 && cy >= 1 && cx + 1 < size && cy + 1 < size) {  // no tap clamped: three rows
     for (int dy = -1; dy <= 1; ++dy) {
@@ -150,8 +157,14 @@ float ShadowMap::filtered(const ImageF& image, int cx, int cy, float biased) con
 }
 
 void ShadowMap::visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const {
+  Taps t[8];
+  taps8(p, n, l, count, t);
+  for (int j = 0; j < count; ++j) out[j] = filtered(t[j]);
+}
+
+void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const {
   if (type == LightType::Directional) {
-    for (int j = 0; j < count; ++j) out[j] = visibility(p[j], n[j], l[j]);
+    for (int j = 0; j < count; ++j) out[j] = taps(p[j], n[j], l[j]);
     return;
   }
   using L = par::Lanes<8>;
@@ -200,7 +213,7 @@ void ShadowMap::visibility8(const glm::vec3* p, const glm::vec3* n, const glm::v
   const f32 biased = dist - kDepthBias * footprint;
   const i32 cx = L::min(L::to_int(px), i32(size - 1)), cy = L::min(L::to_int(py), i32(size - 1));
   for (int j = 0; j < count; ++j)
-    out[j] = dist[j] <= 0.0f ? 1.0f : filtered(cube.distance[face[j]], cx[j], cy[j], biased[j]);
+    out[j] = dist[j] <= 0.0f ? Taps{} : Taps{&cube.distance[face[j]], cx[j], cy[j], biased[j]};
 }
 
 ShadowMaps ShadowMapPass::operator()(par::NodeContext& c) const {

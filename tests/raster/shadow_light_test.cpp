@@ -426,7 +426,17 @@ TEST(ShadowMap, EightTestsAtOnceGiveTheBitsOfOneAtATime) {
         partly_lit += expected[j] > 0.0f && expected[j] < 1.0f;
       }
       maps[k].visibility8(p, n, l, count, got);
-      for (int j = 0; j < count; ++j) ASSERT_EQ(got[j], expected[j]) << "light " << k << " call " << i << " lane " << j;
+      ShadowMap::Taps taps[8];
+      maps[k].taps8(p, n, l, count, taps);
+      for (int j = 0; j < count; ++j) {
+        ASSERT_EQ(got[j], expected[j]) << "light " << k << " call " << i << " lane " << j;
+        // Where the taps lie and what they are compared with, not only how many pass.
+        const ShadowMap::Taps one = maps[k].taps(p[j], n[j], l[j]);
+        ASSERT_EQ(taps[j].img, one.img) << "light " << k << " call " << i << " lane " << j;
+        ASSERT_EQ(taps[j].cx, one.cx);
+        ASSERT_EQ(taps[j].cy, one.cy);
+        ASSERT_EQ(taps[j].biased, one.biased) << "light " << k << " call " << i << " lane " << j;
+      }
     }
   }
   EXPECT_GT(partly_lit, 100u);
