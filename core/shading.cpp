@@ -26,6 +26,13 @@ SurfaceParams surface_params(const Material& m) {
   return s;
 }
 
+int repeat_index(long long i, int n) {
+  // Most lookups land inside the image: no 64-bit division for those (the same index).
+  if (i >= 0 && i < n) return static_cast<int>(i);
+  const long long r = i % n;
+  return static_cast<int>(r < 0 ? r + n : r);
+}
+
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
   if (image.empty()) return glm::vec4(1.0f);
   const float fx = uv.x * static_cast<float>(image.width) - 0.5f;
@@ -33,15 +40,9 @@ glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
   if (!std::isfinite(fx) || !std::isfinite(fy)) return image.pixels[0];
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   const float ax = fx - x0f, ay = fy - y0f;
-  // Most lookups land inside the image: no 64-bit division for those (the same index).
-  auto wrap = [](long long i, int n) {
-    if (i >= 0 && i < n) return static_cast<int>(i);
-    const long long r = i % n;
-    return static_cast<int>(r < 0 ? r + n : r);
-  };
   const long long x0 = static_cast<long long>(x0f), y0 = static_cast<long long>(y0f);
-  const int xa = wrap(x0, image.width), xb = wrap(x0 + 1, image.width);
-  const int ya = wrap(y0, image.height), yb = wrap(y0 + 1, image.height);
+  const int xa = repeat_index(x0, image.width), xb = repeat_index(x0 + 1, image.width);
+  const int ya = repeat_index(y0, image.height), yb = repeat_index(y0 + 1, image.height);
   const glm::vec4 top = image.at(xa, ya) * (1.0f - ax) + image.at(xb, ya) * ax;
   const glm::vec4 bottom = image.at(xa, yb) * (1.0f - ax) + image.at(xb, yb) * ax;
   return top * (1.0f - ay) + bottom * ay;

@@ -156,6 +156,8 @@ glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d);
 glm::vec3 environment_mean_radiance(const Environment& env);
 
 // Bilinear lookup with repeat wrapping in u and v (texel centres at (i+0.5)/w).
+// repeat_index is its wrap: texel index i of any integer on a side of n texels, in [0, n).
+int repeat_index(long long i, int n);
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv);
 
 // Per scene object: 1 when any of its triangles has a refracting material.

@@ -323,10 +323,9 @@ TEST(ShadowMap, SpotLightCubeHoldsTheFacesItsConeReaches) {
   expect_spot_cube_reads_like_the_whole_cube(tilted, 256);
 }
 
-TEST(DirectLight, SurfaceShaderGivesTheBitsOfPerCallShading) {
-  // A point, a spot and a directional light, each with its shadow map, and an environment
-  // with some colour; surfaces of every class (diffuse, glossy, mirror, rough metal,
-  // refractor) at random points, normals and viewers.
+// The occluder scene under the overhead spot, a point light with a range and a sun: one light
+// of each kind, each with its shadow map.
+Scene spot_point_and_sun() {
   Scene scene = floor_and_occluder(overhead_spot());
   Light point;
   point.type = LightType::Point;
@@ -338,6 +337,14 @@ TEST(DirectLight, SurfaceShaderGivesTheBitsOfPerCallShading) {
   sun.direction = {0.3f, -1.0f, 0.2f};
   scene.lights.push_back(point);
   scene.lights.push_back(sun);
+  return scene;
+}
+
+TEST(DirectLight, SurfaceShaderGivesTheBitsOfPerCallShading) {
+  // A point, a spot and a directional light, each with its shadow map, and an environment
+  // with some colour; surfaces of every class (diffuse, glossy, mirror, rough metal,
+  // refractor) at random points, normals and viewers.
+  const Scene scene = spot_point_and_sun();
   par::Executor ex(2);
   const auto maps = render_shadow_maps(ex, scene, 128);
   Environment sky;
@@ -396,15 +403,7 @@ TEST(DirectLight, SurfaceShaderGivesTheBitsOfPerCallShading) {
 TEST(ShadowMap, EightTestsAtOnceGiveTheBitsOfOneAtATime) {
   // Point, spot and directional maps; points anywhere around the lights (on face edges and
   // corners of the cubes too), normals at every angle to the light, 1 to 8 points a call.
-  Scene scene = floor_and_occluder(overhead_spot());
-  Light point;
-  point.type = LightType::Point;
-  point.position = {-1.0f, 2.0f, 1.5f};
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.direction = {0.3f, -1.0f, 0.2f};
-  scene.lights.push_back(point);
-  scene.lights.push_back(sun);
+  const Scene scene = spot_point_and_sun();
   par::Executor ex(2);
   const auto maps = render_shadow_maps(ex, scene, 64);
   std::size_t partly_lit = 0;
