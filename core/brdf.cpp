@@ -164,7 +164,7 @@ BrdfAtView brdf_at_view(const BrdfParams& p, const glm::vec3& n, const glm::vec3
   a.alpha = std::max(p.alpha, kMinAlpha);
   a.diffuse_weight = (1.0f - metallic) * (1.0f - std::clamp(p.transmission, 0.0f, 1.0f));
   a.dielectric_f0 = p.dielectric_f0;
-  // coupled_diffuse_weight's factors that do not depend on the light.
+  // The coupled diffuse weight's factors that do not depend on the light (gltf_brdf below).
   const SpecularAlbedo at_view = specular_albedo(a.cos_nv, a.alpha);
   a.scale_at_view = at_view.scale;
   a.bias_at_view = at_view.bias;
