@@ -91,14 +91,6 @@ std::pair<int, float> grid(float x) {
   return {i, f - float(i)};
 }
 
-// The diffuse weight (1 − E(N·V))(1 − E(N·L)) / (1 − E_avg) of the dielectric (brdf.h).
-float coupled_diffuse_weight(float cos_nl, float cos_nv, float alpha, float f0) {
-  const float e_v = specular_albedo(cos_nv, alpha)(f0);
-  const float e_l = specular_albedo(cos_nl, alpha)(f0);
-  const float e_avg = average_specular_albedo(alpha)(f0);
-  return (1.0f - e_v) * (1.0f - e_l) / std::max(1.0f - e_avg, 1e-6f);
-}
-
 }  // namespace
 
 SpecularAlbedo specular_albedo(float cos_nv, float alpha) {
@@ -164,30 +156,60 @@ float smith_visibility_height_correlated(float cos_nl, float cos_nv, float alpha
   return denom > 0.0f ? 0.5f / denom : 0.0f;
 }
 
-BrdfValue gltf_brdf(const BrdfParams& p, const glm::vec3& n, const glm::vec3& l, const glm::vec3& v) {
+BrdfAtView brdf_at_view(const BrdfParams& p, const glm::vec3& n, const glm::vec3& v) {
+  BrdfAtView a;
+  a.base_color = p.base_color;
+  a.cos_nv = std::max(glm::dot(n, v), 0.0f);
+  const float metallic = std::clamp(p.metallic, 0.0f, 1.0f);
+  a.alpha = std::max(p.alpha, kMinAlpha);
+  a.diffuse_weight = (1.0f - metallic) * (1.0f - std::clamp(p.transmission, 0.0f, 1.0f));
+  a.dielectric_f0 = p.dielectric_f0;
+  // The coupled diffuse weight's factors that do not depend on the light (gltf_brdf below).
+  const SpecularAlbedo at_view = specular_albedo(a.cos_nv, a.alpha);
+  a.scale_at_view = at_view.scale;
+  a.bias_at_view = at_view.bias;
+  a.one_minus_e_v = 1.0f - at_view(p.dielectric_f0);
+  a.one_minus_e_avg = std::max(1.0f - average_specular_albedo(a.alpha)(p.dielectric_f0), 1e-6f);
+  // smith_visibility_height_correlated's root at the viewer (its alpha is already ≥ kMinAlpha).
+  const float nv = std::abs(a.cos_nv), a2 = a.alpha * a.alpha;
+  a.smith_view_root = std::sqrt(nv * nv * (1.0f - a2) + a2);
+  a.f0 = glm::vec3(p.dielectric_f0) * (1.0f - metallic) + p.base_color * metallic;
+  return a;
+}
+
+BrdfValue gltf_brdf(const BrdfAtView& a, const glm::vec3& n, const glm::vec3& l, const glm::vec3& v) {
   BrdfValue out;
   const float cos_nl = glm::dot(n, l);
   if (cos_nl <= 0.0f) return out;
-  const float cos_nv = std::max(glm::dot(n, v), 0.0f);
   const glm::vec3 sum = l + v;
   const float sum2 = glm::dot(sum, sum);
   // l = −v cannot happen with both above the surface except at the horizon; H = N there.
   const glm::vec3 h = sum2 > 1e-12f ? sum / std::sqrt(sum2) : n;
   const float cos_vh = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
 
-  const float metallic = std::clamp(p.metallic, 0.0f, 1.0f);
-  const float alpha = std::max(p.alpha, kMinAlpha);
-  out.diffuse = p.base_color * ((1.0f - metallic) * (1.0f - std::clamp(p.transmission, 0.0f, 1.0f)) *
-                                coupled_diffuse_weight(cos_nl, cos_nv, alpha, p.dielectric_f0) / kPi);
+  // The dielectric's coupled diffuse weight (1 − E(N·V))(1 − E(N·L)) / (1 − E_avg) (brdf.h).
+  const float e_l = specular_albedo(cos_nl, a.alpha)(a.dielectric_f0);
+  const float coupled = a.one_minus_e_v * (1.0f - e_l) / a.one_minus_e_avg;
+  out.diffuse = a.base_color * (a.diffuse_weight * coupled / kPi);
 
   const float cos_nh = glm::dot(n, h);
   if (cos_nh <= 0.0f) return out;
   const glm::vec3 nxh = glm::cross(n, h);
-  const float d = ggx_from_cos_sin(cos_nh * cos_nh, glm::dot(nxh, nxh), alpha);
-  const float vis = smith_visibility_height_correlated(cos_nl, cos_nv, alpha);
-  const glm::vec3 f0 = glm::vec3(p.dielectric_f0) * (1.0f - metallic) + p.base_color * metallic;
-  out.specular = fresnel_schlick(cos_vh, f0) * (d * vis);
+  const float d = ggx_from_cos_sin(cos_nh * cos_nh, glm::dot(nxh, nxh), a.alpha);
+  // smith_visibility_height_correlated with the viewer's root computed once.
+  const float nl = std::abs(cos_nl), nv = std::abs(a.cos_nv);
+  const float a2 = a.alpha * a.alpha;
+  const float gv = nl * a.smith_view_root;
+  const float gl = nv * std::sqrt(nl * nl * (1.0f - a2) + a2);
+  const float denom = gv + gl;
+  const float vis = denom > 0.0f ? 0.5f / denom : 0.0f;
+  out.specular = fresnel_schlick(cos_vh, a.f0) * (d * vis);
   return out;
+}
+
+BrdfValue gltf_brdf(const BrdfParams& p, const glm::vec3& n, const glm::vec3& l, const glm::vec3& v) {
+  if (glm::dot(n, l) <= 0.0f) return {};
+  return gltf_brdf(brdf_at_view(p, n, v), n, l, v);
 }
 
 }  // namespace speculum

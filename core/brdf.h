@@ -60,6 +60,25 @@ struct BrdfValue {
 };
 BrdfValue gltf_brdf(const BrdfParams& p, const glm::vec3& n, const glm::vec3& l, const glm::vec3& v);
 
+// The terms of gltf_brdf that depend on the surface and the viewer alone, computed once for a
+// point lit by several lights: gltf_brdf(brdf_at_view(p, n, v), n, l, v) gives the bits of
+// gltf_brdf(p, n, l, v) (the same operations, in the same order).
+struct BrdfAtView {
+  glm::vec3 base_color{1.0f};
+  glm::vec3 f0{0.04f};          // Schlick's F0 of the specular lobe
+  float alpha = 1.0f;           // ≥ 1e-4
+  float cos_nv = 0.0f;          // N·V clamped to ≥ 0
+  float diffuse_weight = 1.0f;  // (1 − metallic)(1 − transmission)
+  float dielectric_f0 = 0.04f;
+  float one_minus_e_v = 1.0f;   // 1 − the dielectric layer's albedo at N·V
+  float one_minus_e_avg = 1.0f; // 1 − its average albedo (at least 1e-6)
+  float smith_view_root = 1.0f; // √(N·V² (1 − α²) + α²) of the height-correlated V
+  float scale_at_view = 1.0f;   // specular_albedo(N·V, α): shared with the diffuse albedo
+  float bias_at_view = 0.0f;
+};
+BrdfAtView brdf_at_view(const BrdfParams& p, const glm::vec3& n, const glm::vec3& v);
+BrdfValue gltf_brdf(const BrdfAtView& view, const glm::vec3& n, const glm::vec3& l, const glm::vec3& v);
+
 // Smith's masking of one direction for GGX, G1(μ) = 2μ / (μ + √(α² + (1 − α²) μ²)).
 float smith_g1(float cos_n, float alpha);
 

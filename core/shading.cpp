@@ -26,6 +26,13 @@ SurfaceParams surface_params(const Material& m) {
   return s;
 }
 
+int repeat_index(long long i, int n) {
+  // Most lookups land inside the image: no 64-bit division for those (the same index).
+  if (i >= 0 && i < n) return static_cast<int>(i);
+  const long long r = i % n;
+  return static_cast<int>(r < 0 ? r + n : r);
+}
+
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
   if (image.empty()) return glm::vec4(1.0f);
   const float fx = uv.x * static_cast<float>(image.width) - 0.5f;
@@ -33,10 +40,9 @@ glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
   if (!std::isfinite(fx) || !std::isfinite(fy)) return image.pixels[0];
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   const float ax = fx - x0f, ay = fy - y0f;
-  auto wrap = [](long long i, int n) { long long r = i % n; return static_cast<int>(r < 0 ? r + n : r); };
   const long long x0 = static_cast<long long>(x0f), y0 = static_cast<long long>(y0f);
-  const int xa = wrap(x0, image.width), xb = wrap(x0 + 1, image.width);
-  const int ya = wrap(y0, image.height), yb = wrap(y0 + 1, image.height);
+  const int xa = repeat_index(x0, image.width), xb = repeat_index(x0 + 1, image.width);
+  const int ya = repeat_index(y0, image.height), yb = repeat_index(y0 + 1, image.height);
   const glm::vec4 top = image.at(xa, ya) * (1.0f - ax) + image.at(xb, ya) * ax;
   const glm::vec4 bottom = image.at(xa, yb) * (1.0f - ax) + image.at(xb, yb) * ax;
   return top * (1.0f - ay) + bottom * ay;
@@ -77,10 +83,21 @@ SurfaceParams surface_params(const Scene& scene, std::uint32_t material_index, g
   return s;
 }
 
-LightSample sample_light(const Light& light, const glm::vec3& position) {
+LightSampler::LightSampler(const Light& light) : light_(&light) {
+  if (light.type == LightType::Point) return;
+  direction_ = glm::normalize(light.direction);
+  if (light.type != LightType::Spot) return;
+  // glTF KHR_lights_punctual reference falloff: linear in cos between the cones, squared.
+  cos_outer_ = std::cos(light.outer_cone);
+  const float cos_inner = std::cos(light.inner_cone);
+  cone_scale_ = 1.0f / std::max(0.001f, cos_inner - cos_outer_);
+}
+
+LightSample LightSampler::operator()(const glm::vec3& position) const {
+  const Light& light = *light_;
   LightSample out;
   if (light.type == LightType::Directional) {
-    out.direction = -glm::normalize(light.direction);
+    out.direction = -direction_;
     out.distance = std::numeric_limits<float>::infinity();
     out.irradiance = light.color * light.intensity;
     return out;
@@ -99,17 +116,15 @@ LightSample sample_light(const Light& light, const glm::vec3& position) {
   }
   float cone = 1.0f;
   if (light.type == LightType::Spot) {
-    // glTF KHR_lights_punctual reference falloff: linear in cos between the cones, squared.
-    const float cos_outer = std::cos(light.outer_cone);
-    const float cos_inner = std::cos(light.inner_cone);
-    const float scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
-    const float cd = glm::dot(glm::normalize(light.direction), -out.direction);
-    const float a = std::clamp((cd - cos_outer) * scale, 0.0f, 1.0f);
+    const float cd = glm::dot(direction_, -out.direction);
+    const float a = std::clamp((cd - cos_outer_) * cone_scale_, 0.0f, 1.0f);
     cone = a * a;
   }
   out.irradiance = light.color * (light.intensity * window * cone / d2);
   return out;
 }
+
+LightSample sample_light(const Light& light, const glm::vec3& position) { return LightSampler(light)(position); }
 
 glm::vec3 specular_f0(const SurfaceParams& s) {
   const float dielectric = fresnel_f0(s.ior);
@@ -123,12 +138,23 @@ glm::vec3 specular_reflectance(const SurfaceParams& s, float cos_nv) {
   return specular_albedo(cos_nv, s.roughness * s.roughness)(specular_f0(s));
 }
 
-glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv) {
-  // What shade_light's coupled Lambert lobe (core/brdf.h) reflects under uniform light:
-  // base (1 − E(N·V)), E the dielectric specular layer's albedo at the same α.
-  const BrdfParams p = brdf_params_for_punctual_light(s);
-  const float e = specular_albedo(std::clamp(cos_nv, 0.0f, 1.0f), p.alpha)(p.dielectric_f0);
+namespace {
+// What shade_light's coupled Lambert lobe (core/brdf.h) reflects under uniform light:
+// base (1 − E(N·V)), E the dielectric specular layer's albedo at N·V and the same α.
+glm::vec3 diffuse_albedo_over_pi_of(const SurfaceParams& s, float e) {
   return s.base_color * ((1.0f - s.metallic) * (1.0f - s.transmission) * (1.0f - e) / kPi);
+}
+}  // namespace
+
+glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, const BrdfAtView& view) {
+  // view.alpha is the punctual α (≥ kMinPunctualRoughness², so its clamp to kMinAlpha changed
+  // nothing) and the table clamps N·V to [0, 1] either way: the same lookup as below.
+  return diffuse_albedo_over_pi_of(s, SpecularAlbedo{view.scale_at_view, view.bias_at_view}(view.dielectric_f0));
+}
+
+glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv) {
+  const BrdfParams p = brdf_params_for_punctual_light(s);
+  return diffuse_albedo_over_pi_of(s, specular_albedo(std::clamp(cos_nv, 0.0f, 1.0f), p.alpha)(p.dielectric_f0));
 }
 
 LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u) {
@@ -155,15 +181,21 @@ BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s) {
   return p;
 }
 
-glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
+glm::vec3 shade_light(const SurfaceParams& s, const BrdfAtView& view, const glm::vec3& n, const glm::vec3& v,
                       const LightSample& light) {
   const float cos_nl = glm::dot(n, light.direction);
   if (cos_nl <= 0.0f) return glm::vec3(0.0f);
-  const BrdfValue f = gltf_brdf(brdf_params_for_punctual_light(s), n, light.direction, v);
+  const BrdfValue f = gltf_brdf(view, n, light.direction, v);
   // Mirror-class surfaces: the delta lobe's image of a point light is a point of zero solid
   // angle, which camera rays never see directly either, so it adds nothing (see shading.h).
   const glm::vec3 brdf = s.is_mirror_lobe() ? f.diffuse : f.total();
   return brdf * (cos_nl * light.irradiance);
+}
+
+glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
+                      const LightSample& light) {
+  if (glm::dot(n, light.direction) <= 0.0f) return glm::vec3(0.0f);
+  return shade_light(s, brdf_at_view(brdf_params_for_punctual_light(s), n, v), n, v, light);
 }
 
 glm::vec2 equirect_uv(const glm::vec3& d) {

@@ -91,6 +91,19 @@ struct LightSample {
   glm::vec3 irradiance{0.0f};             // at normal incidence: colour × E (0: out of reach)
 };
 LightSample sample_light(const Light& light, const glm::vec3& position);
+// sample_light's per-light constants (the unit direction, the spot cone's cosines) computed
+// once, for a pass that samples one light at many points: sampler(p) gives the bits of
+// sample_light(light, p).
+class LightSampler {
+ public:
+  explicit LightSampler(const Light& light);
+  LightSample operator()(const glm::vec3& position) const;
+
+ private:
+  const Light* light_;
+  glm::vec3 direction_{0.0f};  // unit (spot and directional lights)
+  float cos_outer_ = 0.0f, cone_scale_ = 1.0f;  // spot lights
+};
 
 // F0 of the specular lobe, and the weight of a reflection looked up or traced along R for a
 // viewer at cos_nv = N·V: the lobe's directional albedo E(F0) (glossy; the split-sum scale
@@ -102,6 +115,10 @@ glm::vec3 specular_reflectance(const SurfaceParams& s, float cos_nv);
 // f(l, v) (N·L) E with the glTF BRDF above (no highlight on mirror-class surfaces). The
 // caller decides visibility (shadow ray or shadow map).
 glm::vec3 shade_light(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
+                      const LightSample& light);
+// The same for a point shaded under several lights, its viewer's terms computed once
+// (view = brdf_at_view(brdf_params_for_punctual_light(s), n, v)): the same bits.
+glm::vec3 shade_light(const SurfaceParams& s, const BrdfAtView& view, const glm::vec3& n, const glm::vec3& v,
                       const LightSample& light);
 // The BRDF inputs shade_light uses (roughness clamped to kMinPunctualRoughness).
 BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s);
@@ -119,6 +136,9 @@ LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, cons
 // weight of incident irradiance, (1 - metallic)(1 - transmission)(1 - E_dielectric(N·V))
 // base_color / π (1/sr), exact for uniform incident light.
 glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv);
+// The same at the viewer of view = brdf_at_view(brdf_params_for_punctual_light(s), n, v), its
+// albedo lookup reused: the bits of diffuse_albedo_over_pi(s, N·V).
+glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, const BrdfAtView& view);
 
 // Equirect mapping (see the header comment) and the environment radiance towards -d
 // (d: unit direction of the ray leaving the scene).
@@ -136,6 +156,8 @@ glm::vec3 environment_radiance(const Environment& env, const glm::vec3& d);
 glm::vec3 environment_mean_radiance(const Environment& env);
 
 // Bilinear lookup with repeat wrapping in u and v (texel centres at (i+0.5)/w).
+// repeat_index is its wrap: texel index i of any integer on a side of n texels, in [0, n).
+int repeat_index(long long i, int n);
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv);
 
 // Per scene object: 1 when any of its triangles has a refracting material.

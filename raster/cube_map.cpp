@@ -108,6 +108,23 @@ CubeCoord cube_coord(const glm::vec3& d, int size) {
                  std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
 }
 
+unsigned cube_faces_near(const glm::vec3& p, float margin) {
+  // Over the directions within angle θ of p the largest q·m is sin(asin(p·m) + θ) (up to
+  // θ ≤ π/2), so one of them is on m's side when p·m ≥ −sin θ: σ p_k − |p_j| ≥ −√2 sin θ.
+  // Beyond π/2 every face passes (the sum is at least −√2).
+  const float slack = margin < 1.5707963f ? 1.4142136f * std::sin(margin) : 2.0f;
+  unsigned mask = 0;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const int k = f / 2;
+    const float along = (f % 2 == 0 ? 1.0f : -1.0f) * p[k];
+    bool near = true;
+    for (int j = 0; j < 3 && near; ++j)
+      if (j != k) near = along - std::fabs(p[j]) >= -slack;
+    if (near) mask |= 1u << f;
+  }
+  return mask;
+}
+
 glm::vec2 cube_face_plane_pixel(int face, const glm::vec3& d, int size) {
   const FaceFrame& f = frame(face);
   const float depth = glm::dot(d, f.forward);
@@ -183,6 +200,9 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
   CubeMap cube;
   cube.size = options.size;
   cube.centre = centre;
+  // One G-buffer for every face: its planes (about 90 bytes a texel) are allocated and
+  // cleared once, not once per face on the thread that launches the face's passes.
+  GBuffer g;
   for (int face = 0; face < kCubeFaces; ++face) {
     if (!((options.face_mask >> face) & 1u)) {
       cube.distance[face] = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
@@ -210,7 +230,9 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
                                     visible_position(scene.mesh, vis, i) - centre);
                           });
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
-    if (shade) cube.colour[face] = shade(resolve_gbuffer(executor, scene, vis, centre), cam, face, read.empty() ? nullptr : &read);
+    if (!shade) continue;
+    resolve_gbuffer(executor, scene, vis, centre, g);
+    cube.colour[face] = shade(g, cam, face, read.empty() ? nullptr : &read);
   }
   return cube;
 }

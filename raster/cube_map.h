@@ -41,6 +41,12 @@ struct CubeFaceAxes {
 };
 const CubeFaceAxes& cube_face_axes(int face);
 
+// Bit f set: face f may hold a direction within angle `margin` of unit direction p. Face f
+// (axis k, sign σ) holds the directions with σ p_k ≥ |p_j| for j ≠ k, the side of four great
+// circles (unit normals m = (σ e_k ∓ e_j)/√2) where q·m ≥ 0; each circle is tested on its own:
+// a superset test, so no face a direction within the margin lands on is left out.
+unsigned cube_faces_near(const glm::vec3& p, float margin);
+
 // Continuous pixel coordinates of direction d on the plane of face `face` (any face whose axis
 // d makes an acute angle with: not clamped to the face, no face chosen), so that a
 // neighbourhood of d can be bounded on a face next to the one d lands on.

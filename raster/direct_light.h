@@ -24,6 +24,25 @@ namespace speculum::raster {
 glm::vec3 shade_surface(const Scene& scene, const SurfaceParams& s, const glm::vec3& p, glm::vec3 n,
                         const glm::vec3& v, const std::vector<ShadowMap>& shadows, const EnvironmentMap& env);
 
+// shade_surface for the many points of one pass: each light's constants computed once
+// (core/shading.h LightSampler) and each point's viewer terms once for all lights
+// (core/brdf.h BrdfAtView); operator() gives shade_surface's bits.
+class SurfaceShader {
+ public:
+  SurfaceShader(const Scene& scene, const std::vector<ShadowMap>& shadows, const EnvironmentMap& env);
+  glm::vec3 operator()(const SurfaceParams& s, const glm::vec3& p, glm::vec3 n, const glm::vec3& v) const;
+  // The same for `count` (1..8) points, out[j] for s[j], p[j], n[j], v[j]: each light's
+  // shadow tests of the points it reaches in one ShadowMap::visibility8 call.
+  void shade8(const SurfaceParams* const* s, const glm::vec3* p, const glm::vec3* n, const glm::vec3* v, int count,
+              glm::vec3* out) const;
+
+ private:
+  const Scene* scene_;
+  const std::vector<ShadowMap>* shadows_;
+  const EnvironmentMap* env_;
+  std::vector<LightSampler> lights_;
+};
+
 // `camera` is the one the G-buffer was rendered with (for background directions).
 // `shadows` may be empty: lights are then unshadowed. `read` (may be null) flags the samples
 // wanted; the others are left black (the texels of a cube face no reader reaches).

@@ -96,24 +96,6 @@ float sample_need(const GBuffer& g, std::size_t i) {
   return need;
 }
 
-// Faces within angle `margin` of unit direction p. Face f (axis k, sign σ) holds the
-// directions with σ p_k ≥ |p_j| for j ≠ k; a direction within `margin` of it is at most
-// `margin` (as a chord, at most the angle) outside each of the four bounding great circles
-// (unit normals (σ e_k ∓ e_j)/√2): a superset test, so no face that is read is left out.
-unsigned faces_near(const glm::vec3& p, float margin) {
-  const float slack = 1.4142136f * margin;
-  unsigned mask = 0;
-  for (int f = 0; f < kCubeFaces; ++f) {
-    const int k = f / 2;
-    const float along = (f % 2 == 0 ? 1.0f : -1.0f) * p[k];
-    bool near = true;
-    for (int j = 0; j < 3 && near; ++j)
-      if (j != k) near = along - std::fabs(p[j]) >= -slack;
-    if (near) mask |= 1u << f;
-  }
-  return mask;
-}
-
 // Faces within `margin` of the great-circle arc from unit a to unit b: points along it at
 // most 0.1 rad apart, each tested with the margin grown by half a step (every point of the
 // arc is that close to one of them). Nearly opposite ends have no one arc: every face.
@@ -128,7 +110,7 @@ unsigned faces_near_arc(const glm::vec3& a, const glm::vec3& b, float margin) {
     const float u = static_cast<float>(i) / static_cast<float>(steps);
     const glm::vec3 p = sin_angle > 1e-6f ? glm::normalize((std::sin((1.0f - u) * angle) * a + std::sin(u * angle) * b) / sin_angle)
                                           : a;
-    mask |= faces_near(p, margin + 0.5f * step + 1e-3f);
+    mask |= cube_faces_near(p, margin + 0.5f * step + 1e-3f);
   }
   return mask;
 }
@@ -152,7 +134,7 @@ constexpr float kWholeFaceMargin = 0.5f;
 // size/(2z²) texels, from d's point on the face's plane. One texel more absorbs rounding.
 void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int n, int size, const glm::vec3& d,
                float margin) {
-  const unsigned faces = faces_near(d, margin);
+  const unsigned faces = cube_faces_near(d, margin);
   constexpr float kFaceHalfAngle = 0.95531662f;  // acos(1/√3)
   const float z = std::cos(kFaceHalfAngle + margin);
   const float half = margin >= kWholeFaceMargin ? 0.0f : margin * static_cast<float>(size) / (2.0f * z * z) + 1.0f;
@@ -267,7 +249,7 @@ unsigned faces_read(par::Executor& executor, const GBuffer& g, const std::vector
       const glm::vec3 r = glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i]));
       const float exponent = s.phong_exponent;
       if (sizing.reads == MapSizing::Reads::direction) {
-        mask |= faces_near(r, std::max(lookup_reach(size, level_count, exponent), 1e-3f));
+        mask |= cube_faces_near(r, std::max(lookup_reach(size, level_count, exponent), 1e-3f));
         continue;
       }
       // A search reads distances and colour along the directions from the centre to the
@@ -280,7 +262,7 @@ unsigned faces_read(par::Executor& executor, const GBuffer& g, const std::vector
                  widest_lobe_sample(sizing.lobe_directions, exponent * (4.0f / 3.0f)) + 0.02f;
       const glm::vec3 from = g.position.pixels[i] - centre;
       const float from_length = glm::length(from);
-      mask |= from_length > 0.0f ? faces_near_arc(from / from_length, r, margin) : faces_near(r, margin);
+      mask |= from_length > 0.0f ? faces_near_arc(from / from_length, r, margin) : cube_faces_near(r, margin);
     }
     per_chunk[begin / kChunk] = mask;
   });

@@ -11,6 +11,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "core/camera_rays.h"
+#include "parallel/lanes.h"
 
 namespace speculum::raster {
 namespace {
@@ -37,6 +38,18 @@ constexpr float kDepthBias = 1.0f;
 float normal_offset(float footprint, const glm::vec3& n, const glm::vec3& l) {
   const float c = std::clamp(glm::dot(n, l), 0.0f, 1.0f);
   return kNormalOffset * footprint * std::sqrt(1.0f - c * c);
+}
+
+// The faces of a spot light's shadow cube that a shadow test can read: visibility runs only
+// where sample_light gives the light (every caller skips a zero irradiance), i.e. at points
+// within the outer cone, and it looks up p + q n with q at most kNormalOffset footprints
+// (2 kNormalOffset |p − light| / size), at most asin(2 kNormalOffset / size) off p's
+// direction; its 3×3 taps stay on the face that lookup lands on. The cone is widened by that
+// and 1e-3 rad for the rounding of the cone test.
+unsigned spot_cone_faces(const Light& light, int size) {
+  const float shift = 2.0f * kNormalOffset / static_cast<float>(size);
+  if (!(shift < 0.5f) || !(light.outer_cone < 1.5f)) return 0x3fu;
+  return cube_faces_near(glm::normalize(light.direction), light.outer_cone + std::asin(shift) + 1e-3f);
 }
 
 }  // namespace
@@ -75,6 +88,7 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
       opt.size = size;
       opt.znear = 1e-3f * radius;
       opt.zfar = 4.0f * radius + glm::length(light.position - centre);
+      if (light.type == LightType::Spot) opt.face_mask = spot_cone_faces(light, size);
       m.cube = render_cube_map(executor, scene, light.position, opt);
     }
     maps.push_back(std::move(m));
@@ -83,6 +97,10 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
 }
 
 float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const {
+  return filtered(taps(p, n, l));
+}
+
+ShadowMap::Taps ShadowMap::taps(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const {
   // The receiver's footprint: world width of one map texel at p, across the light's rays.
   // A cube texel subtends at most 2/size radians (its width on the unit-distance face
   // plane, at the face centre); a directional texel is one slice of the far camera's frustum.
@@ -96,15 +114,15 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
   const glm::vec3 lookup = p + n * q;
   const glm::vec3 d = lookup - eye;
   const float dist = glm::length(d);
-  if (dist <= 0.0f) return 1.0f;
+  if (dist <= 0.0f) return {};
 
   const ImageF* img;
   glm::vec2 pixel;
   if (type == LightType::Directional) {
     const glm::vec4 clip = view_projection * glm::vec4(lookup, 1.0f);
-    if (clip.w <= 0.0f) return 1.0f;
+    if (clip.w <= 0.0f) return {};
     pixel = {(clip.x / clip.w * 0.5f + 0.5f) * size, (0.5f - clip.y / clip.w * 0.5f) * size};
-    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= size || pixel.y >= size) return 1.0f;
+    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= size || pixel.y >= size) return {};
     img = &distance;
   } else {
     const CubeCoord c = cube_coord(d, cube.size);
@@ -114,6 +132,14 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
   const float biased = dist - kDepthBias * footprint;
   const int cx = std::min(static_cast<int>(pixel.x), size - 1);
   const int cy = std::min(static_cast<int>(pixel.y), size - 1);
+  return {img, cx, cy, biased};
+}
+
+float ShadowMap::filtered(const Taps& t) const {
+  if (!t.img) return 1.0f;
+  const ImageF* img = t.img;
+  const int cx = t.cx, cy = t.cy;
+  const float biased = t.biased;
   int lit = 0;
   if (cx >= 1 && cy >= 1 && cx + 1 < size && cy + 1 < size) {  // no tap clamped: three rows
     for (int dy = -1; dy <= 1; ++dy) {
@@ -128,6 +154,66 @@ float ShadowMap::visibility(const glm::vec3& p, const glm::vec3& n, const glm::v
       lit += img->at(x, y) >= biased;
     }
   return lit / 9.0f;
+}
+
+void ShadowMap::visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const {
+  Taps t[8];
+  taps8(p, n, l, count, t);
+  for (int j = 0; j < count; ++j) out[j] = filtered(t[j]);
+}
+
+void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const {
+  if (type == LightType::Directional) {
+    for (int j = 0; j < count; ++j) out[j] = taps(p[j], n[j], l[j]);
+    return;
+  }
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
+  using i32 = L::i32;
+  // Lanes past `count` repeat point 0: valid inputs, their results dropped.
+  alignas(32) float in[9][8];
+  for (int j = 0; j < 8; ++j) {
+    const int k = j < count ? j : 0;
+    for (int c = 0; c < 3; ++c) in[c][j] = p[k][c], in[3 + c][j] = n[k][c], in[6 + c][j] = l[k][c];
+  }
+  f32 pv[3], nv[3], lv[3];
+  for (int c = 0; c < 3; ++c) pv[c] = L::load(in[c]), nv[c] = L::load(in[3 + c]), lv[c] = L::load(in[6 + c]);
+  // glm's dot of two vec3 is (x·x' + y·y') + z·z', and length is the root of the dot.
+  const auto dot = [](const f32* a, const f32* b) { return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]; };
+  const auto clamp = [](f32 v, f32 lo, f32 hi) { return L::select(v < lo, lo, L::select(hi < v, hi, v)); };
+  const glm::vec3 eye = cube.centre;
+  const float texel_angle = 2.0f / static_cast<float>(cube.size);
+  f32 from_eye[3];
+  for (int c = 0; c < 3; ++c) from_eye[c] = pv[c] - eye[c];
+  const f32 footprint = L::sqrt(dot(from_eye, from_eye)) * texel_angle;
+  // normal_offset
+  const f32 cos_nl = clamp(dot(nv, lv), f32(0.0f), f32(1.0f));
+  const f32 q = kNormalOffset * footprint * L::sqrt(1.0f - cos_nl * cos_nl);
+  f32 d[3];
+  for (int c = 0; c < 3; ++c) d[c] = (pv[c] + nv[c] * q) - eye[c];
+  const f32 dist = L::sqrt(dot(d, d));
+  // cube_coord: the face of the largest component (ties as there), then its projection.
+  const f32 ax = L::abs(d[0]), ay = L::abs(d[1]), az = L::abs(d[2]);
+  const auto is_x = (ax >= ay) && (ax >= az);
+  const auto is_y = !is_x && (ay >= az);
+  const f32 major = L::select(is_x, d[0], L::select(is_y, d[1], d[2]));
+  i32 face = L::select(is_x, i32(0), L::select(is_y, i32(2), i32(4)));
+  face = L::select(!(major >= 0.0f), face + 1, face);
+  f32 depth(0.0f), along_right(0.0f), along_up(0.0f);
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const L::mask here = face == f;
+    const CubeFaceAxes& a = cube_face_axes(f);
+    depth = L::select(here, a.forward_sign * d[a.forward], depth);
+    along_right = L::select(here, a.right_sign * d[a.right], along_right);
+    along_up = L::select(here, a.up_sign * d[a.up], along_up);
+  }
+  const float s = static_cast<float>(cube.size);
+  const f32 px = clamp((along_right / depth + 1.0f) * 0.5f * s, f32(0.0f), f32(s));
+  const f32 py = clamp((1.0f - along_up / depth) * 0.5f * s, f32(0.0f), f32(s));
+  const f32 biased = dist - kDepthBias * footprint;
+  const i32 cx = L::min(L::to_int(px), i32(size - 1)), cy = L::min(L::to_int(py), i32(size - 1));
+  for (int j = 0; j < count; ++j)
+    out[j] = dist[j] <= 0.0f ? Taps{} : Taps{&cube.distance[face[j]], cx[j], cy[j], biased[j]};
 }
 
 ShadowMaps ShadowMapPass::operator()(par::NodeContext& c) const {

@@ -18,7 +18,8 @@ namespace speculum::raster {
 struct ShadowMap {
   LightType type = LightType::Point;
   int size = 0;
-  CubeMap cube;               // point and spot lights: distance from the light position
+  CubeMap cube;               // point and spot lights: distance from the light position (a
+                              // spot light's: only the faces its cone reaches, the others +inf)
   Camera camera;              // directional lights: the far camera along the light
   glm::mat4 view_projection{1.0f};
   ImageF distance;            // directional: |y − camera.eye|
@@ -28,7 +29,25 @@ struct ShadowMap {
   // 2·sin θ texel footprints (θ between n and l; the footprint is one texel's world width
   // at p), and the depth test allows one footprint: a plane is lit at every incidence,
   // and light leaks at most about one footprint under an occluder touching the receiver.
+  // Asked only where the light reaches p (sample_light's irradiance is not zero).
   float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
+  // The same for `count` (1..8) points at once, out[j] for p[j], n[j], l[j].
+  void visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const;
+
+  // Where visibility reads: the texel its 3×3 taps are centred on and the biased distance
+  // they are compared with (img null: no tap, the point is lit).
+  struct Taps {
+    const ImageF* img = nullptr;
+    int cx = 0, cy = 0;
+    float biased = 0.0f;
+  };
+  Taps taps(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
+  // taps for `count` (1..8) points: a cube map's (point and spot lights) eight share their
+  // arithmetic in lanes, with per lane the operations of taps in its order (the same bits);
+  // a directional map's run one by one.
+  void taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const;
+  // The fraction of the taps at least `biased` away.
+  float filtered(const Taps& t) const;
 };
 
 using ShadowMaps = std::vector<ShadowMap>;

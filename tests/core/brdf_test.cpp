@@ -1,11 +1,15 @@
 // The glTF 2.0 metallic-roughness BRDF (core/brdf.h) and the direct-light shading built on
 // it (core/shading.h): reciprocity, a white-furnace energy bound, continuity across the
 // curve R·L = 0 where the old Phong highlight of exponent 0 had a step, the spec's
-// smooth limit, metal tinting and the single (1 - transmission) factor.
+// smooth limit, metal tinting and the single (1 - transmission) factor; and the forms that
+// compute a point's viewer terms and a light's constants once (BrdfAtView, LightSampler)
+// against the formulas written out per call, bit for bit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -262,6 +266,138 @@ TEST(ShadeLight, MirrorClassHasNoPunctualHighlightAndGlossyPeakIsFinite) {
   const float a = kMinPunctualRoughness * kMinPunctualRoughness;
   const float expected = fresnel_schlick(std::cos(0.4f), 0.9f) / (4.0f * kPi * a * a * std::cos(0.4f));
   EXPECT_NEAR(peak.x, expected, 0.01f * expected);
+}
+
+// gltf_brdf written out per call (every term recomputed for each light), the formula
+// BrdfAtView factors: its bits are what the factored form must give.
+BrdfValue per_call_gltf_brdf(const BrdfParams& p, const glm::vec3& n, const glm::vec3& l, const glm::vec3& v) {
+  BrdfValue out;
+  const float cos_nl = glm::dot(n, l);
+  if (cos_nl <= 0.0f) return out;
+  const float cos_nv = std::max(glm::dot(n, v), 0.0f);
+  const glm::vec3 sum = l + v;
+  const float sum2 = glm::dot(sum, sum);
+  const glm::vec3 h = sum2 > 1e-12f ? sum / std::sqrt(sum2) : n;
+  const float cos_vh = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
+  const float metallic = std::clamp(p.metallic, 0.0f, 1.0f);
+  const float alpha = std::max(p.alpha, 1e-4f);
+  const float e_v = specular_albedo(cos_nv, alpha)(p.dielectric_f0);
+  const float e_l = specular_albedo(cos_nl, alpha)(p.dielectric_f0);
+  const float e_avg = average_specular_albedo(alpha)(p.dielectric_f0);
+  const float coupled = (1.0f - e_v) * (1.0f - e_l) / std::max(1.0f - e_avg, 1e-6f);
+  out.diffuse = p.base_color * ((1.0f - metallic) * (1.0f - std::clamp(p.transmission, 0.0f, 1.0f)) * coupled / kPi);
+  const float cos_nh = glm::dot(n, h);
+  if (cos_nh <= 0.0f) return out;
+  const glm::vec3 nxh = glm::cross(n, h);
+  const float a2 = alpha * alpha;
+  const float dd = cos_nh * cos_nh * a2 + glm::dot(nxh, nxh);
+  const float d = a2 / (kPi * dd * dd);
+  const float vis = smith_visibility_height_correlated(cos_nl, cos_nv, alpha);
+  const glm::vec3 f0 = glm::vec3(p.dielectric_f0) * (1.0f - metallic) + p.base_color * metallic;
+  out.specular = fresnel_schlick(cos_vh, f0) * (d * vis);
+  return out;
+}
+
+// A unit direction from two uniform numbers (uniform on the sphere).
+glm::vec3 random_direction(glm::vec2 u) { return spherical_local(1.0f - 2.0f * u.x, u.y); }
+
+TEST(GltfBrdf, ViewTermsGiveTheBitsOfThePerCallFormula) {
+  std::size_t lit = 0, highlights = 0;
+  for (std::uint32_t i = 0; i < 20000; ++i) {
+    SurfaceParams s;
+    const glm::vec2 a = random_float2(i, 0, 0, 11), b = random_float2(i, 0, 2, 11);
+    s.roughness = i % 7 == 0 ? 0.0f : a.x;  // mirror-class surfaces too
+    s.metallic = a.y;
+    s.transmission = i % 5 == 0 ? b.x : 0.0f;
+    s.ior = 1.0f + b.y;
+    s.base_color = glm::vec3(a.x, b.x, 1.0f - a.y);
+    const BrdfParams p = brdf_params_for_punctual_light(s);
+    const glm::vec3 n = random_direction(random_float2(i, 0, 4, 11));
+    const glm::vec3 l = random_direction(random_float2(i, 0, 6, 11));
+    // Viewers on both sides of the surface (N·V < 0 is clamped alike).
+    const glm::vec3 v = random_direction(random_float2(i, 0, 8, 11));
+    const BrdfAtView view = brdf_at_view(p, n, v);
+    const BrdfValue expected = per_call_gltf_brdf(p, n, l, v);
+    const BrdfValue factored = gltf_brdf(view, n, l, v), unfactored = gltf_brdf(p, n, l, v);
+    ASSERT_EQ(factored.diffuse, expected.diffuse) << i;
+    ASSERT_EQ(factored.specular, expected.specular) << i;
+    ASSERT_EQ(unfactored.diffuse, expected.diffuse) << i;
+    ASSERT_EQ(unfactored.specular, expected.specular) << i;
+    lit += expected.diffuse != glm::vec3(0.0f);
+    highlights += expected.specular != glm::vec3(0.0f);
+
+    LightSample ls;
+    ls.direction = l;
+    ls.irradiance = glm::vec3(1.0f, 2.0f, 0.5f);
+    ASSERT_EQ(shade_light(s, view, n, v, ls), shade_light(s, n, v, ls)) << i;
+    ASSERT_EQ(diffuse_albedo_over_pi(s, view), diffuse_albedo_over_pi(s, glm::dot(n, v))) << i;
+  }
+  EXPECT_GT(lit, 8000u);
+  EXPECT_GT(highlights, 5000u);
+}
+
+// sample_light written out per call (the light's direction and cone cosines recomputed at
+// every point), the formula LightSampler factors.
+LightSample per_call_sample_light(const Light& light, const glm::vec3& position) {
+  LightSample out;
+  if (light.type == LightType::Directional) {
+    out.direction = -glm::normalize(light.direction);
+    out.distance = std::numeric_limits<float>::infinity();
+    out.irradiance = light.color * light.intensity;
+    return out;
+  }
+  const glm::vec3 to_light = light.position - position;
+  const float d2 = glm::dot(to_light, to_light);
+  if (!(d2 > 0.0f)) return out;
+  const float d = std::sqrt(d2);
+  out.direction = to_light / d;
+  out.distance = d;
+  float window = 1.0f;
+  if (light.range > 0.0f) {
+    const float r = d / light.range, r2 = r * r;
+    window = std::clamp(1.0f - r2 * r2, 0.0f, 1.0f);
+  }
+  float cone = 1.0f;
+  if (light.type == LightType::Spot) {
+    const float cos_outer = std::cos(light.outer_cone), cos_inner = std::cos(light.inner_cone);
+    const float scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
+    const float a = std::clamp((glm::dot(glm::normalize(light.direction), -out.direction) - cos_outer) * scale, 0.0f, 1.0f);
+    cone = a * a;
+  }
+  out.irradiance = light.color * (light.intensity * window * cone / d2);
+  return out;
+}
+
+TEST(ShadeLight, LightSamplerGivesTheBitsOfThePerCallFormula) {
+  std::vector<Light> lights(4);
+  lights[0].type = LightType::Point;
+  lights[0].position = {0.5f, 2.0f, -1.0f};
+  lights[1] = lights[0];
+  lights[1].range = 3.0f;
+  lights[2].type = LightType::Spot;
+  lights[2].position = {1.0f, 2.5f, 0.5f};
+  lights[2].direction = {-0.4f, -1.0f, -0.3f};  // not unit: the sampler normalizes it
+  lights[2].inner_cone = 0.2f;
+  lights[2].outer_cone = 0.6f;
+  lights[2].range = 6.0f;
+  lights[3].type = LightType::Directional;
+  lights[3].direction = {0.3f, -1.0f, 0.2f};
+  std::size_t in_cone = 0;
+  for (const Light& light : lights) {
+    const LightSampler sampler(light);
+    for (std::uint32_t i = 0; i < 5000; ++i) {
+      const glm::vec3 p = light.position + 4.0f * random_direction(random_float2(i, 0, 0, 13)) *
+                                               random_float(i, 0, 2, 13);
+      const LightSample expected = per_call_sample_light(light, p), got = sampler(p);
+      ASSERT_EQ(got.direction, expected.direction) << i;
+      ASSERT_EQ(got.irradiance, expected.irradiance) << i;
+      ASSERT_EQ(got.distance, expected.distance) << i;
+      const LightSample via_function = sample_light(light, p);
+      ASSERT_EQ(via_function.irradiance, expected.irradiance) << i;
+      in_cone += light.type == LightType::Spot && expected.irradiance != glm::vec3(0.0f);
+    }
+  }
+  EXPECT_GT(in_cone, 200u);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
-// Tests of cube maps and the environment node: face conventions round-trip, cube-map
-// distance against a brute-force ray oracle (SURVEY §4 distance maps), prefiltered
-// environment and SH irradiance against analytic constants.
+// Tests of cube maps and the environment node: face conventions round-trip, the faces near a
+// direction, cube-map distance against a brute-force ray oracle (SURVEY §4 distance maps),
+// prefiltered environment and SH irradiance against analytic constants.
 #include "raster/cube_map.h"
 
 #include <array>
@@ -34,6 +34,28 @@ TEST(CubeMapFaces, DirectionAndCoordinateRoundTrip) {
         const Ray r = primary_ray(cube_face_camera(face, {}, 0.1f, 10.0f), size, size, x, y);
         EXPECT_LT(glm::length(r.direction - d), 1e-5f);
       }
+}
+
+// cube_faces_near holds the face of every direction within its margin of p (directions on
+// the cap's rim, where the bound is tight, and inside it), at margins up to past π/2; and it
+// is no looser than the cap: straight down, 0.7 rad stays on −Y, whose sides start at 45°.
+TEST(CubeMapFaces, FacesNearHoldEveryDirectionWithinTheMargin) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int trial = 0; trial < 400; ++trial) {
+    const glm::vec3 p = spherical_local(1.0f - 2.0f * unit(rng), unit(rng));
+    const float margin = 1.8f * unit(rng) * unit(rng);
+    const unsigned faces = cube_faces_near(p, margin);
+    const Onb frame(p);
+    for (int k = 0; k < 400; ++k) {
+      const float angle = margin * (k % 2 == 0 ? 1.0f : unit(rng));
+      const glm::vec3 q = frame.to_world(spherical_local(std::cos(angle), unit(rng)));
+      ASSERT_TRUE((faces >> cube_coord(q, 64).face) & 1u) << "trial " << trial << " margin " << margin;
+    }
+  }
+  EXPECT_EQ(cube_faces_near({0.0f, -1.0f, 0.0f}, 0.7f), 1u << 3);
+  EXPECT_EQ(cube_faces_near({0.0f, -1.0f, 0.0f}, 0.8f) & 0x3bu, 0x3bu);  // −Y and its four sides
+  EXPECT_EQ(cube_faces_near({0.0f, -1.0f, 0.0f}, 1.6f), 0x3fu);
 }
 
 // A tile mask's texel count is the number of level-0 texels its read tiles hold, on sides that
