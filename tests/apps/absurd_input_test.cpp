@@ -31,32 +31,30 @@ std::string refused(const std::string& args, const fs::path& dir) {
   return r.err;
 }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
 TEST(AbsurdInput, FrameSizesAndSamplesNameTheirLimit) {
   const fs::path dir = test::scratch_dir();
   std::string e = refused("render --width 100000 --height 100000 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "--width")) << e;
-  EXPECT_TRUE(contains(e, "16384")) << e;
+  EXPECT_TRUE(test::contains(e, "--width")) << e;
+  EXPECT_TRUE(test::contains(e, "16384")) << e;
   e = refused("inspect --width 16384 --height 16384 -q -o out", dir);
-  EXPECT_TRUE(contains(e, "at most 8388608 (2^23)")) << e;
+  EXPECT_TRUE(test::contains(e, "at most 8388608 (2^23)")) << e;
   e = refused("render -t reference --width 1 --height 1 --spp 1000000000 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "--spp")) << e;
-  EXPECT_TRUE(contains(e, "65536")) << e;
+  EXPECT_TRUE(test::contains(e, "--spp")) << e;
+  EXPECT_TRUE(test::contains(e, "65536")) << e;
   e = refused("render -t reference --width 4096 --height 4096 --spp 65536 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "reference takes at most 67108864 (2^26)")) << e;
+  EXPECT_TRUE(test::contains(e, "reference takes at most 67108864 (2^26)")) << e;
   e = refused("render -t yu-lod --width 1 --height 1 --spp 1000000000 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "--spp")) << e;
+  EXPECT_TRUE(test::contains(e, "--spp")) << e;
   e = refused("render --spp 1000000000 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "--spp")) << e;
+  EXPECT_TRUE(test::contains(e, "--spp")) << e;
 }
 
 TEST(AbsurdInput, SceneSizesNameTheirLimit) {
   const fs::path dir = test::scratch_dir();
   std::string e = refused("render sphere-in-room:size=10000000000 --width 1 --height 1 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "10000000]")) << e;
+  EXPECT_TRUE(test::contains(e, "10000000]")) << e;
   e = refused("render sphere-in-room:size=10000001 --width 1 --height 1 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "10000000]")) << e;
+  EXPECT_TRUE(test::contains(e, "10000000]")) << e;
 }
 
 // A file claiming more than it holds, or more than a scene may hold: refused from its
@@ -82,19 +80,19 @@ TEST(AbsurdInput, FileCountsNameTheirLimit) {
                                                          "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]}", 1) +
                               " --width 1 --height 1 -q -o x.png",
                           dir);
-  EXPECT_TRUE(contains(e, "absurd count 2147483648 (more than the limit of 2^28)")) << e;
+  EXPECT_TRUE(test::contains(e, "absurd count 2147483648 (more than the limit of 2^28)")) << e;
   // 2^27 elements (within an accessor's limit) in the same buffer.
   e = refused("render " + gltf("short.gltf", "{\"bufferView\":0,\"componentType\":5126,\"count\":134217728,"
                                              "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]}", 1) +
                   " --width 1 --height 1 -q -o x.png",
               dir);
-  EXPECT_TRUE(contains(e, "more than the limit of 33554432 vertices (2^25)")) << e;
+  EXPECT_TRUE(test::contains(e, "more than the limit of 33554432 vertices (2^25)")) << e;
   // 2^28 - 1 zeros from no bytes at all (an accessor without a bufferView).
   e = refused("render " + gltf("zeros.gltf", "{\"componentType\":5126,\"count\":268435455,\"type\":\"VEC3\","
                                              "\"min\":[0,0,0],\"max\":[0,0,0]}", 1) +
                   " --width 1 --height 1 -q -o x.png",
               dir);
-  EXPECT_TRUE(contains(e, "more than the limit of 33554432 vertices (2^25)")) << e;
+  EXPECT_TRUE(test::contains(e, "more than the limit of 33554432 vertices (2^25)")) << e;
   // A binary STL claiming 2^24 + 1 triangles.
   {
     std::string stl(80, ' ');
@@ -104,10 +102,10 @@ TEST(AbsurdInput, FileCountsNameTheirLimit) {
     std::ofstream(dir / "big.stl", std::ios::binary) << stl;
   }
   e = refused("render " + test::sh_quote((dir / "big.stl").string()) + " --width 1 --height 1 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "16777217 triangles: more than the limit of 16777216 (2^24)")) << e;
+  EXPECT_TRUE(test::contains(e, "16777217 triangles: more than the limit of 16777216 (2^24)")) << e;
   std::ofstream(dir / "big.off") << "OFF\n2000000000 2000000000 0\n0 0 0\n";
   e = refused("render " + test::sh_quote((dir / "big.off").string()) + " --width 1 --height 1 -q -o x.png", dir);
-  EXPECT_TRUE(contains(e, "header declares 2000000000 vertices but the file has only")) << e;
+  EXPECT_TRUE(test::contains(e, "header declares 2000000000 vertices but the file has only")) << e;
 }
 
 // Coordinates that overflow a float are named as such in every mesh format (not as "no faces"
@@ -131,7 +129,7 @@ TEST(AbsurdInput, OverflowingCoordinatesAreNonFiniteVertices) {
   for (const auto& f : files) {
     std::ofstream(dir / f.name) << f.text;
     const std::string e = refused("info " + test::sh_quote((dir / f.name).string()), dir);
-    EXPECT_TRUE(contains(e, "non-finite vertex")) << f.name << ": " << e;
+    EXPECT_TRUE(test::contains(e, "non-finite vertex")) << f.name << ": " << e;
   }
 }
 

@@ -27,14 +27,12 @@ std::string one_line_error(const std::string& args, const fs::path& dir) {
   return r.err;
 }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
 TEST(CliErrors, OptionParserErrorsAreOneLine) {
   const fs::path dir = test::scratch_dir();
-  EXPECT_TRUE(contains(one_line_error("render --width abc -q", dir), "--width"));
-  EXPECT_TRUE(contains(one_line_error("render --width 0 -q", dir), "--width"));
-  EXPECT_TRUE(contains(one_line_error("render --no-such-option -q", dir), "--no-such-option"));
-  EXPECT_TRUE(contains(one_line_error("render --spp -q", dir), "--spp"));
+  EXPECT_TRUE(test::contains(one_line_error("render --width abc -q", dir), "--width"));
+  EXPECT_TRUE(test::contains(one_line_error("render --width 0 -q", dir), "--width"));
+  EXPECT_TRUE(test::contains(one_line_error("render --no-such-option -q", dir), "--no-such-option"));
+  EXPECT_TRUE(test::contains(one_line_error("render --spp -q", dir), "--spp"));
   one_line_error("", dir);  // no subcommand
 }
 
@@ -43,21 +41,21 @@ TEST(CliErrors, HelpStillPrintsAndExitsZero) {
   for (const char* args : {"--help", "render --help", "techniques --help"}) {
     const test::CommandResult r = test::run_speculum(args, dir);
     EXPECT_EQ(r.status, 0) << args;
-    EXPECT_TRUE(contains(r.out, "Usage")) << args << r.out;
+    EXPECT_TRUE(test::contains(r.out, "Usage")) << args << r.out;
     EXPECT_TRUE(r.err.empty()) << args << r.err;
   }
 }
 
 TEST(CliErrors, MisspeltNamesGetASuggestion) {
   const fs::path dir = test::scratch_dir();
-  EXPECT_TRUE(contains(one_line_error("rendr sphere-in-room", dir), "did you mean 'render'?"));
-  EXPECT_TRUE(contains(one_line_error("render sphere-in-rom -q -o x.png", dir), "did you mean 'sphere-in-room'?"));
-  EXPECT_TRUE(contains(one_line_error("render -t envmapp -q -o x.png", dir), "did you mean 'envmap'?"));
-  EXPECT_TRUE(contains(one_line_error("render -t distance-map --param linear_step=4 -q -o x.png", dir),
+  EXPECT_TRUE(test::contains(one_line_error("rendr sphere-in-room", dir), "did you mean 'render'?"));
+  EXPECT_TRUE(test::contains(one_line_error("render sphere-in-rom -q -o x.png", dir), "did you mean 'sphere-in-room'?"));
+  EXPECT_TRUE(test::contains(one_line_error("render -t envmapp -q -o x.png", dir), "did you mean 'envmap'?"));
+  EXPECT_TRUE(test::contains(one_line_error("render -t distance-map --param linear_step=4 -q -o x.png", dir),
                        "did you mean 'linear_steps'?"));
-  EXPECT_TRUE(contains(one_line_error("render --aov albdo -q -o x.exr", dir), "did you mean 'albedo'?"));
+  EXPECT_TRUE(test::contains(one_line_error("render --aov albdo -q -o x.exr", dir), "did you mean 'albedo'?"));
   // Unrelated words get no suggestion.
-  EXPECT_FALSE(contains(one_line_error("render -t zzzzzzzz -q -o x.png", dir), "did you mean"));
+  EXPECT_FALSE(test::contains(one_line_error("render -t zzzzzzzz -q -o x.png", dir), "did you mean"));
   EXPECT_FALSE(fs::exists(dir / "x.png"));
 }
 
@@ -67,10 +65,10 @@ TEST(CliErrors, BadParamValuesNameTheParameterTechniqueAndRange) {
     const std::string e = one_line_error(std::string("render -t distance-map --width 16 --height 16 -q --param "
                                                      "linear_steps=") + value + " -o x.png",
                                          dir);
-    EXPECT_TRUE(contains(e, "linear_steps")) << e;
+    EXPECT_TRUE(test::contains(e, "linear_steps")) << e;
     if (std::string(value) != "nan" && std::string(value) != "inf") {
-      EXPECT_TRUE(contains(e, "'distance-map'")) << e;
-      EXPECT_TRUE(contains(e, "integer in [1, ")) << e;
+      EXPECT_TRUE(test::contains(e, "'distance-map'")) << e;
+      EXPECT_TRUE(test::contains(e, "integer in [1, ")) << e;
     }
   }
   EXPECT_FALSE(fs::exists(dir / "x.png"));
@@ -78,19 +76,19 @@ TEST(CliErrors, BadParamValuesNameTheParameterTechniqueAndRange) {
 
 TEST(CliErrors, AbsurdSizesAreRejectedUpFrontNamingTheLimit) {
   const fs::path dir = test::scratch_dir();
-  EXPECT_TRUE(contains(one_line_error("render --width 100000 -q -o x.png", dir), "--width"));
-  EXPECT_TRUE(contains(one_line_error("render --cube-size 100000 -q -o x.png", dir), "--cube-size"));
-  EXPECT_TRUE(contains(one_line_error("render --shadow-size 100000 -q -o x.png", dir), "--shadow-size"));
-  EXPECT_TRUE(contains(one_line_error("render --spp 1000000 -q -o x.png", dir), "--spp"));
+  EXPECT_TRUE(test::contains(one_line_error("render --width 100000 -q -o x.png", dir), "--width"));
+  EXPECT_TRUE(test::contains(one_line_error("render --cube-size 100000 -q -o x.png", dir), "--cube-size"));
+  EXPECT_TRUE(test::contains(one_line_error("render --shadow-size 100000 -q -o x.png", dir), "--shadow-size"));
+  EXPECT_TRUE(test::contains(one_line_error("render --spp 1000000 -q -o x.png", dir), "--spp"));
   const std::string samples = one_line_error("render --width 16384 --height 16384 -q -o x.png", dir);
-  EXPECT_TRUE(contains(samples, "samples")) << samples;
+  EXPECT_TRUE(test::contains(samples, "samples")) << samples;
   // Each technique's own limit (Technique::max_samples), named in the message.
-  EXPECT_TRUE(contains(samples, "envmap takes at most 8388608 (2^23)")) << samples;
+  EXPECT_TRUE(test::contains(samples, "envmap takes at most 8388608 (2^23)")) << samples;
   const std::string rays = one_line_error("render -t ray-hierarchy --width 4096 --height 2048 -q -o x.png", dir);
-  EXPECT_TRUE(contains(rays, "ray-hierarchy takes at most 4194304 (2^22)")) << rays;
+  EXPECT_TRUE(test::contains(rays, "ray-hierarchy takes at most 4194304 (2^22)")) << rays;
   const std::string paths = one_line_error("render -t reference --width 16384 --height 16384 -q -o x.png", dir);
-  EXPECT_TRUE(contains(paths, "reference takes at most 67108864 (2^26)")) << paths;
-  EXPECT_TRUE(contains(one_line_error("render sphere-in-room:size=1e13 -q -o x.png", dir), "size"));
+  EXPECT_TRUE(test::contains(paths, "reference takes at most 67108864 (2^26)")) << paths;
+  EXPECT_TRUE(test::contains(one_line_error("render sphere-in-room:size=1e13 -q -o x.png", dir), "size"));
   EXPECT_FALSE(fs::exists(dir / "x.png"));
 }
 
@@ -100,21 +98,21 @@ TEST(CliErrors, WriteFailuresSayWhyAndNameTheUsersPath) {
   // A directory that does not exist.
   const std::string missing = (dir / "no-such-dir" / "out.png").string();
   std::string e = one_line_error(small + test::sh_quote(missing), dir);
-  EXPECT_TRUE(contains(e, missing)) << e;
-  EXPECT_TRUE(contains(e, "does not exist")) << e;
+  EXPECT_TRUE(test::contains(e, missing)) << e;
+  EXPECT_TRUE(test::contains(e, "does not exist")) << e;
   // A "directory" that is a file.
   std::ofstream(dir / "file.txt") << "x";
   const std::string under_file = (dir / "file.txt" / "out.exr").string();
   e = one_line_error(small + test::sh_quote(under_file), dir);
-  EXPECT_TRUE(contains(e, under_file)) << e;
-  EXPECT_TRUE(contains(e, "not a directory")) << e;
+  EXPECT_TRUE(test::contains(e, under_file)) << e;
+  EXPECT_TRUE(test::contains(e, "not a directory")) << e;
   // The output path is a directory.
   fs::create_directories(dir / "taken.png");
   e = one_line_error(small + test::sh_quote((dir / "taken.png").string()), dir);
-  EXPECT_TRUE(contains(e, "is a directory")) << e;
+  EXPECT_TRUE(test::contains(e, "is a directory")) << e;
   // A file system that refuses writes (/proc, even for root).
   e = one_line_error(small + "/proc/speculum-out.png", dir);
-  EXPECT_TRUE(contains(e, "/proc/speculum-out.png")) << e;
+  EXPECT_TRUE(test::contains(e, "/proc/speculum-out.png")) << e;
   // Nothing left behind: the scratch directory holds only what the test made.
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_TRUE(entry.path().filename() == "file.txt" || entry.path().filename() == "taken.png" ||

@@ -9,19 +9,10 @@
 #include "apps/techniques/technique_table.h"
 #include "core/scene_loader.h"
 #include "parallel/executor.h"
+#include "tests/apps/node_counter.h"
 
 namespace speculum::pipeline {
 namespace {
-
-double counter(const FrameResult& r, const std::string& node, const std::string& name) {
-  for (const auto& n : r.report.nodes)
-    if (n.name == node) {
-      const auto it = n.counters.find(name);
-      if (it != n.counters.end()) return it->second;
-    }
-  ADD_FAILURE() << "no counter " << node << "/" << name;
-  return -1.0;
-}
 
 FrameResult render(const Scene& s, const std::string& technique, const std::string& param, int value,
                    int bounces = 0) {
@@ -46,10 +37,10 @@ TEST(FallbackCounters, PlanarMirrorDepthExhaustedIsWhatTheNextDepthRenders) {
   for (int k = 0; k <= 2; ++k) {
     SCOPED_TRACE(k);
     const FrameResult at = render(s, "planar-mirror", "depth", k), next = render(s, "planar-mirror", "depth", k + 1);
-    const double exhausted = counter(at, "planar_mirror_reflect", "fallback_depth_exhausted");
+    const double exhausted = node_counter(at, "planar_mirror_reflect", "fallback_depth_exhausted");
     EXPECT_GT(exhausted, 0.0);  // the corridor's mirrors face each other: every depth stops somewhere
-    EXPECT_EQ(exhausted, counter(next, "planar_mirror_reflect", "mirror_samples") -
-                             counter(at, "planar_mirror_reflect", "mirror_samples"));
+    EXPECT_EQ(exhausted, node_counter(next, "planar_mirror_reflect", "mirror_samples") -
+                             node_counter(at, "planar_mirror_reflect", "mirror_samples"));
   }
 }
 
@@ -60,9 +51,9 @@ TEST(FallbackCounters, RayHierarchyDepthExhaustedIsTheNextGeneration) {
     SCOPED_TRACE(b);
     const FrameResult at = render(s, "ray-hierarchy", "", 0, b), next = render(s, "ray-hierarchy", "", 0, b + 1);
     const std::string last = b == 1 ? "shade_hits" : "shade_hits_" + std::to_string(b);
-    const double exhausted = counter(at, last, "fallback_depth_exhausted");
+    const double exhausted = node_counter(at, last, "fallback_depth_exhausted");
     EXPECT_GT(exhausted, 0.0);  // mirrors facing each other: every generation meets a mirror
-    EXPECT_EQ(exhausted, counter(next, "bounce_rays_" + std::to_string(b + 1), "rays"));
+    EXPECT_EQ(exhausted, node_counter(next, "bounce_rays_" + std::to_string(b + 1), "rays"));
   }
 }
 
@@ -73,15 +64,15 @@ TEST(FallbackCounters, RayHierarchyDepthExhaustedIsTheNextGeneration) {
 TEST(FallbackCounters, ConeTracingDoubleConesOnTheBowlOnly) {
   const Scene bowl = load_scene("bowl:size=3000"), room = load_scene("sphere-in-room:size=3000");
   const FrameResult b = render(bowl, "cone-tracing", "", 0), r = render(room, "cone-tracing", "", 0);
-  EXPECT_GT(counter(b, "pixel_cones", "fallback_double_cone"), 100.0);
-  EXPECT_EQ(counter(r, "pixel_cones", "fallback_double_cone"), 0.0);
+  EXPECT_GT(node_counter(b, "pixel_cones", "fallback_double_cone"), 100.0);
+  EXPECT_EQ(node_counter(r, "pixel_cones", "fallback_double_cone"), 0.0);
   for (const FrameResult* f : {&b, &r})
-    EXPECT_EQ(counter(*f, "pixel_cones", "rays"),
-              counter(*f, "pixel_cones", "cones") + counter(*f, "pixel_cones", "fallback_double_cone") +
-                  counter(*f, "pixel_cones", "refraction_rays"));
+    EXPECT_EQ(node_counter(*f, "pixel_cones", "rays"),
+              node_counter(*f, "pixel_cones", "cones") + node_counter(*f, "pixel_cones", "fallback_double_cone") +
+                  node_counter(*f, "pixel_cones", "refraction_rays"));
   const FrameResult few = render(room, "cone-tracing", "kept", 1);
-  EXPECT_GT(counter(few, "cone_triangle_coverage", "kept_overflow"), 0.0);
-  EXPECT_EQ(counter(few, "cone_triangle_coverage", "max_kept"), 1.0);
+  EXPECT_GT(node_counter(few, "cone_triangle_coverage", "kept_overflow"), 0.0);
+  EXPECT_EQ(node_counter(few, "cone_triangle_coverage", "max_kept"), 1.0);
 }
 
 // Layered distance map: each specular hit past the last bounce is one more search at the
@@ -92,9 +83,9 @@ TEST(FallbackCounters, LayeredDepthExhaustedIsTheNextBouncesSearches) {
     SCOPED_TRACE(b);
     const FrameResult at = render(s, "layered-distance-map", "bounces", b),
                       next = render(s, "layered-distance-map", "bounces", b + 1);
-    const double exhausted = counter(at, "layered_reflect", "fallback_depth_exhausted");
+    const double exhausted = node_counter(at, "layered_reflect", "fallback_depth_exhausted");
     EXPECT_GT(exhausted, 0.0);
-    EXPECT_EQ(exhausted, counter(next, "layered_reflect", "searches") - counter(at, "layered_reflect", "searches"));
+    EXPECT_EQ(exhausted, node_counter(next, "layered_reflect", "searches") - node_counter(at, "layered_reflect", "searches"));
   }
 }
 

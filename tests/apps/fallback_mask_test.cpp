@@ -11,6 +11,7 @@
 #include "core/fallback_mask.h"
 #include "core/scene_loader.h"
 #include "parallel/executor.h"
+#include "tests/apps/node_counter.h"
 
 namespace speculum::pipeline {
 namespace {
@@ -45,15 +46,6 @@ Captured render(const Scene& s, const std::string& technique, int bounces, bool 
   return c;
 }
 
-double counter(const FrameResult& r, const std::string& node, const std::string& name) {
-  const par::NodeRecord* n = r.report.find(node);
-  if (!n || !n->counters.count(name)) {
-    ADD_FAILURE() << "no counter " << node << "/" << name;
-    return -1.0;
-  }
-  return n->counters.at(name);
-}
-
 const FallbackMask& mask(const Captured& c, const std::string& node) {
   static const FallbackMask none;
   const auto it = c.masks.find(node);
@@ -72,7 +64,7 @@ TEST(FallbackMask, RayHierarchyMarksEveryExhaustedSample) {
   const Scene s = load_scene("water-slab:size=3000");
   const Captured c = render(s, "ray-hierarchy", 1, true);
   const FallbackMask& m = mask(c, "shade_hits");
-  const double exhausted = counter(c.frame, "shade_hits", "fallback_depth_exhausted");
+  const double exhausted = node_counter(c.frame, "shade_hits", "fallback_depth_exhausted");
   EXPECT_GT(exhausted, 0.0);  // glass at one bounce always continues
   EXPECT_EQ(double(m.count(Fallback::depth_exhausted)), exhausted);
   EXPECT_EQ(m.count(Fallback::depth_exhausted), m.reason.size() - m.count(Fallback::none));
@@ -84,7 +76,7 @@ TEST(FallbackMask, YuLodMarksEveryRefractorSample) {
   const Scene s = load_scene("glass-sphere:size=3000");
   const Captured c = render(s, "yu-lod", 0, true);
   const FallbackMask& m = mask(c, "refractor_environment");
-  const double refractors = counter(c.frame, "refractor_environment", "fallback_refractor_environment");
+  const double refractors = node_counter(c.frame, "refractor_environment", "fallback_refractor_environment");
   EXPECT_GT(refractors, 0.0);
   EXPECT_EQ(double(m.count(Fallback::refractor_environment)), refractors);
   expect_same_image(c, render(s, "yu-lod", 0, false));
@@ -96,8 +88,8 @@ TEST(FallbackMask, LayeredMarksTheSamplesWhosePathsFellBack) {
   const Scene s = load_scene("water-slab:size=3000");
   const Captured c = render(s, "layered-distance-map", 0, true);
   const FallbackMask& m = mask(c, "layered_reflect");
-  const double exhausted = counter(c.frame, "layered_reflect", "fallback_depth_exhausted");
-  const double missed = counter(c.frame, "layered_reflect", "fallback_search_missed");
+  const double exhausted = node_counter(c.frame, "layered_reflect", "fallback_depth_exhausted");
+  const double missed = node_counter(c.frame, "layered_reflect", "fallback_search_missed");
   const std::size_t marked = m.reason.size() - m.count(Fallback::none);
   EXPECT_GT(marked, 0u);
   EXPECT_LE(double(marked), exhausted + missed);

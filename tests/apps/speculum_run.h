@@ -41,6 +41,9 @@ inline std::filesystem::path scratch_dir() {
   return dir;
 }
 
+// Whether `s` contains `part` (the CLI tests check messages by their key phrases).
+inline bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
 inline std::string sh_quote(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);

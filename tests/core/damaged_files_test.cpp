@@ -20,6 +20,7 @@
 
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "tests/core/scene_test_util.h"
 
 namespace speculum {
 namespace {
@@ -112,16 +113,11 @@ Outcome damage(const fs::path& dir, const std::string& name, const std::string& 
   return out;
 }
 
-fs::path scratch(const std::string& what) {
-  const fs::path dir = fs::temp_directory_path() / ("speculum_damaged_" + what + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path damaged_scratch(const std::string& what) { return testing::temp_dir("damaged_" + what); }
 
 TEST(DamagedFiles, TestDataFilesCutAndFlippedLoadOrAreRejected) {
   const fs::path good = fs::path(SPECULUM_TEST_DATA) / "good";
-  const fs::path dir = scratch("good");
+  const fs::path dir = damaged_scratch("good");
   for (const char* companion : {"quad.mtl", "checker.png"}) fs::copy_file(good / companion, dir / companion);
   std::size_t rejected = 0;
   for (const char* name : {"triangle.gltf", "triangle.glb", "tetra.obj", "quad.obj", "tetra.off", "tetra.ply", "tetra.stl"}) {
@@ -139,7 +135,7 @@ TEST(DamagedFiles, TestDataFilesCutAndFlippedLoadOrAreRejected) {
 }
 
 TEST(DamagedFiles, BinaryPlyBothEndiansAndBinaryStlCutAndFlipped) {
-  const fs::path dir = scratch("binary");
+  const fs::path dir = damaged_scratch("binary");
   const struct {
     const char* name;
     std::string bytes;
@@ -159,7 +155,7 @@ TEST(DamagedFiles, BinaryPlyBothEndiansAndBinaryStlCutAndFlipped) {
 TEST(DamagedFiles, RealWorldFilesCutAndFlippedLoadOrAreRejected) {
   const fs::path models = "/usr/share/assimp/models";
   SPECULUM_REQUIRE(fs::exists(models), "the Debian package assimp-testmodels");
-  const fs::path dir = scratch("assimp");
+  const fs::path dir = damaged_scratch("assimp");
   std::size_t tried = 0;
   for (const char* rel : {"glTF2/BoxTextured-glTF-Binary/BoxTextured.glb", "glTF2/BoxTextured-glTF-Embedded/BoxTextured.gltf",
                           "PLY/cube_binary.ply", "PLY/cube.ply", "STL/Spider_binary.stl",

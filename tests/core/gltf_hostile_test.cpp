@@ -10,20 +10,14 @@
 
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "tests/core/scene_test_util.h"
 
 namespace speculum {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("speculum_hostile_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-void write(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
+fs::path hostile_scratch(const std::string& name) { return testing::temp_dir("hostile_" + name); }
 
 // One triangle (positions in a data URI), optionally a base-colour image at `image_uri`,
 // and `buffer_view` as the position bufferView's JSON.
@@ -59,25 +53,25 @@ std::string load_error(const fs::path& file, bool allow = false) {
 }
 
 TEST(GltfHostile, ValidTriangleLoads) {
-  const fs::path dir = scratch("valid");
-  write(dir / "ok.gltf", triangle_gltf());
+  const fs::path dir = hostile_scratch("valid");
+  testing::write_text(dir / "ok.gltf", triangle_gltf());
   EXPECT_EQ(load_error(dir / "ok.gltf"), "");
 }
 
 TEST(GltfHostile, DeepNestingIsRejectedBeforeParsing) {
-  const fs::path dir = scratch("deep");
+  const fs::path dir = hostile_scratch("deep");
   const std::string deep = std::string(300000, '[') + std::string(300000, ']');
-  write(dir / "deep.gltf", R"({"asset":{"version":"2.0"},"extras":)" + deep + "}");
+  testing::write_text(dir / "deep.gltf", R"({"asset":{"version":"2.0"},"extras":)" + deep + "}");
   EXPECT_NE(load_error(dir / "deep.gltf").find("JSON nests deeper than 256 levels"), std::string::npos);
   // Brackets inside strings do not count.
   std::string quoted = triangle_gltf();
   quoted.insert(quoted.size() - 1, R"(,"extras":{"s":")" + std::string(1000, '[') + R"("})");
-  write(dir / "quoted.gltf", quoted);
+  testing::write_text(dir / "quoted.gltf", quoted);
   EXPECT_EQ(load_error(dir / "quoted.gltf"), "");
 }
 
 TEST(GltfHostile, SchemaMinimumsOfByteRangesAreChecked) {
-  const fs::path dir = scratch("minimums");
+  const fs::path dir = hostile_scratch("minimums");
   const struct {
     const char* name;
     std::string json;
@@ -94,7 +88,7 @@ TEST(GltfHostile, SchemaMinimumsOfByteRangesAreChecked) {
       {"huge_count", triangle_gltf("", R"({"buffer":0,"byteLength":36})", "1e300"), "accessors[0].count is"},
   };
   for (const auto& c : cases) {
-    write(dir / (std::string(c.name) + ".gltf"), c.json);
+    testing::write_text(dir / (std::string(c.name) + ".gltf"), c.json);
     const std::string e = load_error(dir / (std::string(c.name) + ".gltf"));
     EXPECT_NE(e.find(c.message), std::string::npos) << c.name << ": " << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
@@ -102,11 +96,11 @@ TEST(GltfHostile, SchemaMinimumsOfByteRangesAreChecked) {
 }
 
 TEST(GltfHostile, UrisOutsideTheSceneFolderAreRefusedUnlessAllowed) {
-  const fs::path root = scratch("outside");
+  const fs::path root = hostile_scratch("outside");
   const fs::path scene_dir = root / "scene";
   fs::create_directories(scene_dir);
-  write(root / "secret.png", "not an image");  // outside the scene's folder
-  write(scene_dir / "inside.png", "not an image either");
+  testing::write_text(root / "secret.png", "not an image");  // outside the scene's folder
+  testing::write_text(scene_dir / "inside.png", "not an image either");
   fs::create_symlink(root / "secret.png", scene_dir / "link.png");
   const struct {
     const char* name;
@@ -120,7 +114,7 @@ TEST(GltfHostile, UrisOutsideTheSceneFolderAreRefusedUnlessAllowed) {
   };
   for (const auto& c : cases) {
     const fs::path file = scene_dir / (std::string(c.name) + ".gltf");
-    write(file, triangle_gltf(c.uri));
+    testing::write_text(file, triangle_gltf(c.uri));
     const std::string e = load_error(file);
     if (c.refused) {
       EXPECT_NE(e.find("outside the scene's folder (--allow-external-files allows it)"), std::string::npos)

@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "tests/core/scene_test_util.h"
 
 namespace speculum {
 namespace {
@@ -70,18 +71,16 @@ struct Asset {
   }
 };
 
-fs::path scratch() {
+fs::path spec_rules_dir() {
   const fs::path dir = fs::temp_directory_path() / ("speculum_spec_rules_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir;
 }
 
-void write(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
-
 // The InputError's message ("" when the file loads); `scene` receives the loaded scene.
 std::string load_error(const std::string& name, const std::string& contents, Scene* scene = nullptr) {
-  const fs::path file = scratch() / name;
-  write(file, contents);
+  const fs::path file = spec_rules_dir() / name;
+  testing::write_text(file, contents);
   try {
     Scene s = load_scene(file.string());
     if (scene) *scene = std::move(s);
@@ -296,7 +295,7 @@ TEST(GltfSpecRules, MissingImageBesideASceneInTheCurrentDirectoryIsNotOutside) {
   a.primitive_extra = R"(,"material":0)";
   a.top_extra = R"(,"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],)"
                 R"("textures":[{"source":0}],"images":[{"uri":"missing.png"}])";
-  const fs::path dir = scratch();
+  const fs::path dir = spec_rules_dir();
   std::ofstream(dir / "cwd.gltf") << a.json();
   const fs::path before = fs::current_path();
   fs::current_path(dir);

@@ -3,6 +3,7 @@
 // under refinement, star-shapedness, and subdivision properties that must hold.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -20,8 +21,6 @@ namespace {
 
 using namespace speculum::mesh;
 using procedural::MeshData;
-
-constexpr double kPi = 3.14159265358979323846;
 
 Scene one_object(MeshData m) {
   procedural::SceneBuilder b("test");
@@ -112,7 +111,7 @@ TEST(MeshProcessing, CylinderMeanCurvatureIsOneOverTwoRadii) {
   const double r = 0.8;
   for (int n : {8, 16, 32, 64}) {
     const MeshData grid = procedural::parametric_grid(n, 4, [&](float u, float v) {
-      const float a = float(2.0 * kPi) * u;
+      const float a = float(2.0 * std::numbers::pi) * u;
       return glm::vec3(float(r) * std::sin(a), 2.0f * v, float(r) * std::cos(a));
     });
     const ObjectMesh om = welded(grid);

@@ -22,7 +22,7 @@
 namespace speculum {
 namespace {
 
-std::string problem(const std::string& text) {
+std::string off_problem(const std::string& text) {
   try {
     (void)read_off("t.off", text);
   } catch (const InputError& e) {
@@ -81,9 +81,9 @@ TEST(OffReader, HomogeneousAndDimensionedVertices) {
   EXPECT_EQ(read_off("t.off", "4OFF\n3 1 0\n0 0 0 2\n4 0 0 4\n0 0.5 0 0.5\n" + faces).positions, kTriangle);
   EXPECT_EQ(read_off("t.off", "nOFF\n3\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n" + faces).positions, kTriangle);
   EXPECT_EQ(read_off("t.off", "4nOFF\n3\n3 1 0\n0 0 0 1\n2 0 0 2\n0 1 0 1\n" + faces).positions, kTriangle);
-  EXPECT_EQ(problem("nOFF\n4\n3 1 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n" + faces),
+  EXPECT_EQ(off_problem("nOFF\n4\n3 1 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n" + faces),
             "OFF: 4-dimensional vertices (nOFF) cannot be rendered, only 3-D ones");
-  EXPECT_EQ(problem("4OFF\n3 1 0\n0 0 0 1\n1 0 0 0\n0 1 0 1\n" + faces),
+  EXPECT_EQ(off_problem("4OFF\n3 1 0\n0 0 0 1\n1 0 0 0\n0 1 0 1\n" + faces),
             "non-finite vertex 1 (a coordinate is NaN, infinite or overflows a float, or its homogeneous w is 0)");
 }
 
@@ -112,17 +112,17 @@ TEST(OffReader, BinaryBigEndian) {
   EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 1, 2}));
   EXPECT_EQ(m.short_faces, 1u);
   // Truncated, absurd counts, a corner count past the data, an index out of range.
-  EXPECT_EQ(problem(head + counts + verts + faces.substr(0, 10)),
+  EXPECT_EQ(off_problem(head + counts + verts + faces.substr(0, 10)),
             "OFF face 0 claims 3 corners but the file holds only 6 more bytes");
-  EXPECT_EQ(problem(head + counts + verts + faces.substr(0, 24)),
+  EXPECT_EQ(off_problem(head + counts + verts + faces.substr(0, 24)),
             "binary OFF data truncated: the file ends before face 0's colour");
-  EXPECT_EQ(problem(head + big_endian({0x7fffffff, 1, 0}) + verts),
+  EXPECT_EQ(off_problem(head + big_endian({0x7fffffff, 1, 0}) + verts),
             "header declares 2147483647 vertices but the file has only 69 bytes");
-  EXPECT_EQ(problem(head + counts + verts + big_endian({0x40000000, 0, 1, 2})),
+  EXPECT_EQ(off_problem(head + counts + verts + big_endian({0x40000000, 0, 1, 2})),
             "OFF face 0 claims 1073741824 corners but the file holds only 12 more bytes");
-  EXPECT_EQ(problem(head + counts + verts + big_endian({3, 0, 1, 3, 0, 3, 0, 1, 2, 0})),
+  EXPECT_EQ(off_problem(head + counts + verts + big_endian({3, 0, 1, 3, 0, 3, 0, 1, 2, 0})),
             "OFF face 0: vertex index 3 is out of range (3 vertices)");
-  EXPECT_EQ(problem(head + big_endian({3, 0xffffffffu, 0}) + verts), "binary OFF header: the face count is negative");
+  EXPECT_EQ(off_problem(head + big_endian({3, 0xffffffffu, 0}) + verts), "binary OFF header: the face count is negative");
 }
 
 TEST(OffReader, ShortAndDegenerateFacesAreCountedAndLeftOut) {
@@ -135,41 +135,41 @@ TEST(OffReader, ShortAndDegenerateFacesAreCountedAndLeftOut) {
 
 TEST(OffReader, MalformedFilesNameTheProblem) {
   const std::string v = "0 0 0\n1 0 0\n0 1 0\n";
-  EXPECT_EQ(problem(""), "file holds no OFF data (only white space or comments)");
-  EXPECT_EQ(problem("PLY\n"), "missing OFF header (neither the OFF keyword nor a vertex count comes first)");
-  EXPECT_EQ(problem("XOFF\n3 1 0\n"), "OFF header: 'XOFF' is not an OFF keyword ([ST][C][N][4][n]OFF)");
-  EXPECT_EQ(problem("OFF\n3 x 0\n"), "OFF header: the face count 'x' is not a whole number below 10^12");
+  EXPECT_EQ(off_problem(""), "file holds no OFF data (only white space or comments)");
+  EXPECT_EQ(off_problem("PLY\n"), "missing OFF header (neither the OFF keyword nor a vertex count comes first)");
+  EXPECT_EQ(off_problem("XOFF\n3 1 0\n"), "OFF header: 'XOFF' is not an OFF keyword ([ST][C][N][4][n]OFF)");
+  EXPECT_EQ(off_problem("OFF\n3 x 0\n"), "OFF header: the face count 'x' is not a whole number below 10^12");
   // Free-form white space: a missing edge count takes the first coordinate's place.
-  EXPECT_EQ(problem("OFF\n3 1\n" + v), "OFF data truncated: the file ends before vertex 2");
+  EXPECT_EQ(off_problem("OFF\n3 1\n" + v), "OFF data truncated: the file ends before vertex 2");
   // Absurd counts are refused from the header, before anything is reserved.
-  EXPECT_EQ(problem("OFF\n1000000000 1 0\n0 0 0\n"), "header declares 1000000000 vertices but the file has only 25 bytes");
-  EXPECT_EQ(problem("OFF\n3 1000000000 0\n" + v), "header declares 1000000000 faces but the file has only 37 bytes");
-  EXPECT_EQ(problem("OFF\n3 1 0\n" + v + "400000000 0 1 2\n"),
+  EXPECT_EQ(off_problem("OFF\n1000000000 1 0\n0 0 0\n"), "header declares 1000000000 vertices but the file has only 25 bytes");
+  EXPECT_EQ(off_problem("OFF\n3 1000000000 0\n" + v), "header declares 1000000000 faces but the file has only 37 bytes");
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n" + v + "400000000 0 1 2\n"),
             "OFF face 0 claims 400000000 corners but the file holds only 7 more bytes");
-  EXPECT_EQ(problem("OFF\n3 1 0\n" + v + "-50 0 1 2\n"), "OFF face 0 has a negative corner count '-50'");
-  EXPECT_EQ(problem("OFF\n3 1 0\n" + v + "3 0 1 3\n"), "OFF face 0: vertex index 3 is out of range (3 vertices)");
-  EXPECT_EQ(problem("OFF\n3 1 0\n" + v + "3 0 -1 2\n"), "OFF face 0: vertex index -1 is out of range (3 vertices)");
-  EXPECT_EQ(problem("OFF\n3 1 0\n" + v + "3 0 1 2.5\n"), "OFF face 0: vertex index '2.5' is not a whole number");
-  EXPECT_EQ(problem("OFF\n3 2 0\n" + v + "3 0 1 2\n"),
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n" + v + "-50 0 1 2\n"), "OFF face 0 has a negative corner count '-50'");
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n" + v + "3 0 1 3\n"), "OFF face 0: vertex index 3 is out of range (3 vertices)");
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n" + v + "3 0 -1 2\n"), "OFF face 0: vertex index -1 is out of range (3 vertices)");
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n" + v + "3 0 1 2.5\n"), "OFF face 0: vertex index '2.5' is not a whole number");
+  EXPECT_EQ(off_problem("OFF\n3 2 0\n" + v + "3 0 1 2\n"),
             "OFF data truncated: the file ends before face 1 (the header declares 2 faces)");
-  EXPECT_EQ(problem("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n"),
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n"),
             "OFF data truncated: the file ends before face 0 (the header declares 1 faces)");
-  EXPECT_EQ(problem("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1\n"), "OFF data truncated: the file ends before vertex 2");
-  EXPECT_EQ(problem("OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n"), "OFF vertex 1: 'zero' is not a number");
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1\n"), "OFF data truncated: the file ends before vertex 2");
+  EXPECT_EQ(off_problem("OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n"), "OFF vertex 1: 'zero' is not a number");
   // Two faces on one line: the second face's values are read as the first one's colour (at
   // most 4 numbers), and the second face is missing.
-  EXPECT_EQ(problem("OFF\n3 2 0\n" + v + "3 0 1 2 3 2 1 0\n"),
+  EXPECT_EQ(off_problem("OFF\n3 2 0\n" + v + "3 0 1 2 3 2 1 0\n"),
             "OFF data truncated: the file ends before face 1 (the header declares 2 faces)");
-  EXPECT_EQ(problem("OFF\n3 2 0\n" + v + "3 0 1 2 4 2 1 0 9\n"),
+  EXPECT_EQ(off_problem("OFF\n3 2 0\n" + v + "3 0 1 2 4 2 1 0 9\n"),
             "OFF face 0: '9' after its corners is not part of a colour (0 to 4 numbers to the end of the line)");
-  EXPECT_EQ(problem("COFF\n3 1 0\n0 0 0 1 1 1 1 1\n1 0 0\n0 1 0\n3 0 1 2\n"), "OFF vertex 0: more than 4 colour values");
+  EXPECT_EQ(off_problem("COFF\n3 1 0\n0 0 0 1 1 1 1 1\n1 0 0\n0 1 0\n3 0 1 2\n"), "OFF vertex 0: more than 4 colour values");
 }
 
 // Coordinates that overflow a float (or a double), NaN and infinity: the vertex is named.
 TEST(OffReader, NonFiniteVerticesAreNamed) {
   for (const char* bad : {"1e39", "-1e39", "1e999", "nan", "inf", "-inf"}) {
     SCOPED_TRACE(bad);
-    EXPECT_EQ(problem(std::string("OFF\n3 1 0\n0 0 0\n1 ") + bad + " 0\n0 1 0\n3 0 1 2\n"),
+    EXPECT_EQ(off_problem(std::string("OFF\n3 1 0\n0 0 0\n1 ") + bad + " 0\n0 1 0\n3 0 1 2\n"),
               "non-finite vertex 1 (a coordinate is NaN, infinite or overflows a float)");
   }
   // Below the smallest float is zero, not an error.

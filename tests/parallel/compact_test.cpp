@@ -86,7 +86,7 @@ TEST(Compact, BothFormsEqualSequentialFilterForEverySize) {
 // 16M flags at a middle ratio and at the ends, both forms, 1/2/8 threads × W = 1, 4, 8, 16
 // (the serial filter is the reference, so every thread count and width gives the same indices).
 TEST(Compact, SixteenMillion) {
-  const std::size_t n = (std::size_t(16) << 20) + 5;
+  const std::size_t n = kLargeSize + 5;
   for (int percent : {37, 0, 100}) {
     const auto keep = flags(n, percent, 5);
     const auto ref = serial_filter(keep);
@@ -176,7 +176,7 @@ TEST(Compact, EveryKernelWidthAndThreadCountEqualsSerial) {
 // against the serial filter.
 void check_every_ratio(std::size_t n, std::initializer_list<std::size_t> block_sizes) {
   std::vector<std::uint32_t> out;
-  for (int percent = 0; percent <= 100; ++percent) {
+  for (int percent = 0; percent <= 100; percent += kPercentStep) {
     const auto keep = flags(n, percent, n + std::size_t(percent));
     const auto ref = serial_filter(keep);
     for (int w : kLaneWidths)

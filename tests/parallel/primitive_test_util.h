@@ -29,6 +29,25 @@ void for_each_lane_width(F&& f) {
   for (int w : kLaneWidths) dispatch_lanes(w, f);
 }
 
+// The large size class: 16M elements. Under a sanitizer (SPECULUM_SANITIZED, defined by the
+// sanitizer builds) 4M: past every size threshold of parallel/ (streaming stores and uncached
+// scans from 8 MiB, many chunks per thread) like 16M, at a quarter of the time, since the
+// instrumented loops run 5 to 15 times slower.
+#ifdef SPECULUM_SANITIZED
+inline constexpr std::size_t kLargeSize = std::size_t(4) << 20;
+#else
+inline constexpr std::size_t kLargeSize = std::size_t(16) << 20;
+#endif
+
+// The kept shares (percent) the ratio sweeps visit: every one from 0 to 100, and every tenth
+// under a sanitizer (the sanitizers look for memory and thread errors, which do not depend
+// on the exact share; the normal build keeps the exhaustive sweep).
+#ifdef SPECULUM_SANITIZED
+inline constexpr int kPercentStep = 10;
+#else
+inline constexpr int kPercentStep = 1;
+#endif
+
 // 0, 1, odd, just over a stream, scan, scatter and compaction chunk (16M cases are separate).
 inline const std::vector<std::size_t>& sizes() {
   static const std::vector<std::size_t> s = {0, 1, 7, 12345, kStreamChunk + 1, kScanChunk + 1, kScatterChunk + 3,

@@ -103,7 +103,7 @@ TEST(RadixSortWidth, StreamingOutputUnalignedSpansEqualStableSort) {
 // throughout. 20-bit keys: about 16 copies of each key, so stability is visible; 32-bit
 // keys: two in-cache passes per bucket after the top-digit scatter.
 TEST(RadixSortWidth, SixteenMillionKeysEqualStableSort) {
-  std::vector<std::uint32_t> keys(std::size_t(16) << 20);
+  std::vector<std::uint32_t> keys(kLargeSize);
   RadixSortScratch<std::uint32_t> scratch;
   for (std::uint32_t mask : {0xfffffu, 0xffffffffu}) {
     for (std::size_t i = 0; i < keys.size(); ++i) keys[i] = hash32(i) & mask;

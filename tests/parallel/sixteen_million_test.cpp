@@ -1,8 +1,9 @@
-// The 16M-element size class (beside sizes 0, 1, odd and just over a chunk) for
-// map, map_lanes, gather, reduce, float scan, stable partition, 64-bit radix sort with
-// payload, segmented min/argmin and histogram: each against a serial loop written here,
-// and identical (exact equality, floats bit for bit) for 1, 2 and 8 threads and, for the
-// width-generic primitives, for every lane width W = 1, 4, 8, 16.
+// The large size class, kLargeSize (16M elements; 4M under a sanitizer), beside sizes 0, 1,
+// odd and just over a chunk, for map, map_lanes, gather, reduce, float scan, stable
+// partition, 64-bit radix sort with payload, segmented min/argmin and histogram: each
+// against a serial loop written here, and identical (exact equality, floats bit for bit)
+// for 1, 2 and 8 threads and, for the width-generic primitives, for every lane width
+// W = 1, 4, 8, 16.
 #include "parallel/partition.h"
 #include "parallel/scan.h"
 #include "parallel/segmented.h"
@@ -22,8 +23,6 @@ namespace speculum::par {
 namespace {
 using namespace test;
 
-constexpr std::size_t k16M = std::size_t(16) << 20;
-
 template <class T>
 bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
@@ -32,7 +31,7 @@ bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
 std::uint64_t hash64(std::uint64_t i) { return std::uint64_t(hash32(i)) << 32 | hash32(i ^ 0x5555555555ull); }
 
 TEST(SixteenMillion, MapAndGatherEqualSerial) {
-  const std::size_t n = k16M + 3;  // a partial last chunk
+  const std::size_t n = kLargeSize + 3;  // a partial last chunk
   std::vector<float> in(n);
   std::vector<std::uint32_t> idx(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -56,7 +55,7 @@ TEST(SixteenMillion, MapAndGatherEqualSerial) {
 // The width-generic lanes_kernel (primitive_test_util.h) over 16M elements: every W and
 // thread count gives the bits of the scalar loop.
 TEST(SixteenMillion, MapLanesEveryWidthAndThreadCountEqualsScalarLoop) {
-  const std::size_t n = k16M + 5;  // a partial last lane group for every W > 1
+  const std::size_t n = kLargeSize + 5;  // a partial last lane group for every W > 1
   std::vector<float> x(n);
   for (std::size_t i = 0; i < n; ++i) x[i] = unit_float(i) * 8.f - 4.f;
   std::vector<float> ref(n);
@@ -74,7 +73,7 @@ TEST(SixteenMillion, MapLanesEveryWidthAndThreadCountEqualsScalarLoop) {
 // reduce: each chunk folded left to right from the identity, chunk results folded in chunk
 // order from the identity (stream.h). Checked for the default chunk and an odd one.
 TEST(SixteenMillion, ReduceFollowsChunkOrderAssociationForEveryThreadCount) {
-  const std::size_t n = k16M + 7;
+  const std::size_t n = kLargeSize + 7;
   std::vector<float> in(n);
   std::vector<std::uint32_t> u(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -119,7 +118,7 @@ TEST(SixteenMillion, ReduceFollowsChunkOrderAssociationForEveryThreadCount) {
 // chunk scanned from init ⊕ the preceding chunk sums folded in order, bit for bit, for every
 // kernel width W (out of place, and in place for the inclusive scan) and thread count.
 TEST(SixteenMillion, FloatScansMatchChunkAssociationForEveryThreadCount) {
-  const std::size_t n = k16M + 4099;
+  const std::size_t n = kLargeSize + 4099;
   std::vector<float> in(n);
   for (std::size_t i = 0; i < n; ++i) in[i] = unit_float(i * 3) * 4.f - 1.9f;
   const float init = -2.5f;
@@ -156,7 +155,7 @@ TEST(SixteenMillion, FloatScansMatchChunkAssociationForEveryThreadCount) {
 // Stable partition: the serial counting scatter (count per bucket, offsets, then every
 // element in index order). p = 2 with a 30 % / 70 % split, p = 300 uniform, p = 2048 skewed.
 TEST(SixteenMillion, PartitionEqualsSerialCountingScatter) {
-  const std::size_t n = k16M + 1;
+  const std::size_t n = kLargeSize + 1;
   std::vector<std::uint32_t> bucket(n);
   for (std::uint32_t p : {2u, 300u, 2048u}) {
     for (std::size_t i = 0; i < n; ++i) {
@@ -184,7 +183,7 @@ TEST(SixteenMillion, PartitionEqualsSerialCountingScatter) {
 // positions, so stability is visible. Reference: a serial LSD counting sort of (key, index)
 // on 8-bit digits over all 64 bits.
 TEST(SixteenMillion, RadixSort64WithPayloadEqualsSerialStableSort) {
-  const std::size_t n = k16M + 9;
+  const std::size_t n = kLargeSize + 9;
   const std::size_t distinct = n / 3;
   std::vector<std::uint64_t> keys(n);
   for (std::size_t i = 0; i < n; ++i) keys[i] = hash64(hash32(i) % distinct) & ~std::uint64_t(0xfffff);
@@ -221,7 +220,7 @@ TEST(SixteenMillion, RadixSort64WithPayloadEqualsSerialStableSort) {
 // in. Reference: the documented rule as a serial loop — strictly smaller wins, and the
 // first non-NaN value claims a segment that has no winner yet.
 TEST(SixteenMillion, SegmentedMinEqualsSerialLoop) {
-  const std::size_t n = k16M;
+  const std::size_t n = kLargeSize;
   const std::uint32_t segments = std::uint32_t(n / 4);
   const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
   std::vector<std::uint32_t> seg(n);
@@ -267,7 +266,7 @@ TEST(SixteenMillion, SegmentedMinEqualsSerialLoop) {
 }
 
 TEST(SixteenMillion, HistogramEqualsSerialCounts) {
-  const std::size_t n = k16M + 1;
+  const std::size_t n = kLargeSize + 1;
   std::vector<std::uint32_t> bin(n);
   for (std::size_t bins : {std::size_t(1), std::size_t(255), std::size_t(4096)}) {
     // Skewed: half the elements in bin bins/2.

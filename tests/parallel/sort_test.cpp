@@ -68,7 +68,7 @@ TEST(Partition, EveryBucketShareAcrossChunksEqualsSerial) {
   const std::size_t n = 3 * kScatterChunk + 7;
   constexpr std::uint32_t others[] = {0, 1, 2, 4, 6};
   std::vector<std::uint32_t> two(n), seven(n);
-  for (int percent = 0; percent <= 100; ++percent) {
+  for (int percent = 0; percent <= 100; percent += kPercentStep) {
     const auto in_share = flags(n, percent, n + std::size_t(percent));
     for (std::size_t i = 0; i < n; ++i) {
       two[i] = in_share[i] ? 0u : 1u;

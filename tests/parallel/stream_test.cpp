@@ -120,7 +120,7 @@ TEST(Stream, FloatScanAcrossTilesMatchesChunkAssociation) {
 // width, into an output one element off line alignment (unaligned head and tail per chunk)
 // and in place.
 TEST(Stream, Scan16MEverySpanWidthAndThreadCount) {
-  const std::size_t n = std::size_t(16) << 20;
+  const std::size_t n = kLargeSize;
   std::vector<std::uint32_t> in(n);
   for (std::size_t i = 0; i < n; ++i) in[i] = hash32(i) & 1023;
   std::vector<std::uint32_t> ex_ref(n), in_ref(n);

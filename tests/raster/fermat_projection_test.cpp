@@ -4,6 +4,7 @@
 // grid refined by Newton, plus the iteration counts ROGER §2.3.2 reports.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -17,7 +18,6 @@
 namespace speculum::raster {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 struct Ellipsoid {
   glm::dvec3 centre{0.0};
@@ -107,7 +107,7 @@ glm::dvec3 ellipsoid_reflection(const Ellipsoid& el, const glm::dvec3& e, const 
   const int n = 400;
   for (int i = 1; i < n; ++i)
     for (int j = 0; j < 2 * n; ++j) {
-      const double t = kPi * i / n, p = kPi * j / n;
+      const double t = std::numbers::pi * i / n, p = std::numbers::pi * j / n;
       const glm::dvec3 x = el.at(t, p);
       const glm::dvec3 nn = glm::normalize((x - el.centre) / (el.radii * el.radii));
       if (glm::dot(e - x, nn) <= 0.0 || glm::dot(v - x, nn) <= 0.0) continue;
@@ -166,13 +166,13 @@ TEST(FermatProjection, IterationsAreFewAtTheCentreAndBoundedAtTheSilhouette) {
   const int n = 60;
   for (int i = 1; i < n; ++i)
     for (int j = 0; j < 2 * n; ++j) {
-      const double t = kPi * i / n, p = kPi * j / n;
+      const double t = std::numbers::pi * i / n, p = std::numbers::pi * j / n;
       const glm::dvec3 v = 4.0 * glm::dvec3(std::sin(t) * std::cos(p), std::cos(t), std::sin(t) * std::sin(p));
       const FermatResult r = fermat_project(sphere, o, eye, v, project, FermatSettings{});
       if (r.status != ProjectionStatus::Converged) continue;
       const double c = glm::dot(r.normal, glm::normalize(eye - r.point));
-      if (c > std::cos(kPi / 12)) centre.push_back(r.iterations);
-      else if (c < std::cos(kPi * 75 / 180)) silhouette.push_back(r.iterations);
+      if (c > std::cos(std::numbers::pi / 12)) centre.push_back(r.iterations);
+      else if (c < std::cos(std::numbers::pi * 75 / 180)) silhouette.push_back(r.iterations);
     }
   ASSERT_GT(centre.size(), 50u);
   ASSERT_GT(silhouette.size(), 50u);

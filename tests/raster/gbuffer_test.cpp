@@ -165,7 +165,7 @@ OracleSample oracle_sample(const Scene& scene, const VisibilityBuffer& vis, glm:
 }
 
 template <class T>
-bool same_bytes(const T& a, const T& b) {
+bool same_object_bytes(const T& a, const T& b) {
   return std::memcmp(&a, &b, sizeof(T)) == 0;
 }
 
@@ -175,10 +175,10 @@ std::size_t mismatches(const Scene& scene, const VisibilityBuffer& vis, glm::vec
   std::size_t bad = 0;
   for (std::size_t i = 0; i < vis.triangle.size(); ++i) {
     const OracleSample o = oracle_sample(scene, vis, eye, i);
-    bad += !(same_bytes(g.object.pixels[i], o.object) && same_bytes(g.position.pixels[i], o.position) &&
-             same_bytes(g.normal.pixels[i], o.normal) && same_bytes(g.uv.pixels[i], o.uv) &&
-             same_bytes(g.surface.pixels[i], o.surface) &&
-             same_bytes(g.reflector.pixels[i], o.reflector));
+    bad += !(same_object_bytes(g.object.pixels[i], o.object) && same_object_bytes(g.position.pixels[i], o.position) &&
+             same_object_bytes(g.normal.pixels[i], o.normal) && same_object_bytes(g.uv.pixels[i], o.uv) &&
+             same_object_bytes(g.surface.pixels[i], o.surface) &&
+             same_object_bytes(g.reflector.pixels[i], o.reflector));
   }
   return bad;
 }
@@ -276,9 +276,9 @@ TEST(GBuffer, TriangleRecordsCopyTheMeshCorners) {
   for (std::size_t t = 0; t < records.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = m.indices[3 * t + k];
-      EXPECT_TRUE(same_bytes(records[t].position[k], m.positions[v]));
-      EXPECT_TRUE(same_bytes(records[t].normal[k], m.normals[v]));
-      EXPECT_TRUE(same_bytes(records[t].uv[k], m.uvs[v]));
+      EXPECT_TRUE(same_object_bytes(records[t].position[k], m.positions[v]));
+      EXPECT_TRUE(same_object_bytes(records[t].normal[k], m.normals[v]));
+      EXPECT_TRUE(same_object_bytes(records[t].uv[k], m.uvs[v]));
     }
     EXPECT_EQ(records.materials()[t], m.triangle_material[t]);
   }

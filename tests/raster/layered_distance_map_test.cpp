@@ -12,6 +12,7 @@
 #include "apps/techniques/render_frame.h"
 #include "core/image_metrics.h"
 #include "core/scene_loader.h"
+#include "tests/raster/frame_test_util.h"
 
 namespace speculum::raster {
 namespace {
@@ -46,7 +47,7 @@ TEST(LayeredDistanceMap, FirstLayerIsTheRasterizedCubeMapAndLayersAreOrdered) {
   EXPECT_GT(second_layer, total / 20) << "surfaces behind surfaces";
 }
 
-pipeline::FrameSettings small_frame(const Scene& s) {
+pipeline::FrameSettings small_layered_frame(const Scene& s) {
   pipeline::FrameSettings f;
   f.width = 96;
   f.height = 72;
@@ -54,12 +55,6 @@ pipeline::FrameSettings small_frame(const Scene& s) {
   f.camera = s.cameras.front();
   f.params["layer_size"] = 64;
   return f;
-}
-
-ImageRGBA frame(const Scene& s, const std::string& t, const pipeline::FrameSettings& f,
-                int threads = 2) {
-  par::Executor ex(threads);
-  return pipeline::render_frame(s, pipeline::find_technique(t), f, ex).display;
 }
 
 // Mean absolute difference (display values × 255) over the pixels where `mask_a` and
@@ -83,18 +78,18 @@ TEST(LayeredDistanceMap, MoreLayersReduceTheErrorOnAnOccludedSetUp) {
   // hide parts of the room that the mirror spheres reflect. Measured where the layer count
   // changes the image (the whole frame's error is dominated by what both share).
   const Scene s = load_scene("sphere-in-room:size=4000");
-  pipeline::FrameSettings f = small_frame(s);
+  pipeline::FrameSettings f = small_layered_frame(s);
   f.width = 192;
   f.height = 144;
   f.params["layer_size"] = 128;
   pipeline::FrameSettings ref = f;
   ref.spp = 4;
   ref.params.clear();  // the reference takes no technique parameters
-  const ImageRGBA reference = frame(s, "reference", ref);
+  const ImageRGBA reference = render_display(s, "reference", ref);
   f.params["layers"] = 1;
-  const ImageRGBA img_one = frame(s, "layered-distance-map", f);
+  const ImageRGBA img_one = render_display(s, "layered-distance-map", f);
   f.params["layers"] = 3;
-  const ImageRGBA img_three = frame(s, "layered-distance-map", f);
+  const ImageRGBA img_three = render_display(s, "layered-distance-map", f);
   std::size_t changed = 0;
   const double one = error_where_they_differ(img_one, reference, img_one, img_three, &changed);
   const double three = error_where_they_differ(img_three, reference, img_one, img_three, &changed);
@@ -105,8 +100,8 @@ TEST(LayeredDistanceMap, MoreLayersReduceTheErrorOnAnOccludedSetUp) {
 
 TEST(LayeredDistanceMap, SameBytesForOneAndTwoThreads) {
   const Scene s = load_scene("sphere-in-room:size=3000");
-  const pipeline::FrameSettings f = small_frame(s);
-  const ImageRGBA a = frame(s, "layered-distance-map", f, 1), b = frame(s, "layered-distance-map", f, 2);
+  const pipeline::FrameSettings f = small_layered_frame(s);
+  const ImageRGBA a = render_display(s, "layered-distance-map", f, 1), b = render_display(s, "layered-distance-map", f, 2);
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.size() * sizeof(a.pixels[0])), 0);
 }

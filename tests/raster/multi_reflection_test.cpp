@@ -12,6 +12,7 @@
 #include "raster/multi_reflection.h"
 #include "raster/shadow_map.h"
 #include "raster/visibility.h"
+#include "tests/raster/frame_test_util.h"
 
 namespace speculum::raster {
 namespace {
@@ -25,7 +26,7 @@ Scene two_mirror_room() {
   return s;
 }
 
-pipeline::FrameSettings small_frame(const Scene& s) {
+pipeline::FrameSettings small_cube_frame(const Scene& s) {
   pipeline::FrameSettings f;
   f.width = 96;
   f.height = 72;
@@ -35,31 +36,20 @@ pipeline::FrameSettings small_frame(const Scene& s) {
   return f;
 }
 
-ImageRGBA frame(const Scene& s, const std::string& technique, const pipeline::FrameSettings& f,
-                int threads = 2) {
-  par::Executor ex(threads);
-  return pipeline::render_frame(s, pipeline::find_technique(technique), f, ex).display;
-}
-
-bool same_bytes(const ImageRGBA& a, const ImageRGBA& b) {
-  return a.width == b.width && a.height == b.height &&
-         std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])) == 0;
-}
-
 TEST(MultiReflection, EachRoundAddsABounceAndMovesTowardsTheReference) {
   const Scene s = two_mirror_room();
-  pipeline::FrameSettings f = small_frame(s);
+  pipeline::FrameSettings f = small_cube_frame(s);
   pipeline::FrameSettings ref = f;
   ref.spp = 4;
-  const ImageRGBA reference = frame(s, "reference", ref);
+  const ImageRGBA reference = render_display(s, "reference", ref);
   // The frame around the specular layer (shadow maps, no anti-aliasing at 96×72 against a
   // 4-spp reference) dominates the error; envmap's error on the same frame is the yardstick.
-  const double envmap = image_error(frame(s, "envmap", f), reference).mae8;
+  const double envmap = image_error(render_display(s, "envmap", f), reference).mae8;
   EXPECT_LT(envmap, 30.0);
   double previous = 1e9;
   for (const int rounds : {1, 2, 3}) {
     f.params["rounds"] = rounds;
-    const double e = image_error(frame(s, "multi-reflection", f), reference).mae8;
+    const double e = image_error(render_display(s, "multi-reflection", f), reference).mae8;
     // Round 2 adds the sphere-in-sphere reflections (was black); round 3 changes little.
     if (rounds <= 2) {
       EXPECT_LT(e, previous) << "rounds " << rounds;
@@ -73,15 +63,15 @@ TEST(MultiReflection, EachRoundAddsABounceAndMovesTowardsTheReference) {
 
 TEST(MultiReflection, OneRoundIsTheDistanceMapTechnique) {
   const Scene s = two_mirror_room();
-  const pipeline::FrameSettings f = small_frame(s);
+  const pipeline::FrameSettings f = small_cube_frame(s);
   pipeline::FrameSettings one_round = f;
   one_round.params["rounds"] = 1;
-  EXPECT_TRUE(same_bytes(frame(s, "multi-reflection", one_round), frame(s, "distance-map", f)));
+  EXPECT_TRUE(same_bytes(render_display(s, "multi-reflection", one_round), render_display(s, "distance-map", f)));
 }
 
 TEST(MultiReflection, LaggedSecondFrameEqualsTwoRounds) {
   const Scene s = two_mirror_room();
-  pipeline::FrameSettings f = small_frame(s);
+  pipeline::FrameSettings f = small_cube_frame(s);
   f.params["lagged"] = 1;
   par::Executor ex(2);
   par::Graph g;
@@ -91,11 +81,11 @@ TEST(MultiReflection, LaggedSecondFrameEqualsTwoRounds) {
   const ImageRGBA first = g.get(out.display);
   g.run(ex);
   const ImageRGBA second = g.get(out.display);
-  pipeline::FrameSettings in_frame = small_frame(s);
+  pipeline::FrameSettings in_frame = small_cube_frame(s);
   in_frame.params["rounds"] = 1;
-  EXPECT_TRUE(same_bytes(first, frame(s, "multi-reflection", in_frame)));
+  EXPECT_TRUE(same_bytes(first, render_display(s, "multi-reflection", in_frame)));
   in_frame.params["rounds"] = 2;
-  EXPECT_TRUE(same_bytes(second, frame(s, "multi-reflection", in_frame)));
+  EXPECT_TRUE(same_bytes(second, render_display(s, "multi-reflection", in_frame)));
   EXPECT_FALSE(same_bytes(first, second));
 }
 
@@ -135,11 +125,11 @@ TEST(MultiReflection, KeptFaceLayersGiveTheBytesOfReRenderedFaces) {
 
 TEST(MultiReflection, SameBytesForOneAndTwoThreads) {
   const Scene s = two_mirror_room();
-  const pipeline::FrameSettings f = small_frame(s);
+  const pipeline::FrameSettings f = small_cube_frame(s);
   pipeline::FrameSettings two_rounds = f;
   two_rounds.params["rounds"] = 2;
-  EXPECT_TRUE(same_bytes(frame(s, "distance-map", f, 1), frame(s, "distance-map", f, 2)));
-  EXPECT_TRUE(same_bytes(frame(s, "multi-reflection", two_rounds, 1), frame(s, "multi-reflection", two_rounds, 2)));
+  EXPECT_TRUE(same_bytes(render_display(s, "distance-map", f, 1), render_display(s, "distance-map", f, 2)));
+  EXPECT_TRUE(same_bytes(render_display(s, "multi-reflection", two_rounds, 1), render_display(s, "multi-reflection", two_rounds, 2)));
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "core/scene_loader.h"
 #include "raster/distance_map_reflect.h"
 #include "raster/envmap_reflect.h"
+#include "tests/raster/frame_test_util.h"
 
 namespace speculum::raster {
 namespace {
@@ -36,11 +37,6 @@ View view_of(const std::string& name, int width, int height, par::Executor& ex) 
   v.env = build_environment(ex, v.scene.environment);
   v.g = resolve_gbuffer(ex, v.scene, render_visibility(ex, v.scene, cam, width, height), cam.eye);
   return v;
-}
-
-bool same_bytes(const ImageRGBA& a, const ImageRGBA& b) {
-  return a.width == b.width && a.height == b.height &&
-         std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])) == 0;
 }
 
 int culled_faces(const ReflectorMaps& maps) {

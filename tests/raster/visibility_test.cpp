@@ -178,7 +178,7 @@ TEST(RasterSetup, DropsOnlyTrianglesThatCoverNoSample) {
   EXPECT_EQ(expected, vis.coverage.pixels);
 }
 
-Camera look(const glm::vec3& eye, const glm::vec3& target, float fov = 45.0f) {
+Camera look_at(const glm::vec3& eye, const glm::vec3& target, float fov = 45.0f) {
   Camera c;
   c.eye = eye;
   c.target = target;
@@ -196,7 +196,7 @@ TEST(RasterWatertight, ClosedTorusFrontCoverageEqualsBackCoverage) {
   scene.name = "torus";
   add_torus(scene, glm::vec3(0.0f), 1.0f, 0.45f, 96, 48);
   par::Executor ex(2);
-  const Camera cam = look({0.2f, -3.4f, 0.7f}, {0.05f, 0.02f, 0.0f});
+  const Camera cam = look_at({0.2f, -3.4f, 0.7f}, {0.05f, 0.02f, 0.0f});
   RasterOptions front, back;
   front.count_coverage = back.count_coverage = true;
   front.cull = CullMode::Back;   // keeps front faces
@@ -258,7 +258,7 @@ TEST(RasterOracle, VisibilityMatchesBruteForceRays) {
     add_triangles(scene, p, {0, 1, 2});
   }
   add_triangles(scene, {{-20, -1.2f, 10}, {20, -1.2f, 10}, {0, -1.2f, -30}}, {0, 1, 2});
-  const Camera cam = look({0.1f, 0.2f, 3.0f}, {0.0f, -0.1f, -1.0f});
+  const Camera cam = look_at({0.1f, 0.2f, 3.0f}, {0.0f, -0.1f, -1.0f});
   const int w = 320, h = 240;
   for (int threads : {1, 2}) {
     par::Executor ex(threads);
@@ -323,7 +323,7 @@ TEST(RasterInterpolation, PerspectiveCorrectUvOnGrazingPlane) {
   const float s = 100.0f;
   add_triangles(scene, {{-s, 0, -s}, {s, 0, -s}, {s, 0, s}, {-s, 0, s}}, {0, 2, 1, 0, 3, 2},
                 {{0, 0}, {1, 0}, {1, 1}, {0, 1}});
-  const Camera cam = look({0.0f, 0.4f, 0.0f}, {0.3f, 0.35f, -10.0f}, 50.0f);
+  const Camera cam = look_at({0.0f, 0.4f, 0.0f}, {0.3f, 0.35f, -10.0f}, 50.0f);
   const int w = 200, h = 150;
   par::Executor ex(2);
   const auto vis = render_visibility(ex, scene, cam, w, h);
@@ -381,7 +381,7 @@ Scene overdraw_scene() {
   add_torus(scene, glm::vec3(0, 0, 1.5f), 1.0f, 0.3f, 64, 32);  // clipped by the near plane
   return scene;
 }
-Camera overdraw_camera() { return look({0.0f, 0.1f, 2.6f}, {0.0f, 0.0f, 0.0f}, 60.0f); }
+Camera overdraw_camera() { return look_at({0.0f, 0.1f, 2.6f}, {0.0f, 0.0f, 0.0f}, 60.0f); }
 
 TEST(RasterDeterminism, BitIdenticalAcrossThreadsAndLanes) {
   const Scene scene = overdraw_scene();
@@ -424,7 +424,7 @@ TEST(RasterDeterminism, LargeFrameWithGuardBandFloorSameBitsAtEveryWidth) {
     idx.insert(idx.end(), {3 * k, 3 * k + 1, 3 * k + 2});
   }
   add_triangles(scene, p, idx);
-  const Camera cam = look({0.0f, 0.4f, 2.6f}, {0.0f, -0.6f, 0.0f}, 60.0f);
+  const Camera cam = look_at({0.0f, 0.4f, 2.6f}, {0.0f, -0.6f, 0.0f}, 60.0f);
   const int width = 720, height = 480;  // 345 600 samples: above the streaming threshold
   RasterOptions scalar;
   scalar.lanes = 1;
@@ -473,9 +473,9 @@ TEST(RasterInput, AbsurdSizesAndCamerasThrowInputError) {
   scene.name = "tiny";
   add_triangles(scene, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2});
   par::Executor ex(1);
-  EXPECT_THROW(render_visibility(ex, scene, look({0, 0, 3}, {0, 0, 0}), 0, 10), InputError);
-  EXPECT_THROW(render_visibility(ex, scene, look({0, 0, 3}, {0, 0, 0}), 100000, 10), InputError);
-  EXPECT_THROW(render_visibility(ex, scene, look({0, 0, 3}, {0, 0, 3}), 10, 10), InputError);
+  EXPECT_THROW(render_visibility(ex, scene, look_at({0, 0, 3}, {0, 0, 0}), 0, 10), InputError);
+  EXPECT_THROW(render_visibility(ex, scene, look_at({0, 0, 3}, {0, 0, 0}), 100000, 10), InputError);
+  EXPECT_THROW(render_visibility(ex, scene, look_at({0, 0, 3}, {0, 0, 3}), 10, 10), InputError);
 }
 
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <random>
 #include <utility>
 #include <vector>
@@ -17,7 +18,6 @@
 namespace speculum::trace {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 struct Moments {
   double area = 0.0;
@@ -31,9 +31,9 @@ double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y
 Moments polygon_clip_oracle(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, int sides = 1024) {
   if (cross2(b - a, c - a) < 0.0) std::swap(b, c);
   std::vector<glm::dvec2> poly = {a, b, c};
-  const double r = std::sqrt(2.0 * kPi / (sides * std::sin(2.0 * kPi / sides)));
+  const double r = std::sqrt(2.0 * std::numbers::pi / (sides * std::sin(2.0 * std::numbers::pi / sides)));
   for (int k = 0; k < sides && !poly.empty(); ++k) {
-    const double a0 = 2.0 * kPi * k / sides, a1 = 2.0 * kPi * (k + 1) / sides;
+    const double a0 = 2.0 * std::numbers::pi * k / sides, a1 = 2.0 * std::numbers::pi * (k + 1) / sides;
     const glm::dvec2 p0(r * std::cos(a0), r * std::sin(a0)), p1(r * std::cos(a1), r * std::sin(a1));
     std::vector<glm::dvec2> next;
     for (std::size_t i = 0; i < poly.size(); ++i) {
@@ -72,7 +72,7 @@ TEST(ConeCoverage, AreaAndCentroidMatchA1024GonClippingInAllEightCases) {
       else if (kind == 1) r = u01(rng) < 0.5 ? u01(rng) : 1.0 + 0.6 * u01(rng);  // near the circle
       else if (kind == 2) r = 1.05 + 0.25 * u01(rng);           // just outside: hexagons
       else r = 1.5 + 3.0 * u01(rng);                            // far: discs inside triangles
-      p = polar(r, 2.0 * kPi * u01(rng));
+      p = polar(r, 2.0 * std::numbers::pi * u01(rng));
     }
     if (std::fabs(cross2(v[1] - v[0], v[2] - v[0])) < 1e-3) continue;
     const DiscCoverage got = disc_triangle_coverage(v[0], v[1], v[2]);
@@ -111,7 +111,7 @@ TEST(ConeCoverage, CircularSegmentAwayFromHalfDisc) {
   }
   // Disc inside the triangle: all of it, centred.
   const DiscCoverage full = disc_triangle_coverage({-10, -10}, {10, -10}, {0, 10});
-  EXPECT_EQ(full.area, kPi);
+  EXPECT_EQ(full.area, std::numbers::pi);
   // Triangle inside the disc: its own area and centroid.
   const DiscCoverage small = disc_triangle_coverage({0.1, 0.1}, {0.5, 0.1}, {0.1, 0.4});
   EXPECT_NEAR(small.area, 0.5 * 0.4 * 0.3, 1e-15);

@@ -2,6 +2,7 @@
 // reflected cone has the pixel's own half-angle (the reflected eye is its apex); a convex
 // spot widens it by 2κw; a strongly concave spot would make a double cone and is traced as a
 // ray, counted; a glossy lobe adds the angle that holds the asked share of its Phong lobe.
+#include "core/sampling.h"
 #include "trace/cone_tracing.h"
 
 #include <cmath>
@@ -36,12 +37,10 @@ struct OnePixel {
   }
 };
 
-constexpr float kPi = 3.14159265f;
-
 TEST(PixelCones, FlatMirrorKeepsThePixelAngleConvexWidensConcaveFallsBack) {
   // Pixel pitch 2 tan 5° at unit distance, on the view axis: Ω = pitch², β = √(Ω/π).
-  const float pitch = 2.0f * std::tan(5.0f * kPi / 180.0f);
-  const float beta = std::sqrt(pitch * pitch / kPi);
+  const float pitch = 2.0f * std::tan(5.0f * speculum::kPi / 180.0f);
+  const float beta = std::sqrt(pitch * pitch / speculum::kPi);
   const float w = 4.0f * std::tan(beta);
   const PixelCones flat = OnePixel(0.0f, 0.0f, 0.0f).cones();
   EXPECT_EQ(flat.cones, 1u);
