@@ -30,7 +30,8 @@ template <int W, class Key, class F>
                                                   unsigned shift, Key mask, F&& f) {
   using V = stdx::fixed_size_simd<Key, W>;
   std::size_t i = b;
-  alignas(64) Key digit[W];
+  // vector_aligned asks for the simd type's alignment: 128 bytes for 16 lanes of 64 bits.
+  alignas(stdx::memory_alignment_v<V>) Key digit[W];
   for (; i + W <= e; i += W) {
     // The digits go through a W-word buffer: reading it back costs a load per lane, where
     // extracting lanes from the register costs a shuffle each.

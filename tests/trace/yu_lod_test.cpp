@@ -49,7 +49,7 @@ TEST(YuLod, LodOffIsTheThreadedTraversalBitForBit) {
     int hits = 0;
     for (std::uint32_t i = 0; i < 3000; ++i) {
       const Ray r = random_ray(i, 5);
-      TraversalCounters ca, cb;
+      TraversalCounters ca;
       LodCounters cl;
       const Hit a = closest_hit_threaded(bvh, r, &ca);
       const LodHit b = closest_hit_lod(bvh, lod, r, 0.01f, opt, &cl);
