@@ -275,6 +275,10 @@ TEST(RasterOracle, VisibilityMatchesBruteForceRays) {
     par::Executor ex(threads);
     const auto vis = render_visibility(ex, scene, cam, w, h);
     const glm::dvec3 forward(glm::normalize(cam.target - cam.eye));
+    // The oracle hit's depth along the view axis, as the visibility buffer stores depth.
+    const auto oracle_depth = [&](const auto& hit, const Ray& ray) {
+      return hit.t * glm::dot(glm::dvec3(ray.direction), forward);
+    };
     std::size_t edge_samples = 0, mismatches_off_edge = 0, hits = 0;
     double max_depth_rel = 0, max_bary = 0, worst_outside = 0;
     for (int y = 0; y < h; ++y)
@@ -299,12 +303,15 @@ TEST(RasterOracle, VisibilityMatchesBruteForceRays) {
               ADD_FAILURE() << "sample " << x << "," << y << " reports triangle " << got
                             << " at " << d << " px from its edges (inside > 0); the oracle misses";
             }
+          } else if (got == kNoId) {
+            ++mismatches_off_edge;
+            ADD_FAILURE() << "sample " << x << "," << y << " reports nothing; the oracle sees triangle "
+                          << hit.triangle;
           } else {
             // Both see a triangle: the reported one may be nearer with its snapped edge just
             // over the sample centre (the same tolerance as above); otherwise it is wrong.
             const double d = signed_pixel_distance(scene, got, cam, w, h, x, y);
-            const double oracle_depth = hit.t * glm::dot(glm::dvec3(ray.direction), forward);
-            if (got != kNoId && std::abs(d) <= kSnapTolerancePixels && vis.depth.at(x, y) < oracle_depth) {
+            if (std::abs(d) <= kSnapTolerancePixels && vis.depth.at(x, y) < oracle_depth(hit, ray)) {
               ++edge_samples;
             } else {
               ++mismatches_off_edge;
@@ -319,7 +326,7 @@ TEST(RasterOracle, VisibilityMatchesBruteForceRays) {
         // The distance helper agrees with the oracle where both see the same triangle.
         EXPECT_GE(signed_pixel_distance(scene, got, cam, w, h, x, y), -kSnapTolerancePixels)
             << x << "," << y;
-        const double depth = hit.t * glm::dot(glm::dvec3(ray.direction), forward);
+        const double depth = oracle_depth(hit, ray);
         max_depth_rel = std::max(max_depth_rel, std::abs(vis.depth.at(x, y) - depth) / depth);
         max_bary = std::max({max_bary, std::abs(vis.bary.at(x, y).x - hit.b1),
                              std::abs(vis.bary.at(x, y).y - hit.b2)});
