@@ -30,6 +30,9 @@ namespace {
 // for all rays) and be close: the interval bounds of a wide fan cull little.
 constexpr float kMaxDirectionSpread = 0.05f;  // per component of the normalized direction
 
+// The most packets a stream chunk traces as single rays after a refused packet.
+constexpr int kMaxSkippedPackets = 8;
+
 struct Packet {
   int count = 0;
   int halves = 1;  // 8-lane halves in use: 1 for up to 8 rays, 2 for up to 16
@@ -408,6 +411,11 @@ void closest_hit_stream_packets(const Bvh& bvh, const RayStream& rays, HitStream
   std::vector<TraversalCounters> per_chunk(counters ? chunks : 0);
   ex.parallel_for("trace_closest_packets", packets, per_chunk_packets, [&](std::size_t b, std::size_t e) {
     TraversalCounters c;
+    // A packet refused as incoherent sends the next 1, 2, 4, then up to kMaxSkippedPackets
+    // packets of the chunk straight to single rays before the next try: an incoherent stream
+    // (reflected glossy rays) pays the coherence test on a few packets per chunk instead of
+    // every one. Both paths give the same hits, so this changes the speed only.
+    int skip = 0, backoff = 1;
     for (std::size_t q = b; q < e; ++q) {
       std::size_t slot[kMaxPacketSize];
       int count = 0;
@@ -421,7 +429,15 @@ void closest_hit_stream_packets(const Bvh& bvh, const RayStream& rays, HitStream
       Ray r[kMaxPacketSize];
       Hit hh[kMaxPacketSize];
       for (int k = 0; k < count; ++k) r[k] = rays.get(slot[k]);
-      closest_hit_packet(bvh, r, count, hh, &c);
+      if (skip > 0) {
+        --skip;
+        for (int k = 0; k < count; ++k) hh[k] = closest_hit(bvh, r[k], &c);
+      } else if (closest_hit_packet(bvh, r, count, hh, &c)) {
+        backoff = 1;
+      } else {
+        skip = backoff;
+        backoff = std::min(2 * backoff, kMaxSkippedPackets);
+      }
       for (int k = 0; k < count; ++k) {
         const std::size_t j = slot[k];
         hits.t[j] = hh[k].t;

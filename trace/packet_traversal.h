@@ -28,7 +28,9 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
 // per pixel, row-major), 4x4 pixel tiles of 16 rays are, as rtcIntersect16 is fed: neighbouring
 // pixels share more of their node path than a run of 8 in a row, and one interval test per
 // node serves 16 rays. Chunks of kRayChunk rays on the executor (kernel
-// "trace_closest_packets"). Same hits as closest_hit_stream for any grouping and thread count.
+// "trace_closest_packets"). A refused (incoherent) packet sends the next few packets of its
+// chunk to single rays without the coherence test. Same hits as closest_hit_stream for any
+// grouping and thread count.
 void closest_hit_stream_packets(const Bvh& bvh, const RayStream& rays, HitStream& hits, par::Executor& executor,
                                 TraversalCounters* counters = nullptr, int image_width = 0);
 

@@ -2,7 +2,8 @@
 // oracle's (t, triangle) bit for bit on random, degenerate, closed and real meshes; the
 // packet path is really taken for coherent rays and refused for incoherent ones; rays
 // aimed at shared edges and vertices never leak; streams equal single rays for any
-// thread count and any stream length (partial last packet).
+// thread count and any stream length (partial last packet), and a stream goes back to
+// packets after incoherent rays.
 #include <gtest/gtest.h>
 
 #include "tests/test_dependency.h"
@@ -193,6 +194,38 @@ TEST(PacketTraversal, StreamEqualsSingleRaysForAnyThreadCount) {
       ASSERT_EQ(bits(single.u[i]), bits(packed.u[i])) << "ray " << i;
     }
   }
+}
+
+// A chunk that starts with incoherent rays traces them one by one and skips the coherence
+// test on some of the packets after each refusal, but comes back to packets when the rays
+// turn coherent: the same hits as single rays, and fewer nodes visited than single rays.
+TEST(PacketTraversal, StreamReturnsToPacketsAfterIncoherentRays) {
+  const Soup s = testing::random_soup(5000, 53);
+  par::Executor ex(2);
+  const Bvh bvh = Bvh::build(s.positions, s.indices, ex);
+  const auto cam = pinhole_rays(glm::vec3(0.5f, 0.5f, 3.0f), glm::vec3(0.5f), 32, 16, 0.05f);
+  RayStream rays;
+  rays.resize(2 * kRayChunk);
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    // Each chunk: 64 random rays (8 refused packets), then pinhole rays.
+    const bool random = i % kRayChunk < 64;
+    rays.set(i, random ? testing::random_ray(static_cast<std::uint32_t>(i), 71) : cam[i % cam.size()]);
+  }
+  HitStream single, packed;
+  TraversalCounters single_counts, packed_counts;
+  closest_hit_stream(bvh, rays, single, ex, &single_counts);
+  closest_hit_stream_packets(bvh, rays, packed, ex, &packed_counts);
+  int hits = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    ASSERT_EQ(single.triangle[i], packed.triangle[i]) << "ray " << i;
+    ASSERT_EQ(bits(single.t[i]), bits(packed.t[i])) << "ray " << i;
+    ASSERT_EQ(bits(single.u[i]), bits(packed.u[i])) << "ray " << i;
+    ASSERT_EQ(bits(single.v[i]), bits(packed.v[i])) << "ray " << i;
+    hits += single.triangle[i] != kNoHit;
+  }
+  EXPECT_GT(hits, 100);
+  EXPECT_EQ(packed_counts.rays, rays.size());
+  EXPECT_LT(packed_counts.nodes_visited, single_counts.nodes_visited);
 }
 
 // An image's rays in 4x4 pixel tiles of 16 (partial tiles at the right and bottom edges,
