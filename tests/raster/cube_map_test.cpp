@@ -43,7 +43,8 @@ TEST(CubeMapFaces, FacesNearHoldEveryDirectionWithinTheMargin) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   for (int trial = 0; trial < 400; ++trial) {
-    const glm::vec3 p = spherical_local(1.0f - 2.0f * unit(rng), unit(rng));
+    const float cos_theta = 1.0f - 2.0f * unit(rng);
+    const glm::vec3 p = spherical_local(cos_theta, unit(rng));
     const float margin = 1.8f * unit(rng) * unit(rng);
     const unsigned faces = cube_faces_near(p, margin);
     const Onb frame(p);
@@ -95,7 +96,7 @@ TEST(CubeMapDistance, EqualsOracleHitDistanceInEveryFace) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-2.5f, 2.5f);
   for (int k = 0; k < 30; ++k) {
-    const glm::vec3 c(u(rng), u(rng), u(rng));
+    const glm::vec3 c{u(rng), u(rng), u(rng)};
     add_triangles(scene, {c, c + glm::vec3(0.5f, 0.1f, 0), c + glm::vec3(0, 0.4f, 0.3f)}, {0, 1, 2});
   }
   const glm::vec3 o(0.1f, -0.2f, 0.3f);
@@ -136,7 +137,7 @@ TEST(Environment, ConstantEnvironmentPrefiltersAndIrradiatesExactly) {
   std::mt19937 rng(9);
   std::normal_distribution<float> g;
   for (int k = 0; k < 50; ++k) {
-    const glm::vec3 d = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+    const glm::vec3 d = glm::normalize(glm::vec3{g(rng), g(rng), g(rng)});
     for (float n : {1e6f, 500.0f, 20.0f, 1.0f}) {
       const glm::vec3 L = map.radiance(d, n);
       EXPECT_NEAR(L.x, 0.2f, 1e-4f);
@@ -180,7 +181,7 @@ std::array<ImageRGBA, kCubeFaces> random_cube_faces(int size, std::mt19937& rng)
   std::uniform_real_distribution<float> u(0.0f, 4.0f);
   for (ImageRGBA& f : faces) {
     f = ImageRGBA(size, size);
-    for (glm::vec4& p : f.pixels) p = glm::vec4(u(rng), u(rng), u(rng), 1.0f);
+    for (glm::vec4& p : f.pixels) p = glm::vec4{u(rng), u(rng), u(rng), 1.0f};
   }
   return faces;
 }
@@ -238,7 +239,7 @@ TEST(Environment, TruncatedLevelsGiveTheSameRadianceForTheLobesTheyServe) {
     const EnvironmentMap part = environment_from_faces(ex, faces, false, kept);
     ASSERT_EQ(int(part.levels.size()), kept);
     for (int k = 0; k < 200; ++k) {
-      const glm::vec3 d = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+      const glm::vec3 d = glm::normalize(glm::vec3{g(rng), g(rng), g(rng)});
       for (float m : {n, n * 1.7f, n * 40.0f, 1e6f}) {
         const glm::vec3 a = full.radiance(d, m), b = part.radiance(d, m);
         ASSERT_EQ(a.x, b.x) << "n " << n << " m " << m;
@@ -250,7 +251,7 @@ TEST(Environment, TruncatedLevelsGiveTheSameRadianceForTheLobesTheyServe) {
       const EnvironmentMap short_map = environment_from_faces(ex, faces, false, kept - 2);
       bool differs = false;
       for (int k = 0; k < 50 && !differs; ++k) {
-        const glm::vec3 d = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+        const glm::vec3 d = glm::normalize(glm::vec3{g(rng), g(rng), g(rng)});
         differs = full.radiance(d, n) != short_map.radiance(d, n);
       }
       EXPECT_TRUE(differs) << "n " << n;

@@ -75,7 +75,7 @@ TEST(FermatProjection, SphereMatchesTheAnalyticReflectionPoint) {
   Ellipsoid sphere{o, glm::dvec3(r)};
   auto outside = [&](double lo, double hi) {
     for (;;) {
-      const glm::dvec3 d(uni(rng), uni(rng), uni(rng));
+      const glm::dvec3 d{uni(rng), uni(rng), uni(rng)};
       const double l = glm::length(d);
       if (l < 0.1 || l > 1.0) continue;
       return o + d / l * (lo + (hi - lo) * std::fabs(uni(rng)));
@@ -135,8 +135,8 @@ TEST(FermatProjection, EllipsoidMatchesABruteForceMinimizer) {
   int tested = 0;
   double worst = 0.0;
   for (int i = 0; i < 60 && tested < 25; ++i) {
-    const glm::dvec3 e = el.centre + glm::dvec3(uni(rng) * 2.0, 1.5 + uni(rng), 4.0 + uni(rng));
-    const glm::dvec3 v = el.centre + glm::normalize(glm::dvec3(uni(rng), uni(rng), uni(rng) + 0.8)) * 2.5;
+    const glm::dvec3 e = el.centre + glm::dvec3{uni(rng) * 2.0, 1.5 + uni(rng), 4.0 + uni(rng)};
+    const glm::dvec3 v = el.centre + glm::normalize(glm::dvec3{uni(rng), uni(rng), uni(rng) + 0.8}) * 2.5;
     const glm::dvec3 want = ellipsoid_reflection(el, e, v);
     const FermatResult got = fermat_project(el, el.centre, e, v, fine, tight());
     if (got.status == ProjectionStatus::Hidden) continue;

@@ -116,7 +116,12 @@ TEST(RasterSetup, DropsOnlyTrianglesThatCoverNoSample) {
     auto& d = t % 3 == 0 ? sliver : tiny;
     for (int k = 0; k < 3; ++k) {
       idx.push_back(static_cast<std::uint32_t>(v.size()));
-      v.push_back(t % 11 == 0 && k == 2 ? v.back() : fixed_vertex(cx + d(rng), cy + d(rng)));
+      if (t % 11 == 0 && k == 2) {
+        v.push_back(v.back());
+        continue;
+      }
+      const std::int32_t dx = d(rng), dy = d(rng);  // drawn in this order on every compiler
+      v.push_back(fixed_vertex(cx + dx, cy + dy));
     }
     objects.push_back(0);
   }
@@ -399,9 +404,9 @@ Scene overdraw_scene() {
   std::vector<std::uint32_t> idx;
   for (int k = 0; k < 60000; ++k) {
     // Interpenetrating, sometimes coplanar-duplicate triangles make depth ties likely.
-    const glm::vec3 c(u(rng) * 2, u(rng) * 1.5f, u(rng) * 2);
+    const glm::vec3 c{u(rng) * 2, u(rng) * 1.5f, u(rng) * 2};
     const auto base = static_cast<std::uint32_t>(p.size());
-    for (int i = 0; i < 3; ++i) p.push_back(c + 0.08f * glm::vec3(u(rng), u(rng), u(rng)));
+    for (int i = 0; i < 3; ++i) p.push_back(c + 0.08f * glm::vec3{u(rng), u(rng), u(rng)});
     idx.insert(idx.end(), {base, base + 1, base + 2});
     if (k % 100 == 0) idx.insert(idx.end(), {base, base + 1, base + 2});  // exact duplicate
   }
@@ -447,8 +452,8 @@ TEST(RasterDeterminism, LargeFrameWithGuardBandFloorSameBitsAtEveryWidth) {
   std::vector<glm::vec3> p;
   std::vector<std::uint32_t> idx;
   for (std::uint32_t k = 0; k < 3000; ++k) {
-    const glm::vec3 c(u(rng) * 2, u(rng) * 0.8f, u(rng) * 2 - 1.0f);
-    for (int i = 0; i < 3; ++i) p.push_back(c + 0.05f * glm::vec3(u(rng), u(rng), u(rng)));
+    const glm::vec3 c{u(rng) * 2, u(rng) * 0.8f, u(rng) * 2 - 1.0f};
+    for (int i = 0; i < 3; ++i) p.push_back(c + 0.05f * glm::vec3{u(rng), u(rng), u(rng)});
     idx.insert(idx.end(), {3 * k, 3 * k + 1, 3 * k + 2});
   }
   add_triangles(scene, p, idx);
@@ -541,8 +546,8 @@ TEST(RasterVertexStage, BatchedEqualsOneVertexFunctionBitForBit) {
   std::uniform_real_distribution<float> near_box(-4.0f, 4.0f), far_box(-3000.0f, 3000.0f);
   std::vector<glm::vec3> positions;
   for (int i = 0; i < 997; ++i)  // not a multiple of 8: exercises the tail
-    positions.push_back(i % 3 ? glm::vec3(near_box(rng), near_box(rng), near_box(rng))
-                              : glm::vec3(far_box(rng), far_box(rng), far_box(rng)));
+    positions.push_back(i % 3 ? glm::vec3{near_box(rng), near_box(rng), near_box(rng)}
+                              : glm::vec3{far_box(rng), far_box(rng), far_box(rng)});
   positions.push_back(cam.eye);                        // w = 0
   positions.push_back({0.3f, 0.2f, 3.0f - cam.znear}); // on the near plane
   positions.push_back({3e38f, 0.0f, 0.0f});            // overflows to inf
@@ -576,12 +581,12 @@ TEST(RasterSetup, ChunkedSetupEqualsPerTriangleSetup) {
   std::vector<glm::vec3> positions;
   std::vector<std::uint32_t> indices, objects;
   for (std::uint32_t t = 0; t < 3000; ++t) {
-    const glm::vec3 c(box(rng), box(rng), box(rng));
+    const glm::vec3 c{box(rng), box(rng), box(rng)};
     const float s = t % 4 == 0 ? 150.0f : 1.0f;  // some large triangles cross the near plane
     for (int k = 0; k < 3; ++k) {
       indices.push_back(static_cast<std::uint32_t>(positions.size()));
       positions.push_back(t % 7 == 0 && k == 2 ? positions[positions.size() - 1]  // degenerate
-                                               : c + s * glm::vec3(small(rng), small(rng), small(rng)));
+                                               : c + s * glm::vec3{small(rng), small(rng), small(rng)});
     }
     objects.push_back(t % 5);
   }
@@ -673,9 +678,9 @@ TEST(RasterSetup, LaneSetupEqualsScalarSetupRecordForRecord) {
       for (int k = 0; k < 3; ++k) v[k] = snapped(x + jitter(600), y + jitter(600));
       if (t % 50 == 9) {  // a triangle through the near plane, in clip space
         std::uniform_real_distribution<float> d(-0.5f, 0.5f);
-        v[0] = make_screen_vertex(glm::vec4(d(rng), d(rng), 0.5f, 1.0f), viewport);
-        v[1] = make_screen_vertex(glm::vec4(d(rng), d(rng), 0.5f, 1.0f), viewport);
-        v[2] = make_screen_vertex(glm::vec4(d(rng), d(rng), 0.2f, -0.5f), viewport);
+        v[0] = make_screen_vertex(glm::vec4{d(rng), d(rng), 0.5f, 1.0f}, viewport);
+        v[1] = make_screen_vertex(glm::vec4{d(rng), d(rng), 0.5f, 1.0f}, viewport);
+        v[2] = make_screen_vertex(glm::vec4{d(rng), d(rng), 0.2f, -0.5f}, viewport);
       }
     }
     for (const ScreenVertex& u : v) {

@@ -124,15 +124,15 @@ TEST(ConeCoverage, AbuttingTrianglesCoveringTheConeSumToOne) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 40; ++trial) {
     Cone cone;
-    cone.origin = glm::vec3(float(u(rng)), float(u(rng)), float(u(rng)));
-    cone.axis = glm::normalize(glm::vec3(float(u(rng)), float(u(rng)), 1.5f + float(u(rng))));
+    cone.origin = glm::vec3{float(u(rng)), float(u(rng)), float(u(rng))};
+    cone.axis = glm::normalize(glm::vec3{float(u(rng)), float(u(rng)), 1.5f + float(u(rng))});
     cone.radius = 0.01f + 0.05f * float(u(rng) + 1.0);
     cone.tan_angle = std::tan(0.2f * float(u(rng) + 1.0));
     cone.near = 0.05f;
     // A plane crossing the cone obliquely at distance 2–3, covered by a jittered grid of
     // triangles much larger than the cone's cross-section there.
     const glm::vec3 centre = cone.origin + float(2.5 + 0.5 * u(rng)) * cone.axis;
-    const glm::vec3 n = glm::normalize(cone.axis + 0.5f * glm::vec3(float(u(rng)), float(u(rng)), float(u(rng))));
+    const glm::vec3 n = glm::normalize(cone.axis + 0.5f * glm::vec3{float(u(rng)), float(u(rng)), float(u(rng))});
     const glm::vec3 t1 = glm::normalize(glm::cross(n, glm::vec3(0.3f, 1.0f, 0.2f)));
     const glm::vec3 t2 = glm::cross(n, t1);
     const int grid = 8;
