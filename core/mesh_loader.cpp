@@ -228,6 +228,7 @@ PlyFaces check_ply_body(const std::string& path, std::istream& in, const PlyLayo
   // An integer of `bytes` bytes at `at`, in the file's byte order.
   auto integer = [&](int bytes, bool is_signed) -> long long {
     unsigned char b[8] = {};
+    bytes = std::clamp(bytes, 1, 8);  // PLY integers are 1-8 bytes; stated for the compiler's bounds
     std::memcpy(b, body.data() + at, static_cast<std::size_t>(bytes));
     if (layout.big_endian) std::reverse(b, b + bytes);
     std::uint64_t raw = 0;

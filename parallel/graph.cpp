@@ -131,7 +131,10 @@ std::vector<std::size_t> Graph::topological_order(const std::vector<Edge>& edges
   if (topo.size() != n) {
     std::string msg = "the graph has a cycle through:";
     for (std::size_t i = 0; i < n; ++i)
-      if (remaining[i] != 0) msg += " " + quote(nodes_[i].name);
+      if (remaining[i] != 0) {
+        msg += ' ';  // appended in two steps: GCC 12's -Wrestrict misfires on " " + string
+        msg += quote(nodes_[i].name);
+      }
     throw GraphError(msg);
   }
   return topo;

@@ -122,7 +122,9 @@ void Progress::draw_locked() {
   if (t < delay_ || t - last_draw_ < kRedrawSeconds) return;
   last_draw_ = t;
   drawn_ = true;
-  sink_("\r" + line_locked(t));
+  std::string line = "\r";  // appended, not "\r" + ...: GCC 12's -Wrestrict misfires on that
+  line += line_locked(t);
+  sink_(line);
 }
 
 void Progress::finish() {
@@ -130,7 +132,10 @@ void Progress::finish() {
   if (finished_) return;
   finished_ = true;
   if (!sink_ || !drawn_) return;
-  sink_("\r" + line_locked(elapsed()) + "\n");
+  std::string line = "\r";
+  line += line_locked(elapsed());
+  line += '\n';
+  sink_(line);
 }
 
 void Progress::clear() {
