@@ -89,6 +89,7 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
       opt.znear = 1e-3f * radius;
       opt.zfar = 4.0f * radius + glm::length(light.position - centre);
       if (light.type == LightType::Spot) opt.face_mask = spot_cone_faces(light, size);
+      m.faces = opt.face_mask;
       m.cube = render_cube_map(executor, scene, light.position, opt);
     }
     maps.push_back(std::move(m));

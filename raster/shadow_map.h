@@ -20,6 +20,7 @@ struct ShadowMap {
   int size = 0;
   CubeMap cube;               // point and spot lights: distance from the light position (a
                               // spot light's: only the faces its cone reaches, the others +inf)
+  unsigned faces = 0x3fu;     // bit f: cube face f rendered
   Camera camera;              // directional lights: the far camera along the light
   glm::mat4 view_projection{1.0f};
   ImageF distance;            // directional: |y − camera.eye|

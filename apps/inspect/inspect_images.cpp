@@ -199,10 +199,36 @@ bool has_faces(const std::array<ImageF, 6>& faces) {
                      [&](const ImageF& f) { return f.width == faces[0].width && f.height == faces[0].height; });
 }
 
-void draw_cube(Drawing& d, const std::string& prefix, const raster::CubeMap& cube,
-               par::Executor& executor) {
-  if (has_faces(cube.colour)) d.views.push_back(colour_cross_view(prefix + "colour", cube.colour, executor));
-  if (has_faces(cube.distance)) d.views.push_back(distance_cross_view(prefix + "distance", cube.distance));
+// "; faces -Y, +Z not rendered (why)" for a cube that leaves faces out (bit f of `faces`: face
+// f rendered), else "": their cells of the cross hold no rendering.
+std::string unrendered_faces(unsigned faces, const char* why) {
+  static const char* const names[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+  std::string list;
+  for (int f = 0; f < 6; ++f) {
+    if (faces >> f & 1u) continue;
+    if (!list.empty()) list += ", ";
+    list += names[f];
+  }
+  if (list.empty()) return list;
+  std::string note = "; faces ";
+  note += list;
+  note += " not rendered (";
+  note += why;
+  note += ')';
+  return note;
+}
+
+// The cube's colour and distance crosses; `note` is added to each caption.
+void draw_cube(Drawing& d, const std::string& prefix, const raster::CubeMap& cube, par::Executor& executor,
+               const std::string& note = "") {
+  if (has_faces(cube.colour)) {
+    d.views.push_back(colour_cross_view(prefix + "colour", cube.colour, executor));
+    d.views.back().encoding += note;
+  }
+  if (has_faces(cube.distance)) {
+    d.views.push_back(distance_cross_view(prefix + "distance", cube.distance));
+    d.views.back().encoding += note;
+  }
 }
 
 void draw_gbuffer(Drawing& d, const raster::GBuffer& g) {
@@ -335,8 +361,10 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
     for (std::size_t l = 0; l < shadows->size() && l < kMaxListed; ++l) {
       const auto& s = (*shadows)[l];
       const std::string name = "light" + std::to_string(l);
-      if (has_faces(s.cube.distance))
+      if (has_faces(s.cube.distance)) {
         d.views.push_back(distance_cross_view(name, s.cube.distance));
+        d.views.back().encoding += unrendered_faces(s.faces, "outside the spot light's cone");
+      }
       else if (!s.distance.empty())
         d.views.push_back(scalar_view(name, s.distance));
     }
@@ -348,8 +376,12 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
     d.views.push_back(id_view("clusters", ids));
   } else if (const auto* maps = o.as<raster::ReflectorMaps>()) {
     d.size = std::to_string(maps->cubes.size()) + " cube maps";
-    for (std::size_t m = 0; m < maps->cubes.size() && m < kMaxListed; ++m)
-      draw_cube(d, "map" + std::to_string(m) + ".", maps->cubes[m], executor);
+    for (std::size_t m = 0; m < maps->cubes.size() && m < kMaxListed; ++m) {
+      std::string note = m < maps->faces.size() ? unrendered_faces(maps->faces[m], "no camera sample reads them") : "";
+      if (m < maps->tiles.size() && maps->tiles[m].active())
+        note += "; within the rendered faces, only the tiles the camera's lookups reach";
+      draw_cube(d, "map" + std::to_string(m) + ".", maps->cubes[m], executor, note);
+    }
   } else if (const auto* params = o.as<raster::ReflectorParams>()) {
     // Vertex projection's parameterization: r(u) of each reflector as a cube cross.
     d.size = std::to_string(params->reflectors.size()) + " reflectors";

@@ -9,6 +9,8 @@
 #include "captured_output.h"
 #include "apps/techniques/frame_settings.h"
 #include "raster/gbuffer.h"
+#include "raster/reflector_maps.h"
+#include "raster/shadow_map.h"
 
 namespace speculum::inspect {
 namespace {
@@ -78,6 +80,29 @@ TEST(InspectImages, GBufferGivesOneViewPerFieldAtItsSize) {
       EXPECT_NEAR(linear_to_srgb(v.picture.at(1, 1).z), 1.0f, 1e-3f);
       EXPECT_EQ(v.picture.at(0, 0).z, 0.0f);
     }
+}
+
+// A cube that leaves faces unrendered (a spot light's shadow cube, a reflector map read on
+// some faces only) names them in its caption; a whole cube says nothing of the kind.
+TEST(InspectImages, CubeCaptionsNameTheFacesNotRendered) {
+  std::vector<raster::ShadowMap> shadows(2);
+  for (raster::ShadowMap& m : shadows)
+    for (ImageF& f : m.cube.distance) f = ImageF(2, 2, 1.0f);
+  shadows[0].type = LightType::Spot;
+  shadows[0].faces = 0b010101u;  // +X, +Y, +Z
+  par::Executor ex(1);
+  const Drawing d = draw_output(capture(shadows), ex);
+  ASSERT_EQ(d.views.size(), 2u);
+  EXPECT_NE(d.views[0].encoding.find("faces -X, -Y, -Z not rendered"), std::string::npos) << d.views[0].encoding;
+  EXPECT_EQ(d.views[1].encoding.find("not rendered"), std::string::npos) << d.views[1].encoding;
+
+  raster::ReflectorMaps maps;
+  maps.cubes.resize(1);
+  for (ImageF& f : maps.cubes[0].distance) f = ImageF(2, 2, 1.0f);
+  maps.faces = {0b111110u};
+  const Drawing m = draw_output(capture(maps), ex);
+  ASSERT_EQ(m.views.size(), 1u);
+  EXPECT_NE(m.views[0].encoding.find("faces +X not rendered"), std::string::npos) << m.views[0].encoding;
 }
 
 TEST(InspectImages, ScalarRampSpansTheFiniteValues) {
