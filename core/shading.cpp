@@ -93,37 +93,6 @@ LightSampler::LightSampler(const Light& light) : light_(&light) {
   cone_scale_ = 1.0f / std::max(0.001f, cos_inner - cos_outer_);
 }
 
-LightSample LightSampler::operator()(const glm::vec3& position) const {
-  const Light& light = *light_;
-  LightSample out;
-  if (light.type == LightType::Directional) {
-    out.direction = -direction_;
-    out.distance = std::numeric_limits<float>::infinity();
-    out.irradiance = light.color * light.intensity;
-    return out;
-  }
-  const glm::vec3 to_light = light.position - position;
-  const float d2 = glm::dot(to_light, to_light);
-  if (!(d2 > 0.0f)) return out;  // at the light itself: no defined direction
-  const float d = std::sqrt(d2);
-  out.direction = to_light / d;
-  out.distance = d;
-  float window = 1.0f;
-  if (light.range > 0.0f) {
-    const float r = d / light.range;
-    const float r2 = r * r;
-    window = std::clamp(1.0f - r2 * r2, 0.0f, 1.0f);
-  }
-  float cone = 1.0f;
-  if (light.type == LightType::Spot) {
-    const float cd = glm::dot(direction_, -out.direction);
-    const float a = std::clamp((cd - cos_outer_) * cone_scale_, 0.0f, 1.0f);
-    cone = a * a;
-  }
-  out.irradiance = light.color * (light.intensity * window * cone / d2);
-  return out;
-}
-
 LightSample sample_light(const Light& light, const glm::vec3& position) { return LightSampler(light)(position); }
 
 glm::vec3 specular_f0(const SurfaceParams& s) {

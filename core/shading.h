@@ -46,9 +46,13 @@
 //   v = acos(d.y)/π (+Y at the top row), times intensity.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -104,6 +108,39 @@ class LightSampler {
   glm::vec3 direction_{0.0f};  // unit (spot and directional lights)
   float cos_outer_ = 0.0f, cone_scale_ = 1.0f;  // spot lights
 };
+
+// Inline: a shading loop calls it per point and light, and the call's returned struct
+// cost more than its arithmetic.
+inline LightSample LightSampler::operator()(const glm::vec3& position) const {
+  const Light& light = *light_;
+  LightSample out;
+  if (light.type == LightType::Directional) {
+    out.direction = -direction_;
+    out.distance = std::numeric_limits<float>::infinity();
+    out.irradiance = light.color * light.intensity;
+    return out;
+  }
+  const glm::vec3 to_light = light.position - position;
+  const float d2 = glm::dot(to_light, to_light);
+  if (!(d2 > 0.0f)) return out;  // at the light itself: no defined direction
+  const float d = std::sqrt(d2);
+  out.direction = to_light / d;
+  out.distance = d;
+  float window = 1.0f;
+  if (light.range > 0.0f) {
+    const float r = d / light.range;
+    const float r2 = r * r;
+    window = std::clamp(1.0f - r2 * r2, 0.0f, 1.0f);
+  }
+  float cone = 1.0f;
+  if (light.type == LightType::Spot) {
+    const float cd = glm::dot(direction_, -out.direction);
+    const float a = std::clamp((cd - cos_outer_) * cone_scale_, 0.0f, 1.0f);
+    cone = a * a;
+  }
+  out.irradiance = light.color * (light.intensity * window * cone / d2);
+  return out;
+}
 
 // F0 of the specular lobe, and the weight of a reflection looked up or traced along R for a
 // viewer at cos_nv = N·V: the lobe's directional albedo E(F0) (glossy; the split-sum scale
