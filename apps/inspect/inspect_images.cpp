@@ -364,9 +364,9 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
       if (has_faces(s.cube.distance)) {
         d.views.push_back(distance_cross_view(name, s.cube.distance));
         d.views.back().encoding += unrendered_faces(s.faces, "outside the spot light's cone");
-      }
-      else if (!s.distance.empty())
+      } else if (!s.distance.empty()) {
         d.views.push_back(scalar_view(name, s.distance));
+      }
     }
   } else if (const auto* clusters = o.as<raster::SoffClusters>()) {
     // SOFF Fig. 4: every cluster in its own false colour, diffuse samples black.
