@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 #include <glm/geometric.hpp>
@@ -28,13 +29,8 @@ float ggx_from_cos_sin(float cos2, float sin2, float alpha) {
 // The albedo table: kTableSize² entries over μ_i = i/(n−1) (clamped to ≥ 1e-3: at the
 // horizon itself the viewer sees nothing) and roughness r_j = j/(n−1), α = r_j²; columns in
 // √α resolve the smooth end, where the albedo changes fastest.
-constexpr int kTableSize = 32;
+constexpr int kTableSize = kAlbedoTableSize;
 constexpr int kQuadraturePoints = 1024;
-
-struct AlbedoTable {
-  std::array<SpecularAlbedo, kTableSize * kTableSize> e{};  // [roughness][μ]
-  std::array<SpecularAlbedo, kTableSize> average{};         // [roughness]
-};
 
 // E(μ, α) by importance sampling visible normals over a fixed Hammersley set, summed in
 // double: the estimator F_x G2/G1 has bounded variance, so 1024 points give ~1e-3.
@@ -57,28 +53,60 @@ SpecularAlbedo integrate_albedo(float mu, float alpha) {
   return {float(scale / kQuadraturePoints), float(bias / kQuadraturePoints)};
 }
 
-const AlbedoTable& albedo_table() {
-  static const AlbedoTable table = [] {
-    AlbedoTable t;
-    for (int j = 0; j < kTableSize; ++j) {
-      const float r = float(j) / float(kTableSize - 1);
-      double avg_scale = 0.0, avg_bias = 0.0;
-      for (int i = 0; i < kTableSize; ++i) {
-        const float mu = std::max(float(i) / float(kTableSize - 1), 1e-3f);
-        const SpecularAlbedo e = integrate_albedo(mu, r * r);
-        t.e[std::size_t(j * kTableSize + i)] = e;
-        // 2 ∫ E μ dμ by the trapezoid rule on the table's own μ grid.
-        const double w = (i == 0 || i == kTableSize - 1 ? 0.5 : 1.0) * 2.0 * (float(i) / float(kTableSize - 1)) /
-                         double(kTableSize - 1);
-        avg_scale += w * e.scale;
-        avg_bias += w * e.bias;
-      }
-      t.average[std::size_t(j)] = {float(avg_scale), float(avg_bias)};
+}  // namespace
+
+AlbedoTable albedo_table_by_quadrature() {
+  AlbedoTable t;
+  for (int j = 0; j < kTableSize; ++j) {
+    const float r = float(j) / float(kTableSize - 1);
+    double avg_scale = 0.0, avg_bias = 0.0;
+    for (int i = 0; i < kTableSize; ++i) {
+      const float mu = std::max(float(i) / float(kTableSize - 1), 1e-3f);
+      const SpecularAlbedo e = integrate_albedo(mu, r * r);
+      t.e[std::size_t(j * kTableSize + i)] = e;
+      // 2 ∫ E μ dμ by the trapezoid rule on the table's own μ grid.
+      const double w = (i == 0 || i == kTableSize - 1 ? 0.5 : 1.0) * 2.0 * (float(i) / float(kTableSize - 1)) /
+                       double(kTableSize - 1);
+      avg_scale += w * e.scale;
+      avg_bias += w * e.bias;
     }
-    return t;
-  }();
-  return table;
+    t.average[std::size_t(j)] = {float(avg_scale), float(avg_bias)};
+  }
+  return t;
 }
+
+const AlbedoTable& albedo_table() {
+  static constexpr AlbedoTable kStored =
+#include "core/albedo_table.inc"
+      ;
+  return kStored;
+}
+
+std::string albedo_table_source(const AlbedoTable& table) {
+  std::string out =
+      "// E(mu, alpha) of core/brdf.h's albedo table and its row averages as {scale, bias}, hex floats\n"
+      "// (exact). Printed by albedo_table_source(albedo_table_by_quadrature()); the test\n"
+      "// AlbedoTable.StoredTableIsTheQuadratures writes it to albedo_table.inc.new when they differ.\n"
+      "AlbedoTable{{{\n";
+  char buf[64];
+  const auto entry = [&](const SpecularAlbedo& e, bool last) {
+    std::snprintf(buf, sizeof buf, "{%a, %a}%s", double(e.scale), double(e.bias), last ? "" : ",");
+    out += buf;
+  };
+  for (std::size_t k = 0; k < table.e.size(); ++k) {
+    entry(table.e[k], k + 1 == table.e.size());
+    out += (k + 1) % 4 == 0 ? "\n" : " ";
+  }
+  out += "}}, {{\n";
+  for (std::size_t k = 0; k < table.average.size(); ++k) {
+    entry(table.average[k], k + 1 == table.average.size());
+    out += (k + 1) % 4 == 0 ? "\n" : " ";
+  }
+  out += "}}}\n";
+  return out;
+}
+
+namespace {
 
 SpecularAlbedo lerp(const SpecularAlbedo& a, const SpecularAlbedo& b, float t) {
   return {a.scale + (b.scale - a.scale) * t, a.bias + (b.bias - a.bias) * t};

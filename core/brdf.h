@@ -27,6 +27,9 @@
 // incidence the weight is 0.96²/(1 − E_avg) ≈ 1.05 × the spec's 0.96. Every factor is symmetric in l and v, so f is reciprocal.
 #pragma once
 
+#include <array>
+#include <string>
+
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -97,6 +100,21 @@ struct SpecularAlbedo {
 SpecularAlbedo specular_albedo(float cos_nv, float alpha);
 // Its cosine-weighted mean over view directions, 2 ∫ E(μ) μ dμ (same split).
 SpecularAlbedo average_specular_albedo(float alpha);
+
+// The table specular_albedo and average_specular_albedo interpolate: E(μ_i, α_j) with
+// μ_i = i/(n−1) (at least 1e-3) and α_j = (j/(n−1))², each by 1024-point quadrature, and per
+// row the cosine-weighted mean 2 ∫ E μ dμ (trapezoid rule on the μ grid). It is stored in
+// core/albedo_table.inc, so no process spends the ~80 ms of quadrature at start; the tests
+// compare it with albedo_table_by_quadrature() bit for bit, and albedo_table_source() prints
+// the file.
+constexpr int kAlbedoTableSize = 32;
+struct AlbedoTable {
+  std::array<SpecularAlbedo, kAlbedoTableSize * kAlbedoTableSize> e{};  // [roughness][μ]
+  std::array<SpecularAlbedo, kAlbedoTableSize> average{};               // [roughness]
+};
+const AlbedoTable& albedo_table();
+AlbedoTable albedo_table_by_quadrature();
+std::string albedo_table_source(const AlbedoTable& table);
 
 // A GGX visible normal for a viewer v_local (in the frame whose +Z is the surface normal,
 // v_local.z > 0), from two uniform numbers in [0, 1): the half-vector h has pdf

@@ -7,7 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <fstream>
 #include <limits>
 #include <vector>
 
@@ -334,6 +337,28 @@ TEST(GltfBrdf, ViewTermsGiveTheBitsOfThePerCallFormula) {
   }
   EXPECT_GT(lit, 8000u);
   EXPECT_GT(highlights, 5000u);
+}
+
+// The albedo table in core/albedo_table.inc is the quadrature's, bit for bit: the file is
+// what albedo_table_source prints. On a mismatch the right file is written beside the test
+// binary's working directory, to be copied over core/albedo_table.inc.
+TEST(AlbedoTable, StoredTableIsTheQuadratures) {
+  const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+  const AlbedoTable computed = albedo_table_by_quadrature();
+  const AlbedoTable& stored = albedo_table();
+  bool same = true;
+  for (std::size_t k = 0; k < computed.e.size(); ++k) {
+    same = same && bits(computed.e[k].scale) == bits(stored.e[k].scale) && bits(computed.e[k].bias) == bits(stored.e[k].bias);
+    EXPECT_EQ(bits(computed.e[k].scale), bits(stored.e[k].scale)) << "entry " << k;
+    EXPECT_EQ(bits(computed.e[k].bias), bits(stored.e[k].bias)) << "entry " << k;
+  }
+  for (std::size_t k = 0; k < computed.average.size(); ++k) {
+    same = same && bits(computed.average[k].scale) == bits(stored.average[k].scale) &&
+           bits(computed.average[k].bias) == bits(stored.average[k].bias);
+    EXPECT_EQ(bits(computed.average[k].scale), bits(stored.average[k].scale)) << "average " << k;
+    EXPECT_EQ(bits(computed.average[k].bias), bits(stored.average[k].bias)) << "average " << k;
+  }
+  if (!same) std::ofstream("albedo_table.inc.new") << albedo_table_source(computed);
 }
 
 // sample_light written out per call (the light's direction and cone cosines recomputed at
