@@ -26,10 +26,8 @@ float ggx_from_cos_sin(float cos2, float sin2, float alpha) {
   return a2 / (kPi * d * d);
 }
 
-// The albedo table: kTableSize² entries over μ_i = i/(n−1) (clamped to ≥ 1e-3: at the
-// horizon itself the viewer sees nothing) and roughness r_j = j/(n−1), α = r_j²; columns in
-// √α resolve the smooth end, where the albedo changes fastest.
-constexpr int kTableSize = kAlbedoTableSize;
+// The albedo table's grid (brdf.h): μ clamped to ≥ 1e-3 because at the horizon itself the
+// viewer sees nothing; columns in √α resolve the smooth end, where the albedo changes fastest.
 constexpr int kQuadraturePoints = 1024;
 
 // E(μ, α) by importance sampling visible normals over a fixed Hammersley set, summed in
@@ -57,16 +55,16 @@ SpecularAlbedo integrate_albedo(float mu, float alpha) {
 
 AlbedoTable albedo_table_by_quadrature() {
   AlbedoTable t;
-  for (int j = 0; j < kTableSize; ++j) {
-    const float r = float(j) / float(kTableSize - 1);
+  for (int j = 0; j < kAlbedoTableSize; ++j) {
+    const float r = float(j) / float(kAlbedoTableSize - 1);
     double avg_scale = 0.0, avg_bias = 0.0;
-    for (int i = 0; i < kTableSize; ++i) {
-      const float mu = std::max(float(i) / float(kTableSize - 1), 1e-3f);
+    for (int i = 0; i < kAlbedoTableSize; ++i) {
+      const float mu = std::max(float(i) / float(kAlbedoTableSize - 1), 1e-3f);
       const SpecularAlbedo e = integrate_albedo(mu, r * r);
-      t.e[std::size_t(j * kTableSize + i)] = e;
+      t.e[std::size_t(j * kAlbedoTableSize + i)] = e;
       // 2 ∫ E μ dμ by the trapezoid rule on the table's own μ grid.
-      const double w = (i == 0 || i == kTableSize - 1 ? 0.5 : 1.0) * 2.0 * (float(i) / float(kTableSize - 1)) /
-                       double(kTableSize - 1);
+      const double w = (i == 0 || i == kAlbedoTableSize - 1 ? 0.5 : 1.0) * 2.0 * (float(i) / float(kAlbedoTableSize - 1)) /
+                       double(kAlbedoTableSize - 1);
       avg_scale += w * e.scale;
       avg_bias += w * e.bias;
     }
@@ -88,20 +86,19 @@ std::string albedo_table_source(const AlbedoTable& table) {
       "// (exact). Printed by albedo_table_source(albedo_table_by_quadrature()); the test\n"
       "// AlbedoTable.StoredTableIsTheQuadratures writes it to albedo_table.inc.new when they differ.\n"
       "AlbedoTable{{{\n";
-  char buf[64];
-  const auto entry = [&](const SpecularAlbedo& e, bool last) {
-    std::snprintf(buf, sizeof buf, "{%a, %a}%s", double(e.scale), double(e.bias), last ? "" : ",");
-    out += buf;
+  // One array's entries, four to a line.
+  const auto list = [&](const auto& entries) {
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      char buf[64];
+      const bool last = k + 1 == entries.size();
+      std::snprintf(buf, sizeof buf, "{%a, %a}%s", double(entries[k].scale), double(entries[k].bias), last ? "" : ",");
+      out += buf;
+      out += (k + 1) % 4 == 0 ? "\n" : " ";
+    }
   };
-  for (std::size_t k = 0; k < table.e.size(); ++k) {
-    entry(table.e[k], k + 1 == table.e.size());
-    out += (k + 1) % 4 == 0 ? "\n" : " ";
-  }
+  list(table.e);
   out += "}}, {{\n";
-  for (std::size_t k = 0; k < table.average.size(); ++k) {
-    entry(table.average[k], k + 1 == table.average.size());
-    out += (k + 1) % 4 == 0 ? "\n" : " ";
-  }
+  list(table.average);
   out += "}}}\n";
   return out;
 }
@@ -114,8 +111,8 @@ SpecularAlbedo lerp(const SpecularAlbedo& a, const SpecularAlbedo& b, float t) {
 
 // Position of x ∈ [0, 1] on the table grid: cell index and fraction.
 std::pair<int, float> grid(float x) {
-  const float f = std::clamp(x, 0.0f, 1.0f) * float(kTableSize - 1);
-  const int i = std::min(static_cast<int>(f), kTableSize - 2);
+  const float f = std::clamp(x, 0.0f, 1.0f) * float(kAlbedoTableSize - 1);
+  const int i = std::min(static_cast<int>(f), kAlbedoTableSize - 2);
   return {i, f - float(i)};
 }
 
@@ -125,7 +122,7 @@ SpecularAlbedo specular_albedo(float cos_nv, float alpha) {
   const AlbedoTable& t = albedo_table();
   const auto [j, tr] = grid(std::sqrt(std::clamp(alpha, 0.0f, 1.0f)));
   const auto [i, tm] = grid(cos_nv);
-  auto at = [&](int jj, int ii) { return t.e[std::size_t(jj * kTableSize + ii)]; };
+  auto at = [&](int jj, int ii) { return t.e[std::size_t(jj * kAlbedoTableSize + ii)]; };
   return lerp(lerp(at(j, i), at(j, i + 1), tm), lerp(at(j + 1, i), at(j + 1, i + 1), tm), tr);
 }
 

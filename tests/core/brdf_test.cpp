@@ -346,19 +346,15 @@ TEST(AlbedoTable, StoredTableIsTheQuadratures) {
   const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
   const AlbedoTable computed = albedo_table_by_quadrature();
   const AlbedoTable& stored = albedo_table();
-  bool same = true;
-  for (std::size_t k = 0; k < computed.e.size(); ++k) {
-    same = same && bits(computed.e[k].scale) == bits(stored.e[k].scale) && bits(computed.e[k].bias) == bits(stored.e[k].bias);
-    EXPECT_EQ(bits(computed.e[k].scale), bits(stored.e[k].scale)) << "entry " << k;
-    EXPECT_EQ(bits(computed.e[k].bias), bits(stored.e[k].bias)) << "entry " << k;
-  }
-  for (std::size_t k = 0; k < computed.average.size(); ++k) {
-    same = same && bits(computed.average[k].scale) == bits(stored.average[k].scale) &&
-           bits(computed.average[k].bias) == bits(stored.average[k].bias);
-    EXPECT_EQ(bits(computed.average[k].scale), bits(stored.average[k].scale)) << "average " << k;
-    EXPECT_EQ(bits(computed.average[k].bias), bits(stored.average[k].bias)) << "average " << k;
-  }
-  if (!same) std::ofstream("albedo_table.inc.new") << albedo_table_source(computed);
+  const auto expect_same = [&](const auto& want, const auto& got, const char* what) {
+    for (std::size_t k = 0; k < want.size(); ++k) {
+      EXPECT_EQ(bits(want[k].scale), bits(got[k].scale)) << what << " " << k;
+      EXPECT_EQ(bits(want[k].bias), bits(got[k].bias)) << what << " " << k;
+    }
+  };
+  expect_same(computed.e, stored.e, "entry");
+  expect_same(computed.average, stored.average, "average");
+  if (HasFailure()) std::ofstream("albedo_table.inc.new") << albedo_table_source(computed);
 }
 
 // sample_light written out per call (the light's direction and cone cosines recomputed at
