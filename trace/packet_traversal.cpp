@@ -296,6 +296,11 @@ struct Entry {
   return improved;
 }
 
+// A refused packet's rays, traced as single rays.
+void closest_hits_one_by_one(const Bvh& bvh, const Ray* rays, int count, Hit* out, TraversalCounters* counters) {
+  for (int r = 0; r < count; ++r) out[r] = closest_hit(bvh, rays[r], counters);
+}
+
 // The inner children in `bits` whose entry bound tn[k] is within max_t, sorted far to
 // near into `hits` (the nearest last, where the descent continues); returns their count.
 [[gnu::always_inline]] inline int children_far_to_near(const WideNode& n, unsigned bits, const float* tn,
@@ -321,7 +326,7 @@ bool closest_hit_packet(const Bvh& bvh, const Ray* rays, int count, Hit* out, Tr
   count = std::clamp(count, 0, kMaxPacketSize);
   Packet p;
   if (count < 2 || bvh.wide_root() == kEmptyChild || (bvh.wide_root() & kLeafBit) || !prepare(rays, count, p)) {
-    for (int r = 0; r < count; ++r) out[r] = closest_hit(bvh, rays[r], counters);
+    closest_hits_one_by_one(bvh, rays, count, out, counters);
     return false;
   }
   TraversalCounters c;
@@ -431,7 +436,7 @@ void closest_hit_stream_packets(const Bvh& bvh, const RayStream& rays, HitStream
       for (int k = 0; k < count; ++k) r[k] = rays.get(slot[k]);
       if (skip > 0) {
         --skip;
-        for (int k = 0; k < count; ++k) hh[k] = closest_hit(bvh, r[k], &c);
+        closest_hits_one_by_one(bvh, r, count, hh, &c);
       } else if (closest_hit_packet(bvh, r, count, hh, &c)) {
         backoff = 1;
       } else {

@@ -8,7 +8,9 @@
 
 #include "tests/test_dependency.h"
 
+#include <algorithm>
 #include <cstring>
+#include <string>
 
 #include "core/camera_rays.h"
 #include "trace/bvh.h"
@@ -40,6 +42,17 @@ std::vector<Ray> pinhole_rays(glm::vec3 eye, glm::vec3 target, int w, int h, flo
       rays.push_back(ray);
     }
   return rays;
+}
+
+// Two streams' hits are the same bits, ray by ray (`what` names the comparison).
+void expect_same_hits(const HitStream& want, const HitStream& got, const std::string& what) {
+  ASSERT_EQ(want.triangle.size(), got.triangle.size()) << what;
+  for (std::size_t i = 0; i < want.triangle.size(); ++i) {
+    ASSERT_EQ(want.triangle[i], got.triangle[i]) << "ray " << i << ", " << what;
+    ASSERT_EQ(bits(want.t[i]), bits(got.t[i])) << "ray " << i << ", " << what;
+    ASSERT_EQ(bits(want.u[i]), bits(got.u[i])) << "ray " << i << ", " << what;
+    ASSERT_EQ(bits(want.v[i]), bits(got.v[i])) << "ray " << i << ", " << what;
+  }
 }
 
 // Traces rays in packets of 8 and compares every ray with the oracle. Returns the number
@@ -188,11 +201,7 @@ TEST(PacketTraversal, StreamEqualsSingleRaysForAnyThreadCount) {
     TraversalCounters c;
     closest_hit_stream_packets(bvh, rays, packed, ex, &c);
     EXPECT_EQ(c.rays, rays.size());
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      ASSERT_EQ(single.triangle[i], packed.triangle[i]) << "ray " << i << ", " << threads << " threads";
-      ASSERT_EQ(bits(single.t[i]), bits(packed.t[i])) << "ray " << i;
-      ASSERT_EQ(bits(single.u[i]), bits(packed.u[i])) << "ray " << i;
-    }
+    ASSERT_NO_FATAL_FAILURE(expect_same_hits(single, packed, std::to_string(threads) + " threads"));
   }
 }
 
@@ -215,15 +224,9 @@ TEST(PacketTraversal, StreamReturnsToPacketsAfterIncoherentRays) {
   TraversalCounters single_counts, packed_counts;
   closest_hit_stream(bvh, rays, single, ex, &single_counts);
   closest_hit_stream_packets(bvh, rays, packed, ex, &packed_counts);
-  int hits = 0;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    ASSERT_EQ(single.triangle[i], packed.triangle[i]) << "ray " << i;
-    ASSERT_EQ(bits(single.t[i]), bits(packed.t[i])) << "ray " << i;
-    ASSERT_EQ(bits(single.u[i]), bits(packed.u[i])) << "ray " << i;
-    ASSERT_EQ(bits(single.v[i]), bits(packed.v[i])) << "ray " << i;
-    hits += single.triangle[i] != kNoHit;
-  }
-  EXPECT_GT(hits, 100);
+  ASSERT_NO_FATAL_FAILURE(expect_same_hits(single, packed, "back to packets"));
+  EXPECT_GT(std::count_if(single.triangle.begin(), single.triangle.end(), [](std::uint32_t t) { return t != kNoHit; }),
+            100);
   EXPECT_EQ(packed_counts.rays, rays.size());
   EXPECT_LT(packed_counts.nodes_visited, single_counts.nodes_visited);
 }
