@@ -15,6 +15,8 @@
 #include <utility>
 #include <vector>
 
+#include <glm/gtc/type_ptr.hpp>
+
 #include "core/error.h"
 #include "trace/bvh.h"
 
@@ -193,8 +195,9 @@ Split best_split(const Bins& bins, const Aabb& cbox, std::size_t n, int nb) {
 struct LaneBounds {
   __m128 lo = _mm_set1_ps(3.0e38f), hi = _mm_set1_ps(-3.0e38f);
   __m128 clo = _mm_set1_ps(3.0e38f), chi = _mm_set1_ps(-3.0e38f);
-  void grow(const PrimRef& r) {
-    const __m128 l = _mm_loadu_ps(&r.lo.x), h = _mm_loadu_ps(&r.hi.x);
+  void grow(const PrimRef& r) { grow(_mm_loadu_ps(&r.lo.x), _mm_loadu_ps(&r.hi.x)); }
+  // A ref's lo and hi rows (lane 3: its id and pad bits, ignored).
+  void grow(__m128 l, __m128 h) {
     const __m128 c = _mm_add_ps(l, h);
     lo = _mm_min_ps(lo, l);
     hi = _mm_max_ps(hi, h);
@@ -221,17 +224,29 @@ std::pair<Range, Range> partition(PrimRef* refs, const Range& r, const Split& s,
     for (std::uint32_t i = r.begin; i < mid; ++i) lb.grow(refs[i]);
     for (std::uint32_t i = mid; i < r.end; ++i) rb.grow(refs[i]);
   } else {
+    // Binner::bin on the split axis alone: the same operations on the same component.
+    const int a = s.axis;
+    const float bin_lo = b.lo[a], bin_scale = b.scale[a];
+    auto left = [&](const PrimRef& p) {
+      const float c = glm::value_ptr(p.lo)[a] + glm::value_ptr(p.hi)[a];
+      return std::clamp(static_cast<int>((c - bin_lo) * bin_scale), 0, b.bins - 1) <= s.bin;
+    };
     // Hoare-style in place; every element is classified once and grows its side's bounds.
+    // A swapped pair moves through registers, which also grow the bounds: reading the refs
+    // back right after their stores stalled on store forwarding.
     PrimRef* lo = refs + r.begin;
     PrimRef* hi = refs + r.end;
-    auto left = [&](const PrimRef& p) { return b.bin(p.centroid2(), s.axis) <= s.bin; };
     while (true) {
       while (lo < hi && left(*lo)) lb.grow(*lo++);
       while (lo < hi && !left(*(hi - 1))) rb.grow(*--hi);
       if (lo >= hi) break;
-      std::swap(*lo, *(hi - 1));
-      lb.grow(*lo++);
-      rb.grow(*--hi);
+      --hi;
+      const __m256 x = _mm256_loadu_ps(&lo->lo.x), y = _mm256_loadu_ps(&hi->lo.x);
+      _mm256_storeu_ps(&lo->lo.x, y);
+      _mm256_storeu_ps(&hi->lo.x, x);
+      lb.grow(_mm256_castps256_ps128(y), _mm256_extractf128_ps(y, 1));
+      rb.grow(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1));
+      ++lo;
     }
     L.end = R.begin = static_cast<std::uint32_t>(lo - refs);
   }

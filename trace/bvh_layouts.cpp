@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -14,25 +15,80 @@ namespace speculum::trace {
 
 namespace {
 
-// The threaded layout: parents precede children, so a forward pass hands each child its
-// miss link.
-void derive_threaded(const BulkVector<BinaryNode>& binary, BulkVector<ThreadedNode>& threaded) {
-  threaded.resize(binary.size());
-  if (!binary.empty()) threaded[0].miss = kThreadEnd;
-  for (std::size_t i = 0; i < binary.size(); ++i) {
+// The end of binary node i's subtree, whose nodes are the index range [i, end) in
+// depth-first order: its last node is reached through right children.
+std::size_t subtree_end(const BulkVector<BinaryNode>& binary, std::size_t i) {
+  while (!binary[i].is_leaf()) i = binary[i].right;
+  return i + 1;
+}
+
+// Binary subtrees of at most this many nodes are one task of a parallel sweep.
+std::size_t subtree_grain(std::size_t nodes) { return std::max<std::size_t>(nodes / 64, 4096); }
+
+// The binary tree cut for parallel sweeps: the subtrees of at most subtree_grain nodes whose
+// parent's subtree is larger (each an index range [begin, end) in depth-first order), and the
+// nodes above them, in increasing index order. A node's children lie in its own part, or are
+// top nodes or part roots.
+struct SubtreeParts {
+  std::vector<std::pair<std::size_t, std::size_t>> parts;
+  std::vector<std::size_t> top;
+};
+
+SubtreeParts cut_subtrees(const BulkVector<BinaryNode>& binary) {
+  SubtreeParts cut;
+  const std::size_t grain = subtree_grain(binary.size());
+  std::vector<std::size_t> stack;
+  if (!binary.empty()) stack.push_back(0);
+  while (!stack.empty()) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    const std::size_t end = subtree_end(binary, i);
+    if (end - i <= grain) {
+      cut.parts.emplace_back(i, end);
+      continue;
+    }
+    cut.top.push_back(i);
+    stack.push_back(binary[i].right);
+    stack.push_back(i + 1);
+  }
+  std::sort(cut.top.begin(), cut.top.end());
+  return cut;
+}
+
+// Calls visit(i) for every node, children before parents: each part in parallel from its
+// last node down, then the top nodes in decreasing index order. A visit that reads only its
+// children's results computes the same values as one serial sweep, for any thread count.
+template <class Visit>
+void sweep_bottom_up(par::Executor& ex, std::string_view name, const SubtreeParts& cut, Visit&& visit) {
+  ex.parallel_for(name, cut.parts.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p)
+      for (std::size_t i = cut.parts[p].second; i-- > cut.parts[p].first;) visit(i);
+  });
+  for (std::size_t k = cut.top.size(); k-- > 0;) visit(cut.top[k]);
+}
+
+// The threaded layout: a node's miss link is the node after its subtree (kThreadEnd after the
+// last), whose end is its right child's subtree's end; its hit link is its left child (the
+// next node), or for a leaf the miss link.
+void derive_threaded(const BulkVector<BinaryNode>& binary, const SubtreeParts& cut, par::Executor& ex,
+                     BulkVector<ThreadedNode>& threaded) {
+  const std::size_t n = binary.size();
+  threaded.resize(n);
+  const auto link = [n](std::size_t end) { return end < n ? static_cast<std::uint32_t>(end) : kThreadEnd; };
+  sweep_bottom_up(ex, "bvh_threaded", cut, [&](std::size_t i) {
     const BinaryNode& b = binary[i];
     ThreadedNode& t = threaded[i];
     t.box = b.box;
     t.first = b.first;
     t.count = b.count;
     if (b.is_leaf()) {
+      t.miss = link(i + 1);
       t.hit = t.miss;
     } else {
+      t.miss = threaded[b.right].miss;
       t.hit = static_cast<std::uint32_t>(i + 1);
-      threaded[i + 1].miss = b.right;
-      threaded[b.right].miss = t.miss;
     }
-  }
+  });
 }
 
 // One leaf's triangles as packs of 4 (unused lanes: NaN vertices, id kEmptyChild).
@@ -71,7 +127,7 @@ struct CollapsePlan {
 // parallel (one task each, children before parents), then the few nodes above them in
 // decreasing index order. Every cost is computed by the same operations as in one serial
 // sweep, so the plan does not depend on the thread count.
-CollapsePlan plan_collapse(const BulkVector<BinaryNode>& binary, par::Executor& ex) {
+CollapsePlan plan_collapse(const BulkVector<BinaryNode>& binary, const SubtreeParts& cut, par::Executor& ex) {
   const std::size_t n = binary.size();
   CollapsePlan plan;
   plan.choice.resize(n * kWideArity);
@@ -114,40 +170,85 @@ CollapsePlan plan_collapse(const BulkVector<BinaryNode>& binary, par::Executor& 
       choice[j - 1] = dissolve ? split_left[j] : 0;
     }
   };
-  // The end of i's subtree: its last node is reached through right children.
-  auto subtree_end = [&](std::size_t i) {
-    while (!binary[i].is_leaf()) i = binary[i].right;
-    return i + 1;
-  };
-  const std::size_t grain = std::max<std::size_t>(n / 64, 4096);
-  std::vector<std::size_t> top;
-  std::vector<std::pair<std::size_t, std::size_t>> parts;
-  std::vector<std::size_t> stack;
-  if (n > 0) stack.push_back(0);
-  while (!stack.empty()) {
-    const std::size_t i = stack.back();
-    stack.pop_back();
-    const std::size_t end = subtree_end(i);
-    if (end - i <= grain) {
-      parts.emplace_back(i, end);
-      continue;
-    }
-    top.push_back(i);
-    stack.push_back(binary[i].right);
-    stack.push_back(i + 1);
-  }
-  ex.parallel_for("bvh_collapse_plan", parts.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t p = b; p < e; ++p)
-      for (std::size_t i = parts[p].second; i-- > parts[p].first;) plan_node(i);
-  });
-  std::sort(top.begin(), top.end());
-  for (std::size_t k = top.size(); k-- > 0;) plan_node(top[k]);
+  sweep_bottom_up(ex, "bvh_collapse_plan", cut, plan_node);
   return plan;
 }
 
-// Wide: depth-first allocation, so a child's index is always larger than its parent's.
+// The children of the wide node over binary inner node b, in slot order: the binary nodes the
+// plan keeps as slots.
+int wide_children(const BulkVector<BinaryNode>& binary, const CollapsePlan& plan, std::uint32_t b,
+                  std::uint32_t kids[kWideArity]) {
+  int count = 0;
+  auto emit = [&](auto&& self, std::uint32_t c, int slots) -> void {
+    const int k = binary[c].is_leaf() ? 0 : plan.choice[c * kWideArity + slots - 1];
+    if (k == 0) {
+      kids[count++] = c;
+      return;
+    }
+    self(self, c + 1, k);
+    self(self, binary[c].right, slots - k);
+  };
+  const int k = plan.node_split[b];
+  emit(emit, b + 1, k);
+  emit(emit, binary[b].right, kWideArity - k);
+  return count;
+}
+
+// A wide node over the given children; an inner child's slot is left kEmptyChild, to be
+// set to its wide index when that is known.
+WideNode make_wide_node(const BulkVector<BinaryNode>& binary, const std::vector<std::uint32_t>& leaf_ref,
+                        const std::uint32_t* kids, int count) {
+  WideNode node;
+  std::memset(&node, 0, sizeof(node));
+  for (int k = 0; k < kWideArity; ++k) {
+    if (k >= count) {
+      node.lo_x[k] = node.lo_y[k] = node.lo_z[k] = 3.0e38f;
+      node.hi_x[k] = node.hi_y[k] = node.hi_z[k] = -3.0e38f;
+      node.child[k] = kEmptyChild;
+      continue;
+    }
+    const BinaryNode& c = binary[kids[k]];
+    node.lo_x[k] = c.box.lo.x; node.lo_y[k] = c.box.lo.y; node.lo_z[k] = c.box.lo.z;
+    node.hi_x[k] = c.box.hi.x; node.hi_y[k] = c.box.hi.y; node.hi_z[k] = c.box.hi.z;
+    node.child[k] = c.is_leaf() ? leaf_ref[kids[k]] : kEmptyChild;
+  }
+  return node;
+}
+
+// The wide subtree over binary inner node `root` in preorder (a node, then its children's
+// subtrees in slot order): written to out[0, n) with child indices offset by `offset` when
+// `out` is given, counted only otherwise. Returns n.
+std::uint32_t emit_wide_subtree(const BulkVector<BinaryNode>& binary, const std::vector<std::uint32_t>& leaf_ref,
+                                const CollapsePlan& plan, std::uint32_t root, WideNode* out, std::uint32_t offset) {
+  struct Item {
+    std::uint32_t binary;
+    std::uint32_t parent;  // local index of the wide node to patch (kEmptyChild: the root)
+    int slot;
+  };
+  std::vector<Item> stack{{root, kEmptyChild, 0}};
+  std::uint32_t n = 0;
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    const std::uint32_t me = n++;
+    std::uint32_t kids[kWideArity];
+    const int count = wide_children(binary, plan, it.binary, kids);
+    if (out) {
+      if (it.parent != kEmptyChild) out[it.parent].child[it.slot] = offset + me;
+      out[me] = make_wide_node(binary, leaf_ref, kids, count);
+    }
+    for (int k = count - 1; k >= 0; --k)
+      if (!binary[kids[k]].is_leaf()) stack.push_back({kids[k], me, k});
+  }
+  return n;
+}
+
+// Wide: preorder allocation, so a child's index is always larger than its parent's. The
+// wide nodes over binary subtrees below a size are tasks, counted and then written in
+// parallel; the few nodes above them are placed in one serial preorder walk, each task's
+// nodes at the index its preorder position gives: the same array as one serial walk.
 void derive_wide(const BulkVector<BinaryNode>& binary, const std::vector<std::uint32_t>& leaf_ref,
-                 const CollapsePlan& plan, BulkVector<WideNode>& wide, std::uint32_t& wide_root) {
+                 const CollapsePlan& plan, par::Executor& ex, BulkVector<WideNode>& wide, std::uint32_t& wide_root) {
   wide.clear();
   wide_root = kEmptyChild;
   if (binary.empty()) return;
@@ -155,53 +256,75 @@ void derive_wide(const BulkVector<BinaryNode>& binary, const std::vector<std::ui
     wide_root = leaf_ref[0];
     return;
   }
-  wide.reserve(binary.size() / 2);
-  struct Item {
-    std::uint32_t binary;
-    std::uint32_t parent;  // wide node to patch (kEmptyChild: root)
-    int slot;
-  };
-  std::vector<Item> stack{{0, kEmptyChild, 0}};
-  while (!stack.empty()) {
-    const Item it = stack.back();
-    stack.pop_back();
-    const auto me = static_cast<std::uint32_t>(wide.size());
-    if (it.parent == kEmptyChild) wide_root = me;
-    else wide[it.parent].child[it.slot] = me;
+  const std::size_t grain = subtree_grain(binary.size());
+  // The top nodes in preorder with their children, and the tasks in preorder.
+  struct Top {
     std::uint32_t kids[kWideArity];
-    int count = 0;
-    auto emit = [&](auto&& self, std::uint32_t c, int slots) -> void {
-      const int k = binary[c].is_leaf() ? 0 : plan.choice[c * kWideArity + slots - 1];
-      if (k == 0) {
-        kids[count++] = c;
-        return;
-      }
-      self(self, c + 1, k);
-      self(self, binary[c].right, slots - k);
-    };
-    const int k = plan.node_split[it.binary];
-    emit(emit, it.binary + 1, k);
-    emit(emit, binary[it.binary].right, kWideArity - k);
-    WideNode node;
-    std::memset(&node, 0, sizeof(node));
-    for (int k = 0; k < kWideArity; ++k) {
-      if (k >= count) {
-        node.lo_x[k] = node.lo_y[k] = node.lo_z[k] = 3.0e38f;
-        node.hi_x[k] = node.hi_y[k] = node.hi_z[k] = -3.0e38f;
-        node.child[k] = kEmptyChild;
-        continue;
-      }
-      const BinaryNode& c = binary[kids[k]];
-      node.lo_x[k] = c.box.lo.x; node.lo_y[k] = c.box.lo.y; node.lo_z[k] = c.box.lo.z;
-      node.hi_x[k] = c.box.hi.x; node.hi_y[k] = c.box.hi.y; node.hi_z[k] = c.box.hi.z;
-      node.child[k] = c.is_leaf() ? leaf_ref[kids[k]] : kEmptyChild;  // inner: patched when visited
+    int count;
+  };
+  struct Task {
+    std::uint32_t binary, offset, count;
+  };
+  std::vector<Top> top;
+  std::vector<Task> tasks;
+  auto collect = [&](auto&& self, std::uint32_t b) -> void {
+    Top t;
+    t.count = wide_children(binary, plan, b, t.kids);
+    top.push_back(t);
+    for (int k = 0; k < t.count; ++k) {
+      const std::uint32_t c = t.kids[k];
+      if (binary[c].is_leaf()) continue;
+      if (subtree_end(binary, c) - c <= grain) tasks.push_back({c, 0, 0});
+      else self(self, c);
     }
-    wide.push_back(node);
-    for (int k = count - 1; k >= 0; --k)
-      if (!binary[kids[k]].is_leaf()) stack.push_back({kids[k], me, k});
+  };
+  if (subtree_end(binary, 0) <= grain) tasks.push_back({0, 0, 0});  // the whole tree is one task
+  else collect(collect, 0);
+  ex.parallel_for("bvh_wide_count", tasks.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t)
+      tasks[t].count = emit_wide_subtree(binary, leaf_ref, plan, tasks[t].binary, nullptr, 0);
+  });
+  // Preorder placement: a top node, then each inner child's subtree (a task's nodes, or the
+  // next top node's) in slot order.
+  std::uint32_t cursor = 0;
+  std::size_t next_top = 0, next_task = 0;
+  std::vector<std::uint32_t> top_index(top.size());
+  std::vector<WideNode> top_nodes(top.size());
+  auto place = [&](auto&& self) -> std::uint32_t {
+    const std::size_t me_top = next_top++;
+    const std::uint32_t me = cursor++;
+    const Top& t = top[me_top];
+    WideNode node = make_wide_node(binary, leaf_ref, t.kids, t.count);
+    for (int k = 0; k < t.count; ++k) {
+      const std::uint32_t c = t.kids[k];
+      if (binary[c].is_leaf()) continue;
+      if (next_task < tasks.size() && tasks[next_task].binary == c) {
+        Task& task = tasks[next_task++];
+        task.offset = cursor;
+        cursor += task.count;
+        node.child[k] = task.offset;
+      } else {
+        node.child[k] = self(self);
+      }
+    }
+    top_index[me_top] = me;
+    top_nodes[me_top] = node;
+    return me;
+  };
+  if (top.empty()) {
+    tasks[0].offset = 0;
+    cursor = tasks[0].count;
+  } else {
+    place(place);
   }
+  wide.resize(cursor);
+  for (std::size_t k = 0; k < top.size(); ++k) wide[top_index[k]] = top_nodes[k];
+  ex.parallel_for("bvh_wide_fill", tasks.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t t = b; t < e; ++t)
+      emit_wide_subtree(binary, leaf_ref, plan, tasks[t].binary, wide.data() + tasks[t].offset, tasks[t].offset);
+  });
+  wide_root = 0;
 }
-
 
 }  // namespace
 
@@ -230,12 +353,10 @@ void Bvh::derive_layouts(par::Executor& ex) {
   });
   stats_.triangle_packs = packs_.size();
 
-  // The threaded layout and the wide collapse are independent: one task each.
-  const CollapsePlan plan = plan_collapse(binary_, ex);
-  ex.parallel_for("bvh_layouts", 2, 1, [&](std::size_t task, std::size_t) {
-    if (task == 0) derive_threaded(binary_, threaded_);
-    else derive_wide(binary_, leaf_ref, plan, wide_, wide_root_);
-  });
+  const SubtreeParts cut = cut_subtrees(binary_);
+  const CollapsePlan plan = plan_collapse(binary_, cut, ex);
+  derive_wide(binary_, leaf_ref, plan, ex, wide_, wide_root_);
+  derive_threaded(binary_, cut, ex, threaded_);
 }
 
 std::uint64_t Bvh::content_hash() const {

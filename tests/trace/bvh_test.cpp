@@ -196,6 +196,37 @@ TEST(Bvh, BuildOfAFixedSoupKeepsItsContentHash) {
   EXPECT_EQ(Bvh::build(s.positions, s.indices, ex).content_hash(), 0x024be6ad12ee40ceull);
 }
 
+// The threaded layout is derived bottom-up in parallel parts; its links must be what a serial
+// walk from the root gives: the root's miss link ends the walk, an inner node's left child
+// misses to its right child and its right child to where the node itself misses.
+TEST(Bvh, ThreadedLinksAreTheDepthFirstWalksForAnyThreadCount) {
+  const Soup s = testing::random_soup(120000, 17, 0.02f);
+  for (int threads : {1, 2, 8}) {
+    par::Executor ex(threads);
+    const Bvh bvh = Bvh::build(s.positions, s.indices, ex);
+    const auto& binary = bvh.binary_nodes();
+    const auto& threaded = bvh.threaded_nodes();
+    ASSERT_EQ(threaded.size(), binary.size());
+    ASSERT_GT(binary.size(), 4u * 4096u);  // several parallel parts
+    std::vector<std::uint32_t> miss(binary.size(), 0);
+    miss[0] = kThreadEnd;
+    for (std::size_t i = 0; i < binary.size(); ++i) {
+      const BinaryNode& b = binary[i];
+      if (!b.is_leaf()) {
+        miss[i + 1] = b.right;
+        miss[b.right] = miss[i];
+      }
+      const std::uint32_t hit = b.is_leaf() ? miss[i] : static_cast<std::uint32_t>(i + 1);
+      ASSERT_EQ(threaded[i].miss, miss[i]) << "node " << i << ", " << threads << " threads";
+      ASSERT_EQ(threaded[i].hit, hit) << "node " << i << ", " << threads << " threads";
+      ASSERT_EQ(threaded[i].count, b.count);
+      ASSERT_EQ(threaded[i].first, b.first);
+      ASSERT_EQ(bits(threaded[i].box.lo.x), bits(b.box.lo.x));
+      ASSERT_EQ(bits(threaded[i].box.hi.z), bits(b.box.hi.z));
+    }
+  }
+}
+
 TEST(Bvh, RefitMatchesOracleAfterMotion) {
   Soup s = testing::random_soup(2000, 31);
   par::Executor ex(2);
