@@ -66,7 +66,7 @@ constexpr std::uint32_t kMaxTriangles = 1u << 28;  // leaf references keep 29 bi
 
 // Up to 4 leaf triangles as structure of arrays, intersected together; unused lanes hold
 // NaN vertices (never a hit) and id kEmptyChild.
-struct alignas(64) TrianglePack {
+struct alignas(32) TrianglePack {
   float ax[4], ay[4], az[4];
   float bx[4], by[4], bz[4];
   float cx[4], cy[4], cz[4];
