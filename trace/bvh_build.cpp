@@ -102,7 +102,14 @@ void merge_bins(Bins& into, const Bins& from, int nb) {
 // 1.02M triangles; from 64 refs on, 19 % less).
 constexpr std::size_t kTwoBinSetsFrom = 64;
 
-void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
+// Empties the first nb bins of each axis (the only ones a range of nb bins reads).
+void clear_bins(Bins& bins, int nb) {
+  for (auto& axis : bins) std::fill_n(axis.begin(), nb, Bin{});
+}
+
+// Adds refs[0, n) to `out`, whose first b.bins bins of each axis hold a range's bins so far;
+// `second` is scratch.
+void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out, Bins& second) {
   // Lane 3 of a ref's lo/hi holds the id/pad bits: it is zeroed before the bin index is
   // formed, and ignored in the bin boxes. Lanes 0-2 do exactly Binner::bin's operations.
   const __m128 blo = _mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, 0.0f);
@@ -131,7 +138,7 @@ void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out) {
   // Neighbouring refs (neighbouring triangles) mostly land in the same bins, and each update
   // of a bin waits for the store of the one before: every other ref goes to a second set,
   // merged at the end (min/max/count: exact in any order), which halves that chain.
-  Bins second;
+  clear_bins(second, b.bins);
   std::size_t i = 0;
   for (; i + 1 < n; i += 2) {
     add(refs[i], out);
@@ -291,7 +298,10 @@ void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt,
   std::vector<Item> stack;
   stack.push_back({root, kEmptyChild, 0});
   std::vector<BinaryNode>& nodes = out.nodes;
-  Bins bins;
+  // At most 2n - 1 nodes: reserved address space, so the vector never moves (pages are only
+  // touched as nodes are written).
+  nodes.reserve(2 * static_cast<std::size_t>(root.end - root.begin));
+  Bins bins, scratch;
   while (!stack.empty()) {
     const Item it = stack.back();
     stack.pop_back();
@@ -305,8 +315,8 @@ void build_subtree(PrimRef* refs, const Range& root, const BvhBuildOptions& opt,
     const int nb = small_range_bins(it.range.end - it.range.begin, opt.bins);
     const Binner binner(it.range.cbox, nb);
     if (!leaf) {
-      for (int a = 0; a < 3; ++a) std::fill_n(bins[a].begin(), nb, Bin{});
-      bin_refs(refs + it.range.begin, it.range.end - it.range.begin, binner, bins);
+      clear_bins(bins, nb);
+      bin_refs(refs + it.range.begin, it.range.end - it.range.begin, binner, bins, scratch);
       leaf = make_leaf(it.range, bins, opt, nb, split);
     }
     if (leaf) {
@@ -397,8 +407,9 @@ Bins bin_range_parallel(par::Executor& ex, const BulkVector<PrimRef>& refs, cons
   std::vector<Bins> part(chunks);
   ex.parallel_for("bvh_bin", n, kBinChunk, [&](std::size_t b, std::size_t e) {
     Bins& local = part[b / kBinChunk];
-    for (auto& axis : local) axis.fill(Bin{});
-    bin_refs(refs.data() + range.begin + b, e - b, binner, local);
+    Bins scratch;
+    clear_bins(local, nbins);
+    bin_refs(refs.data() + range.begin + b, e - b, binner, local, scratch);
   });
   Bins bins;
   for (auto& axis : bins) axis.fill(Bin{});
