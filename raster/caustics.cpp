@@ -314,7 +314,7 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         ex.parallel_for("caustic_photons", n, 256, [&](std::size_t b, std::size_t e) {
           for (std::size_t i = b; i < e; ++i) {
             if (gb.object.pixels[i] != object) continue;
-            const SurfaceParams& s = gb.surface.pixels[i];
+            const SurfaceParams& s = gb.surface[i];
             if (!generator_material(s)) continue;
             const glm::vec3 p1 = gb.position.pixels[i];
             const glm::vec3 v = directional ? glm::normalize(light.direction) : glm::normalize(p1 - light.position);
@@ -647,7 +647,7 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
   ex.parallel_for("caustic_gather", n, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (s.is_refractor()) continue;
       const glm::vec3 p = g.position.pixels[i], nrm = g.normal.pixels[i], v = g.view_direction(i);
       glm::vec3 sum(0.0f);

@@ -110,7 +110,7 @@ ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffe
       glm::vec3 p[8], n[8], v[8], radiance[8];
       for (int j = 0; j < count; ++j) {
         const std::size_t i = batch[j];
-        s[j] = &g.surface.pixels[i], p[j] = g.position.pixels[i], n[j] = g.normal.pixels[i], v[j] = g.view_direction(i);
+        s[j] = &g.surface[i], p[j] = g.position.pixels[i], n[j] = g.normal.pixels[i], v[j] = g.view_direction(i);
       }
       shade.shade8(s, p, n, v, count, radiance);
       for (int j = 0; j < count; ++j) out.pixels[batch[j]] = glm::vec4(radiance[j], 1.0f);

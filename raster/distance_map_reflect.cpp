@@ -37,7 +37,7 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
     DistanceReflectStats& st = per_chunk[begin / kChunk];
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
       const std::uint32_t object = g.object.pixels[i];
       const int m = object < maps.map_of_object.size() ? maps.map_of_object[object] : -1;

@@ -16,7 +16,7 @@ ImageRGBA reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& m
                         [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (!takes(s)) continue;
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return map_of(g.object.pixels[i]).radiance(d, exponent);
@@ -53,7 +53,7 @@ ImageRGBA RefractorEnvironmentPass::operator()(par::NodeContext& c, const GBuffe
   std::uint64_t refractor_samples = 0;
   FallbackMask fallbacks = c.capturing() ? FallbackMask(gbuffer.width, gbuffer.height) : FallbackMask();
   for (std::size_t i = 0; i < gbuffer.surface.size(); ++i)
-    if (gbuffer.covered(i) && gbuffer.surface.pixels[i].is_refractor()) {
+    if (gbuffer.covered(i) && gbuffer.surface[i].is_refractor()) {
       ++refractor_samples;
       fallbacks.mark(i, Fallback::refractor_environment);
     }

@@ -44,6 +44,7 @@ struct MaterialInfo {
   bool simple = false;         // neither: constant parameters, normals take the 8-wide path
   std::uint32_t keep_side = 0; // all ones for refractors (see resolve_sample)
   bool specular = false;       // is_specular(constant)
+  std::uint32_t slot = 0;      // the material's index: its shared entry in the surface plane
 };
 
 // Per material, for the 8-lane path: one word gathered by material index whose bits say
@@ -57,6 +58,7 @@ struct SampleContext {
   const glm::vec3& eye;
   const std::vector<MaterialInfo>& materials;
   const std::vector<std::uint32_t>& material_flags;  // kLane* bits per material
+  SurfaceParams* own_surface;  // the surface plane's own entries (textured samples), or null
 };
 
 // One block's slots in the planes' staging buffers (see PlaneWriters).
@@ -65,7 +67,7 @@ struct StagingBlock {
   glm::vec3* position;
   glm::vec3* normal;
   glm::vec2* uv;
-  SurfaceParams* surface;
+  std::uint32_t* surface;  // slots of the surface plane (core/surface_plane.h)
   std::uint32_t* reflector;
 };
 
@@ -80,29 +82,28 @@ T* slots(PlaneWriter<T>& w) {
 }
 
 struct PlaneWriters {
-  PlaneWriter<std::uint32_t> object, reflector;
+  PlaneWriter<std::uint32_t> object, reflector, surface;
   PlaneWriter<glm::vec3> position, normal;
   PlaneWriter<glm::vec2> uv;
-  PlaneWriter<SurfaceParams> surface;
 
   PlaneWriters(GBuffer& g, std::size_t begin, bool stream)
       : object(g.object.pixels.data() + begin, stream),
         reflector(g.reflector.pixels.data() + begin, stream),
+        surface(g.surface.slot.pixels.data() + begin, stream),
         position(g.position.pixels.data() + begin, stream),
         normal(g.normal.pixels.data() + begin, stream),
-        uv(g.uv.pixels.data() + begin, stream),
-        surface(g.surface.pixels.data() + begin, stream) {}
+        uv(g.uv.pixels.data() + begin, stream) {}
 
   StagingBlock block() {
     return {slots<std::uint32_t>(object), slots<glm::vec3>(position), slots<glm::vec3>(normal),
-            slots<glm::vec2>(uv),         slots<SurfaceParams>(surface), slots<std::uint32_t>(reflector)};
+            slots<glm::vec2>(uv),         slots<std::uint32_t>(surface), slots<std::uint32_t>(reflector)};
   }
   void commit(std::size_t n) {
     object.commit(n * sizeof(std::uint32_t));
     position.commit(n * sizeof(glm::vec3));
     normal.commit(n * sizeof(glm::vec3));
     uv.commit(n * sizeof(glm::vec2));
-    surface.commit(n * sizeof(SurfaceParams));
+    surface.commit(n * sizeof(std::uint32_t));
     reflector.commit(n * sizeof(std::uint32_t));
   }
   void finish() {
@@ -169,7 +170,7 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
   }
   const glm::vec2 uv = lerp3(r.uv);
   const MaterialInfo& info = c.materials[mat];
-  SurfaceParams& sp = out.surface[j];
+  SurfaceParams sp;
   const glm::vec3 unmapped = n;  // decides the side (below); the map tilts within it
   if (info.textured || info.normal_mapped) {  // rare: the extra vertex streams come from the mesh
     const TriangleMesh& m = c.m;
@@ -184,6 +185,12 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
     sp = info.textured ? surface_params(c.scene, mat, uv, uv1) : info.constant;
   } else {
     sp = info.constant;
+  }
+  if (info.textured) {
+    c.own_surface[i] = sp;
+    out.surface[j] = SurfacePlane::kOwn;
+  } else {
+    out.surface[j] = mat;  // the shared entry of an untextured material is its index
   }
   // Opaque surfaces are shaded on the side the camera sees (double-sided or not, a visible
   // back face would otherwise shade black); refractors keep their orientation so the
@@ -215,7 +222,7 @@ inline void interpolate_sample(const SampleContext& c, std::size_t i, const Tria
   out.object[j] = object;
   out.position[j] = p;
   out.uv[j] = lerp3(r.uv);
-  out.surface[j] = info.constant;
+  out.surface[j] = info.slot;
   out.reflector[j] = info.specular ? object : kNoId;
 }
 
@@ -315,9 +322,7 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   float* uv = &out.uv[j].x;
   _mm256_storeu_ps(uv, _mm256_permute2f128_ps(uv_lo, uv_hi, 0x20));
   _mm256_storeu_ps(uv + 8, _mm256_permute2f128_ps(uv_lo, uv_hi, 0x31));
-  alignas(32) std::uint32_t m[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(m), mat);
-  for (int l = 0; l < 8; ++l) out.surface[j + l] = c.materials[m[l]].constant;
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.surface + j), mat);  // simple: the shared entry
   return all_valid ? kGroupDone : kGroupNormalsPending;
 }
 
@@ -329,7 +334,7 @@ inline void resolve_background(const SampleContext& c, std::size_t i, const Stag
   out.position[j] = glm::vec3(0.0f);
   out.normal[j] = glm::vec3(0.0f);
   out.uv[j] = glm::vec2(0.0f);
-  out.surface[j] = SurfaceParams{};
+  out.surface[j] = static_cast<std::uint32_t>(c.materials.size());  // the background's entry
   out.reflector[j] = kNoId;
 }
 
@@ -432,14 +437,19 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
   ensure_plane_size(g.normal, w, h);
   g.eye = eye;
   ensure_plane_size(g.uv, w, h);
-  ensure_plane_size(g.surface, w, h);
+  ensure_plane_size(g.surface.slot, w, h);
   ensure_plane_size(g.reflector, w, h);
   const TriangleMesh& m = scene.mesh;
-  // Untextured materials have the same parameters everywhere: evaluate them once.
+  // Untextured materials have the same parameters everywhere: evaluate them once. They are
+  // the surface plane's shared entries (by material index, then the background's defaults);
+  // only textured samples write their own.
   std::vector<MaterialInfo> materials;
   std::vector<std::uint32_t> material_flags;
+  g.surface.shared.clear();
+  bool any_textured = false;
   for (const Material& mat : scene.materials) {
     MaterialInfo info;
+    info.slot = static_cast<std::uint32_t>(materials.size());
     info.constant = surface_params(mat);
     info.textured = mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
                     mat.emissive_texture.valid() || mat.transmission_texture.valid();
@@ -447,12 +457,18 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
     info.simple = !info.textured && !info.normal_mapped;
     info.keep_side = info.constant.is_refractor() ? ~0u : 0u;
     info.specular = is_specular(info.constant);
+    any_textured |= info.textured;
+    g.surface.shared.push_back(info.constant);
     materials.push_back(info);
     material_flags.push_back((info.simple ? kLaneSimple : 0u) |
                                    (info.keep_side ? kLaneKeepSide : 0u) |
                                    (info.specular ? kLaneSpecular : 0u));
   }
-  const SampleContext ctx{scene, m, vis, eye, materials, material_flags};
+  g.surface.shared.push_back(SurfaceParams{});
+  if (any_textured) ensure_plane_size(g.surface.own, w, h);
+  else g.surface.own = {};
+  const SampleContext ctx{scene, m, vis, eye, materials, material_flags,
+                          any_textured ? g.surface.own.pixels.data() : nullptr};
   const bool stream = vis.triangle.size() >= kStreamingMinSamples;
   if (records) {
     const RecordCorners corners{records->data(), records->materials()};
@@ -493,8 +509,8 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const GBufferT
 ImageF specular_level_image(const GBuffer& g) {
   ImageF out(g.width, g.height, 0.0f);
   for (std::size_t i = 0; i < out.size(); ++i) {
-    if (!g.covered(i) || !is_specular(g.surface.pixels[i])) continue;
-    const glm::vec3 f0 = specular_f0(g.surface.pixels[i]);
+    if (!g.covered(i) || !is_specular(g.surface[i])) continue;
+    const glm::vec3 f0 = specular_f0(g.surface[i]);
     out.pixels[i] = std::max({f0.x, f0.y, f0.z});
   }
   return out;
@@ -503,7 +519,7 @@ ImageF specular_level_image(const GBuffer& g) {
 ImageF glossiness_image(const GBuffer& g) {
   ImageF out(g.width, g.height, 0.0f);
   for (std::size_t i = 0; i < out.size(); ++i)
-    if (g.covered(i)) out.pixels[i] = g.surface.pixels[i].phong_exponent;
+    if (g.covered(i)) out.pixels[i] = g.surface[i].phong_exponent;
   return out;
 }
 

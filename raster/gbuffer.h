@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "core/scene.h"
 #include "core/shading.h"
+#include "core/surface_plane.h"
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
 #include "raster/gbuffer_triangles.h"
@@ -28,8 +29,9 @@ struct GBuffer {
                                     // opaque surfaces; geometric orientation for refractors
   glm::vec3 eye{0.0f};              // the camera position (view directions derive from it)
   Buffer2D<glm::vec2> uv;
-  Buffer2D<SurfaceParams> surface;  // diffuse colour, metallic, roughness, glossiness (Phong
-                                    // exponent), ior, transmission, emissive
+  SurfacePlane surface;             // diffuse colour, metallic, roughness, glossiness (Phong
+                                    // exponent), ior, transmission, emissive: surface[i]; an
+                                    // untextured material's samples share one entry
   IdBuffer reflector;               // object id of non-diffuse surfaces, kNoId otherwise
 
   bool covered(std::size_t i) const { return object.pixels[i] != kNoId; }

@@ -295,7 +295,7 @@ glm::vec3 trace_layered(const LayeredDistanceMap& map, const EnvironmentMap& env
                         std::min(int(c.pixel.x), map.size - 1);
   const GBuffer& g = layer.surface[c.face];
   glm::vec3 radiance = glm::vec3(layer.colour[c.face].pixels[i]);
-  const SurfaceParams& s = g.surface.pixels[i];
+  const SurfaceParams& s = g.surface[i];
   if (!g.covered(i) || !is_specular(s)) return radiance;
   // A specular hit: its direct light (already in `colour`) plus what its continuations bring.
   return radiance + specular_continuation(map, env, map.centre + l, r, g.normal.pixels[i], s, o, depth + 1, stats);
@@ -312,7 +312,7 @@ ImageRGBA layered_reflect(par::Executor& executor, const GBuffer& g, const Layer
     LayeredTraceStats& st = per_chunk[begin / kChunk];
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
       const LayeredTraceStats before = st;
       const glm::vec3 radiance = specular_continuation(map, env, g.position.pixels[i], -g.view_direction(i),

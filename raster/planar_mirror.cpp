@@ -125,7 +125,7 @@ struct Recursion {
             // The mirrored camera sees the reflected rays left-right mirrored.
             const glm::vec3 l(mirrored.at(w - 1 - x, static_cast<int>(y)));
             const float cos_nv = std::abs(glm::dot(g.normal.pixels[i], g.view_direction(i)));
-            specular.pixels[i] = glm::vec4(specular_reflectance(g.surface.pixels[i], cos_nv) * l, 1.0f);
+            specular.pixels[i] = glm::vec4(specular_reflectance(g.surface[i], cos_nv) * l, 1.0f);
             ++per_row[y];
           }
       });

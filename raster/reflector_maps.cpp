@@ -73,7 +73,7 @@ float lobe_half_power_angle(float n) { return std::sqrt(2.0f * 0.69314718f / std
 float sample_need(const GBuffer& g, std::size_t i) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   if (!g.covered(i)) return nan;
-  const SurfaceParams& s = g.surface.pixels[i];
+  const SurfaceParams& s = g.surface[i];
   if (!is_specular(s) || s.is_refractor()) return nan;
   const std::uint32_t object = g.object.pixels[i];
   const auto reflected = [&](std::size_t j) { return reflect(-g.view_direction(j), g.normal.pixels[j]); };
@@ -82,7 +82,7 @@ float sample_need(const GBuffer& g, std::size_t i) {
   const std::size_t x = i % w, y = i / w;
   float delta = std::numeric_limits<float>::infinity();
   const auto neighbour = [&](std::size_t j) {
-    if (g.object.pixels[j] != object || !is_specular(g.surface.pixels[j])) return;
+    if (g.object.pixels[j] != object || !is_specular(g.surface[j])) return;
     delta = std::min(delta, glm::length(reflected(j) - r));
   };
   if (x + 1 < w) neighbour(i + 1);
@@ -168,7 +168,7 @@ void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin) {
 GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
   texel.clear();
   for (std::size_t i = 0; i < g.object.size(); ++i)
-    if (g.covered(i) && is_specular(g.surface.pixels[i])) texel.push_back(static_cast<std::uint32_t>(i));
+    if (g.covered(i) && is_specular(g.surface[i])) texel.push_back(static_cast<std::uint32_t>(i));
   GBuffer out;
   const int n = static_cast<int>(texel.size());
   out.width = n;
@@ -178,7 +178,9 @@ GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
   out.position = Buffer2D<glm::vec3>(n, out.height);
   out.normal = Buffer2D<glm::vec3>(n, out.height);
   out.uv = Buffer2D<glm::vec2>(n, out.height);
-  out.surface = Buffer2D<SurfaceParams>(n, out.height);
+  out.surface.slot = IdBuffer(n, out.height);
+  out.surface.shared = g.surface.shared;
+  if (!g.surface.own.empty()) out.surface.own = Buffer2D<SurfaceParams>(n, out.height);
   out.reflector = IdBuffer(n, out.height);
   for (int k = 0; k < n; ++k) {
     const std::size_t i = texel[k];
@@ -186,7 +188,8 @@ GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
     out.position.pixels[k] = g.position.pixels[i];
     out.normal.pixels[k] = g.normal.pixels[i];
     out.uv.pixels[k] = g.uv.pixels[i];
-    out.surface.pixels[k] = g.surface.pixels[i];
+    out.surface.slot.pixels[k] = g.surface.slot.pixels[i];
+    if (!g.surface.own.empty()) out.surface.own.pixels[k] = g.surface.own.pixels[i];
     out.reflector.pixels[k] = g.reflector.pixels[i];
   }
   return out;
@@ -207,7 +210,7 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
     float last_exponent = std::numeric_limits<float>::quiet_NaN(), margin = 0.0f;
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t i = samples[k];
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
       if (s.is_refractor()) {  // refracted lookups go anywhere (faces_read keeps every face)
         for (auto& t : tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
@@ -239,7 +242,7 @@ unsigned faces_read(par::Executor& executor, const GBuffer& g, const std::vector
     unsigned mask = 0;
     for (std::size_t k = begin; k < end && mask != 0x3fu; ++k) {
       const std::size_t i = samples[k];
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
       if (s.is_refractor()) {
         mask = 0x3fu;
@@ -275,7 +278,7 @@ std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& g) 
   std::vector<std::uint8_t> seen(scene.objects.size(), 0);
   for (std::size_t i = 0; i < g.object.size(); ++i) {
     const std::uint32_t o = g.object.pixels[i];
-    if (g.covered(i) && o < seen.size() && is_specular(g.surface.pixels[i])) seen[o] = 1;
+    if (g.covered(i) && o < seen.size() && is_specular(g.surface[i])) seen[o] = 1;
   }
   return seen;
 }
@@ -295,7 +298,7 @@ std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, co
     if (!g.covered(i)) continue;
     const std::uint32_t o = g.object.pixels[i];
     if (o >= scene.objects.size()) continue;
-    const SurfaceParams& s = g.surface.pixels[i];
+    const SurfaceParams& s = g.surface[i];
     if (!is_specular(s)) continue;
     // A refractor's sample, or a specular sample with no neighbour on its object: need 0
     // (the cap) for refractors; a lone sample is no evidence either way and is left out.

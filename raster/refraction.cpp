@@ -155,7 +155,7 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
     ChunkCounts& c = counts[begin / kChunk];
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (!s.is_refractor()) continue;
       const std::uint32_t object = g.object.pixels[i];
       const glm::vec3 p1 = g.position.pixels[i], view = g.view_direction(i), v = -view;

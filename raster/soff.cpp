@@ -63,7 +63,7 @@ SoffClusters soff_cluster(par::Executor& executor, const GBuffer& g, const SoffB
     if (g.covered(i)) max_object = std::max(max_object, g.object.pixels[i]);
   std::vector<std::uint64_t> per_object(n ? std::size_t(max_object) + 1 : 0, 0);
   for (std::size_t i = 0; i < n; ++i)
-    if (g.covered(i) && soff_reflects(g.surface.pixels[i])) ++per_object[g.object.pixels[i]];
+    if (g.covered(i) && soff_reflects(g.surface[i])) ++per_object[g.object.pixels[i]];
   std::vector<std::uint32_t> visible_index(per_object.size(), kNoId);
   std::vector<std::uint32_t> visible_object;
   for (std::size_t o = 0; o < per_object.size(); ++o)
@@ -82,7 +82,7 @@ SoffClusters soff_cluster(par::Executor& executor, const GBuffer& g, const SoffB
   std::vector<std::uint32_t> bin(n, kNoId);
   executor.parallel_for("soff_clusters.bin", n, 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      if (!g.covered(i) || !soff_reflects(g.surface.pixels[i])) continue;
+      if (!g.covered(i) || !soff_reflects(g.surface[i])) continue;
       const std::uint32_t k = visible_index[g.object.pixels[i]];
       int ti = 0, pj = 0;
       soff_bin(g.normal.pixels[i], scale[k], bins, ti, pj);
@@ -322,7 +322,7 @@ SoffCameras soff_cameras(par::Executor& executor, const GBuffer& g, const SoffCl
         positions[k] = g.position.pixels[i];
         normals[k] = nrm;
         reflected[k] = reflect(-g.view_direction(i), nrm);
-        const SurfaceParams& s = g.surface.pixels[i];
+        const SurfaceParams& s = g.surface[i];
         if (s.is_glossy_lobe()) {
           // The GGX lobe's reflected directions: P(tan θ_h > kα) = 1/(1 + k²), so 96% of the
           // half vectors lie within tan θ_h = 5α, and the reflected direction turns by 2θ_h.
@@ -472,9 +472,9 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
       for (std::size_t i = begin; i < end; ++i) {
         if (gb.covered(i)) {
           out.inv_z[base + i] = 1.0f / vis.depth.pixels[i];
-          out.colour[base + i] = shade_surface(scene, gb.surface.pixels[i], gb.position.pixels[i],
+          out.colour[base + i] = shade_surface(scene, gb.surface[i], gb.position.pixels[i],
                                                gb.normal.pixels[i], gb.view_direction(i), shadows, env);
-          out.surface[base + i] = gb.surface.pixels[i];
+          out.surface[base + i] = gb.surface[i];
           out.normal[base + i] = gb.normal.pixels[i];
         } else {
           const float sx = float(i % std::size_t(cam.width)) + 0.5f, sy = float(i / std::size_t(cam.width)) + 0.5f;
@@ -685,7 +685,7 @@ ImageRGBA soff_intersect(par::Executor& executor, const Scene& scene, const GBuf
     SoffIntersectStats& st = per_chunk[begin / kChunk];
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
       const glm::vec3 n = g.normal.pixels[i], v = g.view_direction(i);
       const auto env_lookup = [&](const glm::vec3& d, float exponent) { return env.radiance(d, exponent); };
@@ -716,7 +716,7 @@ ImageRGBA soff_intersect(par::Executor& executor, const Scene& scene, const GBuf
           if (q != kNoId) {
             ++st.self_hits;
             // First order (SOFF §4.4): the diffuse shading of the reflector's sample hit.
-            return shade_surface(scene, g.surface.pixels[q], g.position.pixels[q], g.normal.pixels[q], -d, shadows,
+            return shade_surface(scene, g.surface[q], g.position.pixels[q], g.normal.pixels[q], -d, shadows,
                                  env);
           }
         }

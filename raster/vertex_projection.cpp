@@ -289,7 +289,7 @@ bool hits_itself(const ReflectorParam& param, const glm::dvec3& p, const glm::dv
 }
 
 bool vertex_projection_sample(const GBuffer& g, std::size_t i) {
-  const SurfaceParams& s = g.surface.pixels[i];
+  const SurfaceParams& s = g.surface[i];
   return g.covered(i) && !s.is_refractor() && s.is_mirror_lobe();
 }
 
@@ -389,10 +389,10 @@ ImageRGBA shade_reflected(par::Executor& executor, const Scene& scene, const Ref
           // reflection ROGER §2.3.3 leaves empty, shaded here as the reflector lit directly.
           glm::dvec3 hit, normal;
           if (param.orientation < 0 && hits_itself(param, glm::dvec3(g.position.pixels[i]), glm::dvec3(d), hit, normal))
-            return shade_surface(scene, g.surface.pixels[i], glm::vec3(hit), glm::vec3(normal), -d, shadows, env);
+            return shade_surface(scene, g.surface[i], glm::vec3(hit), glm::vec3(normal), -d, shadows, env);
           return env.radiance(d, exponent);
         };
-        out.pixels[i] = glm::vec4(specular_radiance(g.surface.pixels[i], g.normal.pixels[i], g.view_direction(i), sky), 1.0f);
+        out.pixels[i] = glm::vec4(specular_radiance(g.surface[i], g.normal.pixels[i], g.view_direction(i), sky), 1.0f);
         continue;
       }
       const std::uint32_t* idx = &m.indices[3 * std::size_t(t)];
@@ -410,7 +410,7 @@ ImageRGBA shade_reflected(par::Executor& executor, const Scene& scene, const Ref
       const glm::vec3 view = l > 0.0f ? to_p / l : n;
       const glm::vec3 radiance = shade_surface(scene, s, v, n, view, shadows, env);
       const float cos_nv = glm::dot(g.normal.pixels[i], g.view_direction(i));
-      out.pixels[i] = glm::vec4(specular_reflectance(g.surface.pixels[i], cos_nv) * radiance, 1.0f);
+      out.pixels[i] = glm::vec4(specular_reflectance(g.surface[i], cos_nv) * radiance, 1.0f);
     }
   });
   return out;

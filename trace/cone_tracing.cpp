@@ -34,7 +34,7 @@ std::uint64_t count_flags(const std::vector<std::uint8_t>& f) {
 }  // namespace
 
 PixelCones pixel_cones(par::Executor& ex, const Buffer2D<glm::vec3>& position, const Buffer2D<glm::vec3>& normal,
-                       const Buffer2D<SurfaceParams>& surface, const IdBuffer& object, const IdBuffer& triangle,
+                       const SurfacePlane& surface, const IdBuffer& object, const IdBuffer& triangle,
                        const ImageF& curvature, const Camera& camera, const PixelConeOptions& o) {
   PixelCones pc;
   pc.axes = secondary_rays(ex, position, normal, surface, object, camera.eye);
@@ -52,7 +52,7 @@ PixelCones pixel_cones(par::Executor& ex, const Buffer2D<glm::vec3>& position, c
     for (std::size_t i = b; i < e; ++i) {
       if (!pc.axes.active[i]) continue;
       pc.far[i] = pc.axes.rays.tmax[i];
-      const SurfaceParams& s = surface.pixels[i];
+      const SurfaceParams& s = surface[i];
       if (s.is_refractor()) {  // the curvature's mirror sphere says nothing about refraction
         refracted[i] = 1;
         continue;

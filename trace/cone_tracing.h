@@ -60,7 +60,7 @@ struct PixelCones {
 // tangent plane (with a margin of a quarter of the elevation for the facets' tilt), the far
 // plane far_blur · scene radius / tan θ_g (§5.2.6). Kernel "pixel_cones".
 PixelCones pixel_cones(par::Executor& executor, const Buffer2D<glm::vec3>& position,
-                       const Buffer2D<glm::vec3>& normal, const Buffer2D<SurfaceParams>& surface,
+                       const Buffer2D<glm::vec3>& normal, const SurfacePlane& surface,
                        const IdBuffer& object, const IdBuffer& triangle, const ImageF& curvature,
                        const Camera& camera, const PixelConeOptions& options);
 

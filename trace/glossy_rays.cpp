@@ -31,7 +31,7 @@ float sample_solid_angle(float cos_theta, float exponent, int n) {
 
 GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& positions,
                                 const Buffer2D<glm::vec3>& normals,
-                                const Buffer2D<SurfaceParams>& surface, const IdBuffer& object,
+                                const SurfacePlane& surface, const IdBuffer& object,
                                 const glm::vec3& eye, const GlossyRayOptions& opt) {
   if (opt.rays_per_pixel < 1 || opt.rays_per_pixel > 4096)
     throw InputError("glossy_rays", "rays per pixel out of range (1..4096)");
@@ -44,7 +44,7 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
   out.rays_per_pixel = opt.rays_per_pixel;
   // Which samples trace: a serial pass over flags, then the compaction primitive's order.
   for (std::size_t i = 0; i < n_pix; ++i)
-    if (object.pixels[i] != kNoId && traces_glossy(surface.pixels[i]))
+    if (object.pixels[i] != kNoId && traces_glossy(surface[i]))
       out.pixel.push_back(static_cast<std::uint32_t>(i));
   const std::size_t N = static_cast<std::size_t>(opt.rays_per_pixel);
   const std::size_t P = out.pixel.size();
@@ -65,7 +65,7 @@ GlossyRays generate_glossy_rays(par::Executor& ex, const Buffer2D<glm::vec3>& po
       const std::uint32_t i = out.pixel[k];
       const glm::vec3 p = positions.pixels[i];
       const glm::vec3 n = normals.pixels[i];
-      const SurfaceParams& s = surface.pixels[i];
+      const SurfaceParams& s = surface[i];
       glm::vec3 v = eye - p;
       const float vl = glm::length(v);
       v = vl > 0.0f ? v / vl : n;

@@ -17,6 +17,7 @@
 
 #include "core/image.h"
 #include "core/shading.h"
+#include "core/surface_plane.h"
 #include "parallel/executor.h"
 #include "trace/traversal.h"
 
@@ -61,7 +62,7 @@ float glossy_mixture_pdf(float cos_r, float cos_n, float exponent);
 // Throws InputError when the buffers' sizes differ or rays_per_pixel is outside 1..4096.
 GlossyRays generate_glossy_rays(par::Executor& executor, const Buffer2D<glm::vec3>& positions,
                                 const Buffer2D<glm::vec3>& normals,
-                                const Buffer2D<SurfaceParams>& surface, const IdBuffer& object,
+                                const SurfacePlane& surface, const IdBuffer& object,
                                 const glm::vec3& eye, const GlossyRayOptions& options);
 
 }  // namespace speculum::trace

@@ -70,7 +70,7 @@ void count_active(SecondaryRays& g) {
 }
 
 SecondaryRays secondary_rays(par::Executor& ex, const Buffer2D<glm::vec3>& position,
-                             const Buffer2D<glm::vec3>& normal, const Buffer2D<SurfaceParams>& surface,
+                             const Buffer2D<glm::vec3>& normal, const SurfacePlane& surface,
                              const IdBuffer& object, const glm::vec3& eye) {
   SecondaryRays g = empty_generation(object.width, object.height);
   ex.parallel_for("secondary_rays", object.size(), kPixelChunk, [&](std::size_t b, std::size_t e) {
@@ -88,7 +88,7 @@ SecondaryRays secondary_rays(par::Executor& ex, const Buffer2D<glm::vec3>& posit
       if (!entering) n = -n;
       Ray r;
       glm::vec3 w;
-      if (continuation(surface.pixels[i], p, n, n, entering, dir, r, w)) store(g, i, r, w);
+      if (continuation(surface[i], p, n, n, entering, dir, r, w)) store(g, i, r, w);
     }
   });
   count_active(g);

@@ -13,6 +13,7 @@
 #include "core/image.h"
 #include "core/scene.h"
 #include "core/shading.h"
+#include "core/surface_plane.h"
 #include "parallel/executor.h"
 #include "trace/hit_surface.h"
 #include "trace/traversal.h"
@@ -48,7 +49,7 @@ inline bool has_secondary_ray(const SurfaceParams& s) {
 // weight transmission on total internal reflection; their Fresnel-reflected part is not
 // traced (one ray per pixel). Kernel "secondary_rays".
 SecondaryRays secondary_rays(par::Executor& executor, const Buffer2D<glm::vec3>& position,
-                             const Buffer2D<glm::vec3>& normal, const Buffer2D<SurfaceParams>& surface,
+                             const Buffer2D<glm::vec3>& normal, const SurfacePlane& surface,
                              const IdBuffer& object, const glm::vec3& eye);
 
 // The next generation: every hit on a specular surface spawns its reflected/refracted ray

@@ -63,6 +63,14 @@ std::string plane_hash(const Plane& p) {
   return text;
 }
 
+// The surface plane hashed as the parameters of every sample in turn: the bytes a plane of
+// per-sample parameters would hold, whatever the samples share.
+std::string plane_hash(const SurfacePlane& p) {
+  Buffer2D<SurfaceParams> values(p.width(), p.height());
+  for (std::size_t i = 0; i < p.size(); ++i) values.pixels[i] = p[i];
+  return plane_hash(values);
+}
+
 void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) {
   if (o.repeat < 1) throw InputError("--repeat", "must be at least 1");
   if (double(o.width) * o.height > double(1 << 26))  // ~110 bytes per sample

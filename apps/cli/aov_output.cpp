@@ -63,9 +63,9 @@ AovLayers make_aov_layers(const raster::GBuffer& g, int k, const Camera& camera,
         for (int sx = 0; sx < k; ++sx) {
           const std::size_t i = std::size_t(y * k + sy) * std::size_t(g.width) + std::size_t(x * k + sx);
           if (!g.covered(i)) continue;
-          albedo += g.surface.pixels[i].base_color;
+          albedo += g.surface[i].base_color;
           normal += g.normal.pixels[i];
-          roughness += g.surface.pixels[i].roughness;
+          roughness += g.surface[i].roughness;
           const float d = glm::dot(g.position.pixels[i] - camera.eye, forward);
           if (d < depth) depth = d, position = g.position.pixels[i];
         }

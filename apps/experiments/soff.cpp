@@ -77,7 +77,7 @@ SpecularError specular_mae8(const Scene& scene, const Camera& camera, const Imag
   double sum[3] = {0.0, 0.0, 0.0};
   std::size_t n[3] = {0, 0, 0};
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
-    const SurfaceParams& s = g.surface.pixels[i];
+    const SurfaceParams& s = g.surface[i];
     if (!g.covered(i) || !raster::is_specular(s)) continue;
     double e = 0.0;
     for (int ch = 0; ch < 3; ++ch) e += std::abs(display_to_8bit(a.pixels[i][ch]) - display_to_8bit(b.pixels[i][ch]));

@@ -240,7 +240,7 @@ void draw_gbuffer(Drawing& d, const raster::GBuffer& g) {
   Buffer2D<glm::vec3> base(g.width, g.height);
   ImageF roughness(g.width, g.height);
   for (std::size_t i = 0; i < g.surface.size(); ++i)
-    base.pixels[i] = g.surface.pixels[i].base_color, roughness.pixels[i] = g.surface.pixels[i].roughness;
+    base.pixels[i] = g.surface[i].base_color, roughness.pixels[i] = g.surface[i].roughness;
   d.views.push_back(channels_view("base_color", base, mask));
   d.views.push_back(scalar_view("roughness", roughness, mask));
   d.views.push_back(scalar_view("specular_level", raster::specular_level_image(g), mask));

@@ -304,7 +304,7 @@ void ensure_specular_reference(const MatrixOptions& o, const std::string& scene_
     if (const auto* g = out.as<raster::GBuffer>()) {
       mask = ImageRGBA(g->width, g->height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
       for (std::size_t i = 0; i < g->object.size(); ++i)
-        if (g->covered(i) && raster::is_specular(g->surface.pixels[i])) mask.pixels[i] = glm::vec4(1.0f);
+        if (g->covered(i) && raster::is_specular(g->surface[i])) mask.pixels[i] = glm::vec4(1.0f);
     }
   });
   write_image(k.mask.string(), mask);

@@ -37,7 +37,7 @@ trace::SecondaryRays glossy_generation(par::Executor& ex, const raster::GBuffer&
   ex.parallel_for("glossy_lobe_rays", n, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (s.is_refractor() || !s.is_glossy_lobe()) continue;
       const glm::vec2 u = rotate_unit_square(hamersley(std::uint32_t(sample), std::uint32_t(samples)),
                                              random_float2(std::uint32_t(i), 0, 0, seed));
@@ -111,7 +111,7 @@ struct SpecularTracePass {
     // their lobe is sampled below).
     trace::SecondaryRays first = trace::secondary_rays(ex, g.position, g.normal, g.surface, g.object, g.eye);
     for (std::size_t i = 0; i < first.active.size(); ++i) {
-      const SurfaceParams& s = g.surface.pixels[i];
+      const SurfaceParams& s = g.surface[i];
       if (first.active[i] && !s.is_refractor() && s.is_glossy_lobe()) first.active[i] = 0, --first.count;
     }
     follow(std::move(first));

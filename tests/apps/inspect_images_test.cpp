@@ -56,7 +56,7 @@ TEST(InspectImages, GBufferGivesOneViewPerFieldAtItsSize) {
   g.position = Buffer2D<glm::vec3>(5, 4, glm::vec3(1, 2, 3));
   g.normal = Buffer2D<glm::vec3>(5, 4, glm::vec3(0, 0, 1));
   g.uv = Buffer2D<glm::vec2>(5, 4);
-  g.surface = Buffer2D<SurfaceParams>(5, 4);
+  g.surface = SurfacePlane::uniform(5, 4, SurfaceParams{});
   g.reflector = IdBuffer(5, 4, kNoId);
   par::Executor ex(1);
   const Drawing d = draw_output(capture(g), ex);

@@ -113,7 +113,7 @@ TEST(VertexProjection, ReflectedEdgesWithinOnePixelOfTheTracedOnes) {
     std::size_t samples = 0;
     for (std::size_t i = 0; i < g.object.size(); ++i) {
       if (!g.covered(i)) continue;
-      const SurfaceParams& sp = g.surface.pixels[i];
+      const SurfaceParams& sp = g.surface[i];
       if (sp.is_refractor() || !sp.is_mirror_lobe()) continue;
       ++samples;
       mirror.pixels[i] = 1;

@@ -213,12 +213,12 @@ TEST(EnvmapReflect, LookupDirectionsAreGlmReflectAndRefract) {
   g.position = Buffer2D<glm::vec3>(g.width, 1);
   g.normal = Buffer2D<glm::vec3>(g.width, 1, glm::vec3(0, 0, 1));
   g.uv = Buffer2D<glm::vec2>(g.width, 1);
-  g.surface = Buffer2D<SurfaceParams>(g.width, 1);
+  g.surface = SurfacePlane::per_sample(Buffer2D<SurfaceParams>(g.width, 1));
   for (std::size_t i = 0; i < samples.size(); ++i) {
     g.object.pixels[i] = g.reflector.pixels[i] = 0;
     g.position.pixels[i] = g.eye - 3.0f * samples[i].v;
     g.normal.pixels[i] = samples[i].n;
-    g.surface.pixels[i] = samples[i].s;
+    g.surface.own.pixels[i] = samples[i].s;
   }
   const ImageRGBA spec = envmap_reflect(ex, g, env);
   EXPECT_EQ(spec.pixels.back(), glm::vec4(0, 0, 0, 1));

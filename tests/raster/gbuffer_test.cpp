@@ -54,7 +54,7 @@ TEST(GBuffer, PositionUvAndNormalMapOnAQuad) {
       EXPECT_NEAR(g.uv.pixels[i].x, (p.x + 2) / 4, 1e-3f);
       EXPECT_NEAR(g.uv.pixels[i].y, (p.y + 1) / 2, 1e-3f);
       EXPECT_LT(glm::length(g.normal.pixels[i] - mapped), 1e-5f);
-      EXPECT_EQ(g.surface.pixels[i].base_color, glm::vec3(0.5f, 0.25f, 1.0f));
+      EXPECT_EQ(g.surface[i].base_color, glm::vec3(0.5f, 0.25f, 1.0f));
       EXPECT_EQ(g.reflector.pixels[i], kNoId);  // rough dielectric: not a reflector
       ++checked;
     }
@@ -177,7 +177,7 @@ std::size_t mismatches(const Scene& scene, const VisibilityBuffer& vis, glm::vec
     const OracleSample o = oracle_sample(scene, vis, eye, i);
     bad += !(same_object_bytes(g.object.pixels[i], o.object) && same_object_bytes(g.position.pixels[i], o.position) &&
              same_object_bytes(g.normal.pixels[i], o.normal) && same_object_bytes(g.uv.pixels[i], o.uv) &&
-             same_object_bytes(g.surface.pixels[i], o.surface) &&
+             same_object_bytes(g.surface[i], o.surface) &&
              same_object_bytes(g.reflector.pixels[i], o.reflector));
   }
   return bad;
@@ -188,7 +188,8 @@ void scribble(GBuffer& g) {
   auto fill = [](auto& plane) {
     std::memset(static_cast<void*>(plane.pixels.data()), 0x5a, plane.size() * sizeof(plane.pixels[0]));
   };
-  fill(g.object), fill(g.position), fill(g.normal), fill(g.uv), fill(g.surface), fill(g.reflector);
+  fill(g.object), fill(g.position), fill(g.normal), fill(g.uv), fill(g.reflector);
+  fill(g.surface.slot), fill(g.surface.own);
 }
 
 // Both triangle sources, at a size below and one above the streaming-store threshold, any

@@ -122,7 +122,7 @@ TEST(DirectLight, UnshadowedEqualsSharedShadingModel) {
     const glm::vec3 p = g.position.pixels[i], n = g.normal.pixels[i], v = g.view_direction(i);
     const LightSample ls = sample_light(l, p);
     const glm::vec3 expected = glm::dot(n, ls.direction) > 0.0f
-                                   ? shade_light(g.surface.pixels[i], n, v, ls)
+                                   ? shade_light(g.surface[i], n, v, ls)
                                    : glm::vec3(0.0f);
     EXPECT_NEAR(direct.pixels[i].x, expected.x, 1e-5f + 1e-5f * expected.x);
     ++checked;
@@ -199,7 +199,7 @@ TEST(DirectLight, SpotLightConeFalloffAndShadow) {
     ls.direction = to_light;
     ls.distance = glm::length(l.position - p);
     ls.irradiance = l.color * e;
-    const glm::vec3 expected = shade_light(g.surface.pixels[i], n, v, ls);
+    const glm::vec3 expected = shade_light(g.surface[i], n, v, ls);
     ASSERT_GT(expected.x, 0.0f);
     for (int ch = 0; ch < 3; ++ch)
       ASSERT_NEAR(c[ch], expected[ch], 1e-4f * expected[ch] + 1e-7f) << p.x << "," << p.z;
@@ -229,7 +229,7 @@ TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
   std::size_t checked = 0;
   for (std::size_t i = 0; i < direct.size(); ++i) {
     if (!g.covered(i)) continue;
-    const SurfaceParams& s = g.surface.pixels[i];
+    const SurfaceParams& s = g.surface[i];
     const float cos_nv = glm::dot(g.normal.pixels[i], g.view_direction(i));
     const float e_d = specular_albedo(cos_nv, brdf_params_for_punctual_light(s).alpha)(fresnel_f0(s.ior));
     glm::vec3 expected = (1.0f - e_d) * glm::vec3(0.8f, 0.6f, 0.4f) * sky.constant;
@@ -247,7 +247,7 @@ TEST(DirectLight, ConstantEnvironmentGivesLambertAmbient) {
   std::size_t rough = 0;
   for (std::size_t i = 0; i < metal.size(); ++i) {
     if (!gm.covered(i)) continue;
-    const SurfaceParams& s = gm.surface.pixels[i];
+    const SurfaceParams& s = gm.surface[i];
     glm::vec3 expected(0.0f);
     if (s.has_rough_specular_lobe()) {
       expected = specular_reflectance(s, glm::dot(gm.normal.pixels[i], gm.view_direction(i))) * sky.constant;

@@ -92,7 +92,7 @@ TEST(SoffClusters, EveryReflectingSampleInExactlyOneCluster) {
   }
   std::size_t reflecting = 0;
   for (std::size_t i = 0; i < g.object.size(); ++i) {
-    const bool r = g.covered(i) && soff_reflects(g.surface.pixels[i]);
+    const bool r = g.covered(i) && soff_reflects(g.surface[i]);
     reflecting += r;
     EXPECT_EQ(seen[i], r ? 1 : 0) << "sample " << i;
     EXPECT_EQ(cl.cluster[i] != kNoId, r);
@@ -330,7 +330,7 @@ double specular_mae8(const Scene& scene, const ImageRGBA& a, const ImageRGBA& b)
   double sum = 0.0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
-    if (!g.covered(i) || !is_specular(g.surface.pixels[i])) continue;
+    if (!g.covered(i) || !is_specular(g.surface[i])) continue;
     for (int ch = 0; ch < 3; ++ch)
       sum += std::abs(display_to_8bit(a.pixels[i][ch]) - display_to_8bit(b.pixels[i][ch]));
     ++n;

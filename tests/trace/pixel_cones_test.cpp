@@ -14,7 +14,7 @@ namespace {
 
 struct OnePixel {
   Buffer2D<glm::vec3> position{1, 1}, normal{1, 1};
-  Buffer2D<SurfaceParams> surface{1, 1};
+  SurfacePlane surface = SurfacePlane::per_sample(Buffer2D<SurfaceParams>(1, 1));
   IdBuffer object{1, 1, 0}, triangle{1, 1, 7};
   ImageF curvature{1, 1, 0.0f};
   Camera camera;
@@ -25,7 +25,7 @@ struct OnePixel {
     s.metallic = 1.0f;
     s.roughness = roughness;
     s.phong_exponent = phong;
-    surface.pixels[0] = s;
+    surface.own.pixels[0] = s;
     curvature.pixels[0] = kappa;
     camera.eye = {0.0f, 0.0f, 4.0f};
     camera.target = {0.0f, 0.0f, 0.0f};

@@ -19,14 +19,14 @@ namespace {
 
 struct PrimaryPlanes {
   Buffer2D<glm::vec3> position, normal;
-  Buffer2D<SurfaceParams> surface;
+  SurfacePlane surface;  // every sample its own parameters
   IdBuffer object;
 };
 
 // What the G-buffer holds, from traced primary rays (trace tests do not use raster/):
 // opaque normals facing the camera, refractor normals in their geometric orientation.
 PrimaryPlanes primary_planes(const Scene& scene, const Bvh& bvh, const Camera& cam, int w, int h) {
-  PrimaryPlanes g{{w, h}, {w, h}, {w, h}, {w, h, kNoId}};
+  PrimaryPlanes g{{w, h}, {w, h}, SurfacePlane::per_sample(Buffer2D<SurfaceParams>(w, h)), {w, h, kNoId}};
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const Ray r = primary_ray(cam, w, h, x + 0.5f, y + 0.5f);
@@ -35,7 +35,7 @@ PrimaryPlanes primary_planes(const Scene& scene, const Bvh& bvh, const Camera& c
       const HitSurface hs = hit_surface(scene, hit, r.direction);
       g.position.at(x, y) = hs.p;
       g.normal.at(x, y) = hs.s.is_refractor() && !hs.entering ? -hs.n : hs.n;
-      g.surface.at(x, y) = hs.s;
+      g.surface.own.at(x, y) = hs.s;
       g.object.at(x, y) = scene.mesh.triangle_object[hit.triangle];
     }
   return g;

@@ -25,7 +25,7 @@ GlossyRays one_pixel_rays(int n_rays, float exponent, par::Executor& ex, glm::ve
   SurfaceParams s;
   s.roughness = 0.3f;
   s.phong_exponent = exponent;
-  Buffer2D<SurfaceParams> surf(1, 1, s);
+  const SurfacePlane surf = SurfacePlane::uniform(1, 1, s);
   IdBuffer obj(1, 1, 0u);
   GlossyRayOptions o;
   o.rays_per_pixel = n_rays;
@@ -124,7 +124,7 @@ TEST(YuSampling, WeightedRaysEstimateTheReflectionIntegral) {
       m.metallic = 1.0f;
       m.base_color = glm::vec4(0.9f, 0.6f, 0.3f, 1.0f);
       const SurfaceParams sp = surface_params(m);
-      Buffer2D<SurfaceParams> surf(1, 1, sp);
+      const SurfacePlane surf = SurfacePlane::uniform(1, 1, sp);
       IdBuffer obj(1, 1, 0u);
       GlossyRayOptions o;
       o.rays_per_pixel = 4096;
