@@ -162,8 +162,8 @@ bool CubeTileMask::covers(int face, int level, int x, int y) const {
   if (t.empty()) return false;
   const int n = tiles_per_side();
   // The level-0 texels under level-`level` texel (x, y), and the tiles they fall in.
-  const int x0 = (x << level) / kTile, x1 = std::min(n - 1, (((x + 1) << level) - 1) / kTile);
-  const int y0 = (y << level) / kTile, y1 = std::min(n - 1, (((y + 1) << level) - 1) / kTile);
+  const int x0 = (x << level) / tile, x1 = std::min(n - 1, (((x + 1) << level) - 1) / tile);
+  const int y0 = (y << level) / tile, y1 = std::min(n - 1, (((y + 1) << level) - 1) / tile);
   for (int ty = y0; ty <= y1; ++ty)
     for (int tx = x0; tx <= x1; ++tx)
       if (t[static_cast<std::size_t>(ty) * n + tx]) return true;
@@ -177,7 +177,7 @@ std::vector<std::uint8_t> CubeTileMask::texels(int face) const {
   const int n = tiles_per_side();
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x)
-      out[static_cast<std::size_t>(y) * size + x] = t[static_cast<std::size_t>(y / kTile) * n + x / kTile];
+      out[static_cast<std::size_t>(y) * size + x] = t[static_cast<std::size_t>(y / tile) * n + x / tile];
   return out;
 }
 
@@ -186,11 +186,11 @@ double CubeTileMask::texel_count(unsigned face_mask) const {
   double count = 0.0;
   for (int f = 0; f < kCubeFaces; ++f) {
     if (!((face_mask >> f) & 1u) || tiles[f].empty()) continue;
-    // Tiles on the last row or column hold only the texels left of a side not divisible by kTile.
+    // Tiles on the last row or column hold only the texels left of a side not divisible by the tile.
     for (int ty = 0; ty < n; ++ty)
       for (int tx = 0; tx < n; ++tx)
         if (tiles[f][static_cast<std::size_t>(ty) * n + tx])
-          count += double(std::min(kTile, size - tx * kTile)) * std::min(kTile, size - ty * kTile);
+          count += double(std::min(tile, size - tx * tile)) * std::min(tile, size - ty * tile);
   }
   return count;
 }

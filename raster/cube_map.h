@@ -69,17 +69,18 @@ struct CubeMap {
   float distance_at(const CubeCoord& c) const;
 };
 
-// Which texels of each face a map's readers can reach, in square tiles of kTile level-0
+// Which texels of each face a map's readers can reach, in square tiles of `tile` level-0
 // texels: a refinement of CubeMapOptions::face_mask for maps whose reads are known (the
 // directions a frame looks up; reflector_maps.h). A texel outside every read tile is never
 // read at any level, so it need not be shaded or prefiltered.
 struct CubeTileMask {
-  static constexpr int kTile = 8;
+  static constexpr int kTile = 8;  // the default tile side
   int size = 0;  // level-0 side; 0: no mask (every texel of the faces in face_mask)
+  int tile = kTile;  // tile side in level-0 texels
   std::array<std::vector<std::uint8_t>, kCubeFaces> tiles;  // tiles_per_side()² per face, 1: read
 
   bool active() const { return size > 0; }
-  int tiles_per_side() const { return (size + kTile - 1) / kTile; }
+  int tiles_per_side() const { return (size + tile - 1) / tile; }
   // Level-`level` texel (x, y) of `face` (a side of size >> level) overlaps a read tile.
   bool covers(int face, int level, int x, int y) const;
   // The level-0 texels of `face` in read tiles, one byte each (1: read), row-major.

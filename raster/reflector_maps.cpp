@@ -2,6 +2,7 @@
 #include "raster/reflector_maps.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -125,35 +126,71 @@ float widest_lobe_sample(int count, float n) {
 // most of the face anyway, and below it the bound of mark_near holds.
 constexpr float kWholeFaceMargin = 0.5f;
 
-// Marks in `tiles` (one CubeTileMask face array each, n tiles a side, for a map of side
-// `size`) the tiles holding every texel centre within angle `margin` of unit direction d.
-// Along a great circle the face-plane coordinate ndc = (d·right)/(d·forward) moves at most
-// 1/(d·forward)² per radian; a texel t read by d lies on face f (d·forward ≥ 1/√3, i.e. within
-// acos(1/√3) of the axis) and every point of the arc from d to t is within `margin` of t, so
-// along it d·forward ≥ cos(acos(1/√3) + margin) = z: t is at most margin/z² in ndc, margin·
-// size/(2z²) texels, from d's point on the face's plane. One texel more absorbs rounding.
-void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int n, int size, const glm::vec3& d,
-               float margin) {
+// Sets tiles t[first, first + count): chunks of samples mark one mask at once, and a tile is
+// only ever set to 1, so the mask is the same whatever thread marked what.
+void mark(std::vector<std::uint8_t>& t, std::size_t first, std::size_t count) {
+  for (std::size_t k = first; k < first + count; ++k) std::atomic_ref<std::uint8_t>(t[k]).store(1, std::memory_order_relaxed);
+}
+
+// The angle within which lookup_level's bilinear taps lie around a direction: a texel's
+// diagonal (lookup_reach for a lobe read at level 0 alone).
+float texel_reach(int size) { return 2.0f * 1.4142136f / static_cast<float>(size); }
+
+// Marks in `tiles` (one CubeTileMask face array each, n tiles of `tile` texels a side, for a
+// map of side `size`) the tiles holding every texel centre within angle `margin` of unit
+// direction d. Along a great circle the face-plane coordinate ndc = (p·right)/(p·forward)
+// moves at most 1/(p·forward)² per radian. A texel t read by d lies on face f (within
+// acos(1/√3) of its axis) and every point p of the arc from d to t is within `margin` of both
+// t and d, so along it p·forward ≥ cos(min(acos(1/√3), θ_d) + margin) = z, θ_d being d's angle
+// to the axis: t is at most margin/z² in ndc, margin·size/(2z²) texels, from d's point on the
+// face's plane. One texel more absorbs rounding.
+void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int tile, int n, int size,
+               const glm::vec3& d, float margin) {
   const unsigned faces = cube_faces_near(d, margin);
   constexpr float kFaceHalfAngle = 0.95531662f;  // acos(1/√3)
-  const float z = std::cos(kFaceHalfAngle + margin);
-  const float half = margin >= kWholeFaceMargin ? 0.0f : margin * static_cast<float>(size) / (2.0f * z * z) + 1.0f;
-  constexpr int tile = CubeTileMask::kTile;
   for (int f = 0; f < kCubeFaces; ++f) {
     if (!((faces >> f) & 1u)) continue;
     std::vector<std::uint8_t>& t = tiles[f];
     if (margin >= kWholeFaceMargin) {
-      std::fill(t.begin(), t.end(), std::uint8_t(1));
+      mark(t, 0, t.size());
       continue;
     }
+    const float theta_d = std::acos(std::clamp(glm::dot(d, cube_direction(f, {0.5f, 0.5f}, 1)), -1.0f, 1.0f));
+    const float z = std::cos(std::min(kFaceHalfAngle, theta_d) + margin);
+    const float half = margin * static_cast<float>(size) / (2.0f * z * z) + 1.0f;
     const glm::vec2 p = cube_face_plane_pixel(f, d, size);
     const float lo_x = (p.x - half) / tile, hi_x = (p.x + half) / tile;
     const float lo_y = (p.y - half) / tile, hi_y = (p.y + half) / tile;
     if (!(hi_x >= 0.0f && hi_y >= 0.0f && lo_x < float(n) && lo_y < float(n))) continue;
     const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(n - 1, static_cast<int>(hi_x));
     const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(n - 1, static_cast<int>(hi_y));
-    for (int y = y0; y <= y1; ++y) std::fill_n(t.begin() + static_cast<std::ptrdiff_t>(y) * n + x0, x1 - x0 + 1, std::uint8_t(1));
+    for (int y = y0; y <= y1; ++y) mark(t, static_cast<std::size_t>(y) * n + x0, static_cast<std::size_t>(x1 - x0 + 1));
   }
+}
+
+// Marks the level-0 texels a lookup along unit direction d reads when it reads level 0 alone
+// (EnvironmentMap::radiance of a lobe no wider than a texel: lookup_level's bilinear taps),
+// with a hundredth of a texel to spare for the rounding of the reader's own (unnormalized)
+// direction. Near a face's edge, where that rounding could pick the neighbouring face, the
+// angular bound of mark_near marks instead.
+void mark_taps(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int tile, int n, int size,
+               const glm::vec3& d) {
+  const glm::vec3 a = glm::abs(d);
+  const float largest = std::max({a.x, a.y, a.z});
+  const float second = a.x == largest ? std::max(a.y, a.z) : a.y == largest ? std::max(a.x, a.z) : std::max(a.x, a.y);
+  if (second >= largest * (1.0f - 1e-3f)) {
+    mark_near(tiles, tile, n, size, d, texel_reach(size));
+    return;
+  }
+  const CubeCoord c = cube_coord(d, size);
+  constexpr float kSlack = 0.01f;
+  const float last = static_cast<float>(size - 1);
+  // bilinear_face's taps: x0 = int(clamp(x − 0.5, 0, side − 1)) and x0 + 1 (clamped).
+  const auto first_tap = [&](float p, float delta) { return static_cast<int>(std::clamp(p - 0.5f + delta, 0.0f, last)); };
+  const int x0 = first_tap(c.pixel.x, -kSlack), x1 = std::min(first_tap(c.pixel.x, kSlack) + 1, size - 1);
+  const int y0 = first_tap(c.pixel.y, -kSlack), y1 = std::min(first_tap(c.pixel.y, kSlack) + 1, size - 1);
+  for (int y = y0 / tile; y <= y1 / tile; ++y)
+    mark(tiles[c.face], static_cast<std::size_t>(y) * n + x0 / tile, static_cast<std::size_t>(x1 / tile - x0 / tile + 1));
 }
 
 }  // namespace
@@ -162,7 +199,7 @@ void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin) {
   const int n = mask.tiles_per_side();
   for (auto& t : mask.tiles)
     if (t.size() != static_cast<std::size_t>(n) * n) t.assign(static_cast<std::size_t>(n) * n, 0);
-  mark_near(mask.tiles, n, mask.size, d, margin);
+  mark_near(mask.tiles, mask.tile, n, mask.size, d, margin);
 }
 
 GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
@@ -199,35 +236,35 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
                         int size, int level_count) {
   CubeTileMask mask;
   mask.size = size;
+  // A map read at level 0 alone (mirror lobes) is read at each lookup's bilinear taps: texel
+  // tiles. A prefiltered level reads a wide footprint of level 0 anyway.
+  if (level_count == 1) mask.tile = 1;
   const int n = mask.tiles_per_side();
   for (auto& t : mask.tiles) t.assign(static_cast<std::size_t>(n) * n, 0);
-  constexpr std::size_t kChunk = 4096;
-  const std::size_t chunks = (samples.size() + kChunk - 1) / kChunk;
-  std::vector<std::array<std::vector<std::uint8_t>, kCubeFaces>> per_chunk(chunks);
-  executor.parallel_for("reflector_cube_maps.tiles", samples.size(), kChunk, [&](std::size_t begin, std::size_t end) {
-    auto& tiles = per_chunk[begin / kChunk];
-    for (auto& t : tiles) t.assign(static_cast<std::size_t>(n) * n, 0);
+  std::atomic<bool> refracts{false};
+  executor.parallel_for("reflector_cube_maps.tiles", samples.size(), 4096, [&](std::size_t begin, std::size_t end) {
     float last_exponent = std::numeric_limits<float>::quiet_NaN(), margin = 0.0f;
+    bool level0 = false;
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t i = samples[k];
       const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
       if (s.is_refractor()) {  // refracted lookups go anywhere (faces_read keeps every face)
-        for (auto& t : tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
+        refracts.store(true, std::memory_order_relaxed);
         break;
       }
       // specular_radiance's lookup: along R with the material's exponent (as faces_read).
       if (!(s.phong_exponent == last_exponent)) {
         last_exponent = s.phong_exponent;
         margin = std::max(lookup_reach(size, level_count, s.phong_exponent), 1e-3f);
+        level0 = levels_for_lobes(size, s.phong_exponent) == 1;
       }
-      mark_near(tiles, n, size, glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i])), margin);
+      const glm::vec3 r = glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i]));
+      if (level0) mark_taps(mask.tiles, mask.tile, n, size, r);
+      else mark_near(mask.tiles, mask.tile, n, size, r, margin);
     }
   });
-  // OR of the chunks' marks: the same whatever thread marked what.
-  for (const auto& tiles : per_chunk)
-    for (int f = 0; f < kCubeFaces; ++f)
-      for (std::size_t k = 0; k < tiles[f].size(); ++k) mask.tiles[f][k] |= tiles[f][k];
+  if (refracts.load()) for (auto& t : mask.tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
   return mask;
 }
 
