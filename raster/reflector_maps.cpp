@@ -233,14 +233,14 @@ GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
 }
 
 CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
-                        int size, int level_count) {
+                        int size, int level_count, bool refractors_read_at_surface) {
   CubeTileMask mask;
   mask.size = size;
   // A map read at level 0 alone (mirror lobes) is read at each lookup's bilinear taps: texel
   // tiles. A prefiltered level reads a wide footprint of level 0 anyway.
   if (level_count == 1) mask.tile = 1;
-  const int n = mask.tiles_per_side();
-  for (auto& t : mask.tiles) t.assign(static_cast<std::size_t>(n) * n, 0);
+  const int n_tiles = mask.tiles_per_side();
+  for (auto& t : mask.tiles) t.assign(static_cast<std::size_t>(n_tiles) * n_tiles, 0);
   std::atomic<bool> refracts{false};
   executor.parallel_for("reflector_cube_maps.tiles", samples.size(), 4096, [&](std::size_t begin, std::size_t end) {
     float last_exponent = std::numeric_limits<float>::quiet_NaN(), margin = 0.0f;
@@ -249,9 +249,21 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
       const std::size_t i = samples[k];
       const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
-      if (s.is_refractor()) {  // refracted lookups go anywhere (faces_read keeps every face)
-        refracts.store(true, std::memory_order_relaxed);
-        break;
+      if (s.is_refractor()) {
+        if (!refractors_read_at_surface) {  // paths through it go anywhere (faces_read keeps every face)
+          refracts.store(true, std::memory_order_relaxed);
+          break;
+        }
+        // specular_radiance's two lookups, both at level 0 alone (kSharpLookupExponent).
+        glm::vec3 n = g.normal.pixels[i];
+        const glm::vec3 v = g.view_direction(i);
+        const bool entering = glm::dot(n, v) >= 0.0f;
+        if (!entering) n = -n;
+        glm::vec3 t;
+        mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(reflect(-v, n)));
+        if (refract(-v, n, entering ? s.ior : 1.0f / s.ior, t))
+          mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(t));
+        continue;
       }
       // specular_radiance's lookup: along R with the material's exponent (as faces_read).
       if (!(s.phong_exponent == last_exponent)) {
@@ -260,8 +272,8 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
         level0 = levels_for_lobes(size, s.phong_exponent) == 1;
       }
       const glm::vec3 r = glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i]));
-      if (level0) mark_taps(mask.tiles, mask.tile, n, size, r);
-      else mark_near(mask.tiles, mask.tile, n, size, r, margin);
+      if (level0) mark_taps(mask.tiles, mask.tile, n_tiles, size, r);
+      else mark_near(mask.tiles, mask.tile, n_tiles, size, r, margin);
     }
   });
   if (refracts.load()) for (auto& t : mask.tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
@@ -431,7 +443,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     // only the tiles around the directions read, as well as only the faces.
     CubeTileMask tiles;
     if (!samples_of.empty() && sizing.reads == MapSizing::Reads::direction && std::has_single_bit(unsigned(side))) {
-      tiles = tiles_read(executor, *camera_view, samples_of[o], side, levels);
+      tiles = tiles_read(executor, *camera_view, samples_of[o], side, levels, sizing.refractors_read_at_surface);
       opt.face_mask = 0;
       for (int f = 0; f < kCubeFaces; ++f)
         if (std::find(tiles.tiles[f].begin(), tiles.tiles[f].end(), std::uint8_t(1)) != tiles.tiles[f].end())

@@ -71,6 +71,11 @@ struct MapSizing {
   // centre to the points of its ray) are not rendered or prefiltered. Refractors' maps keep
   // every face.
   enum class Reads { anywhere, direction, search } reads = Reads::anywhere;
+  // With Reads::direction: whether a refractor's map is read only where its camera samples
+  // look up the reflected and refracted directions at its surface (specular_radiance, as
+  // envmap_reflect does), or also by paths through it (the refraction pass's searches), which
+  // may go anywhere.
+  bool refractors_read_at_surface = false;
   int lobe_directions = 8;  // search: sub-lobe searches per glossy lobe (distance_map_reflect)
   // Whether anything reads the maps' colour. When only their distances are searched (the
   // caustics' photons, SURVEY §6.1), no face is resolved or shaded and nothing is prefiltered:
@@ -91,10 +96,12 @@ void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin);
 
 // The tiles of a map of side `size` (a power of two) with `level_count` levels that the
 // lookups along R of the camera samples `samples` of one reflector can reach (every texel
-// within lookup_reach of a read direction), for maps read only along R (Reads::direction).
-// A refractor's sample marks every tile. Exposed for tests.
+// within lookup_reach of a read direction, or the bilinear taps of a lookup at level 0
+// alone), for maps read only along R (Reads::direction). A refractor's sample marks the taps
+// of its reflected and refracted directions when `refractors_read_at_surface`, else every
+// tile. Exposed for tests.
 CubeTileMask tiles_read(par::Executor& executor, const GBuffer& camera_view, const std::vector<std::uint32_t>& samples,
-                        int size, int level_count);
+                        int size, int level_count, bool refractors_read_at_surface = false);
 
 // 1 for each object with a specular sample in `camera_view` (what `skip_unseen` keeps).
 std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& camera_view);

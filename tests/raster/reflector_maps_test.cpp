@@ -124,16 +124,19 @@ TEST(ReflectorMaps, MarkedTilesHoldEveryTexelWithinTheMargin) {
 }
 
 // Lookups along R read only the tiles near their directions: maps rendered on those tiles
-// alone give the same specular layer, byte for byte, as complete maps, and fewer texels.
+// alone give the same specular layer, byte for byte, as complete maps, and fewer texels; with
+// refractors_read_at_surface, a refractor's map too.
 TEST(ReflectorMaps, UnreadTilesChangeNoLookedUpSample) {
   par::Executor ex(2);
-  for (const char* name : {"living-room", "glossy-plane", "glass-sphere"}) {
-    SCOPED_TRACE(name);
+  for (const char* name : {"living-room", "glossy-plane", "glass-sphere"})
+  for (const bool at_surface : {false, true}) {
+    SCOPED_TRACE(std::string(name) + (at_surface ? ", refractors read at the surface" : ""));
     const View v = view_of(name, 128, 96, ex);
     for (const int size : {64, 128}) {
       const ReflectorMaps all = render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g);
       MapSizing looked_up;
       looked_up.reads = MapSizing::Reads::direction;
+      looked_up.refractors_read_at_surface = at_surface;
       const ReflectorMaps tiled =
           render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g, ReflectorSelection::all, {}, nullptr, looked_up);
       ASSERT_EQ(tiled.tiles.size(), tiled.cubes.size());
@@ -155,6 +158,9 @@ TEST(ReflectorMaps, UnreadTilesChangeNoLookedUpSample) {
       }
       if (std::string(name) == "glass-sphere") {
         EXPECT_GT(rendered_texels(tiled), 0.0);
+        // Its glass ball's map (read at level 0 alone) keeps all its texels unless only the
+        // lookups at its surface read it.
+        EXPECT_EQ(rendered_texels(tiled) < 0.5 * whole_faces, at_surface);
       }
       EXPECT_TRUE(same_bytes(envmap_reflect(ex, v.g, v.env, &all), envmap_reflect(ex, v.g, v.env, &tiled)));
     }
