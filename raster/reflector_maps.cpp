@@ -127,9 +127,13 @@ float widest_lobe_sample(int count, float n) {
 constexpr float kWholeFaceMargin = 0.5f;
 
 // Sets tiles t[first, first + count): chunks of samples mark one mask at once, and a tile is
-// only ever set to 1, so the mask is the same whatever thread marked what.
+// only ever set to 1, so the mask is the same whatever thread marked what. A tile already set
+// is not written again (the threads would otherwise trade its cache line back and forth).
 void mark(std::vector<std::uint8_t>& t, std::size_t first, std::size_t count) {
-  for (std::size_t k = first; k < first + count; ++k) std::atomic_ref<std::uint8_t>(t[k]).store(1, std::memory_order_relaxed);
+  for (std::size_t k = first; k < first + count; ++k) {
+    std::atomic_ref<std::uint8_t> tile(t[k]);
+    if (!tile.load(std::memory_order_relaxed)) tile.store(1, std::memory_order_relaxed);
+  }
 }
 
 // The angle within which lookup_level's bilinear taps lie around a direction: a texel's
@@ -144,15 +148,18 @@ float texel_reach(int size) { return 2.0f * 1.4142136f / static_cast<float>(size
 // t and d, so along it p·forward ≥ cos(min(acos(1/√3), θ_d) + margin) = z, θ_d being d's angle
 // to the axis: t is at most margin/z² in ndc, margin·size/(2z²) texels, from d's point on the
 // face's plane. One texel more absorbs rounding.
+// `whole` (bit f: face f marked whole already) spares a caller marking many directions the
+// repeated whole-face marks.
 void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int tile, int n, int size,
-               const glm::vec3& d, float margin) {
-  const unsigned faces = cube_faces_near(d, margin);
+               const glm::vec3& d, float margin, unsigned& whole) {
+  const unsigned faces = cube_faces_near(d, margin) & ~whole;
   constexpr float kFaceHalfAngle = 0.95531662f;  // acos(1/√3)
   for (int f = 0; f < kCubeFaces; ++f) {
     if (!((faces >> f) & 1u)) continue;
     std::vector<std::uint8_t>& t = tiles[f];
     if (margin >= kWholeFaceMargin) {
       mark(t, 0, t.size());
+      whole |= 1u << f;
       continue;
     }
     const float theta_d = std::acos(std::clamp(glm::dot(d, cube_direction(f, {0.5f, 0.5f}, 1)), -1.0f, 1.0f));
@@ -174,12 +181,12 @@ void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int til
 // direction. Near a face's edge, where that rounding could pick the neighbouring face, the
 // angular bound of mark_near marks instead.
 void mark_taps(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int tile, int n, int size,
-               const glm::vec3& d) {
+               const glm::vec3& d, unsigned& whole) {
   const glm::vec3 a = glm::abs(d);
   const float largest = std::max({a.x, a.y, a.z});
   const float second = a.x == largest ? std::max(a.y, a.z) : a.y == largest ? std::max(a.x, a.z) : std::max(a.x, a.y);
   if (second >= largest * (1.0f - 1e-3f)) {
-    mark_near(tiles, tile, n, size, d, texel_reach(size));
+    mark_near(tiles, tile, n, size, d, texel_reach(size), whole);
     return;
   }
   const CubeCoord c = cube_coord(d, size);
@@ -199,7 +206,8 @@ void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin) {
   const int n = mask.tiles_per_side();
   for (auto& t : mask.tiles)
     if (t.size() != static_cast<std::size_t>(n) * n) t.assign(static_cast<std::size_t>(n) * n, 0);
-  mark_near(mask.tiles, mask.tile, n, mask.size, d, margin);
+  unsigned whole = 0;
+  mark_near(mask.tiles, mask.tile, n, mask.size, d, margin, whole);
 }
 
 GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
@@ -245,6 +253,7 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
   executor.parallel_for("reflector_cube_maps.tiles", samples.size(), 4096, [&](std::size_t begin, std::size_t end) {
     float last_exponent = std::numeric_limits<float>::quiet_NaN(), margin = 0.0f;
     bool level0 = false;
+    unsigned whole = 0;  // faces this chunk marked whole
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t i = samples[k];
       const SurfaceParams& s = g.surface[i];
@@ -260,9 +269,9 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
         const bool entering = glm::dot(n, v) >= 0.0f;
         if (!entering) n = -n;
         glm::vec3 t;
-        mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(reflect(-v, n)));
+        mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(reflect(-v, n)), whole);
         if (refract(-v, n, entering ? s.ior : 1.0f / s.ior, t))
-          mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(t));
+          mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(t), whole);
         continue;
       }
       // specular_radiance's lookup: along R with the material's exponent (as faces_read).
@@ -272,8 +281,8 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
         level0 = levels_for_lobes(size, s.phong_exponent) == 1;
       }
       const glm::vec3 r = glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i]));
-      if (level0) mark_taps(mask.tiles, mask.tile, n_tiles, size, r);
-      else mark_near(mask.tiles, mask.tile, n_tiles, size, r, margin);
+      if (level0) mark_taps(mask.tiles, mask.tile, n_tiles, size, r, whole);
+      else mark_near(mask.tiles, mask.tile, n_tiles, size, r, margin, whole);
     }
   });
   if (refracts.load()) for (auto& t : mask.tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
