@@ -75,15 +75,15 @@ struct Range {
   Aabb box, cbox;  // bounds of the triangles and of their (doubled) centroids
 };
 
+// The bin of a (doubled) centroid c on axis a is clamp(int((c[a] − lo[a]) · scale[a]), 0,
+// bins − 1), the conversion truncating toward zero: bin_refs computes it in lanes for the
+// three axes, partition on the split axis alone, with the same operations.
 struct Binner {
   glm::vec3 lo, scale;
   int bins;
   Binner(const Aabb& cbox, int nbins) : lo(cbox.lo), bins(nbins) {
     const glm::vec3 ext = cbox.hi - cbox.lo;
     for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? static_cast<float>(nbins) * (1.0f - 1e-6f) / ext[a] : 0.0f;
-  }
-  int bin(const glm::vec3& c, int a) const {
-    return std::clamp(static_cast<int>((c[a] - lo[a]) * scale[a]), 0, bins - 1);
   }
 };
 
@@ -111,7 +111,7 @@ void clear_bins(Bins& bins, int nb) {
 // `second` is scratch.
 void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out, Bins& second) {
   // Lane 3 of a ref's lo/hi holds the id/pad bits: it is zeroed before the bin index is
-  // formed, and ignored in the bin boxes. Lanes 0-2 do exactly Binner::bin's operations.
+  // formed, and ignored in the bin boxes. Lanes 0-2 compute Binner's bin index.
   const __m128 blo = _mm_setr_ps(b.lo.x, b.lo.y, b.lo.z, 0.0f);
   const __m128 scale = _mm_setr_ps(b.scale.x, b.scale.y, b.scale.z, 0.0f);
   const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
@@ -120,7 +120,7 @@ void bin_refs(const PrimRef* refs, std::size_t n, const Binner& b, Bins& out, Bi
     const __m128 lo = _mm_loadu_ps(&ref.lo.x);
     const __m128 hi = _mm_loadu_ps(&ref.hi.x);
     const __m128 c = _mm_and_ps(xyz, _mm_add_ps(lo, hi));
-    // Truncation toward zero, as static_cast<int> in Binner::bin.
+    // Truncation toward zero (Binner).
     const __m128i idx = _mm_min_epi32(_mm_max_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, blo), scale)), bottom), top);
     alignas(16) std::int32_t k[4];
     _mm_store_si128(reinterpret_cast<__m128i*>(k), idx);
@@ -231,7 +231,7 @@ std::pair<Range, Range> partition(PrimRef* refs, const Range& r, const Split& s,
     for (std::uint32_t i = r.begin; i < mid; ++i) lb.grow(refs[i]);
     for (std::uint32_t i = mid; i < r.end; ++i) rb.grow(refs[i]);
   } else {
-    // Binner::bin on the split axis alone: the same operations on the same component.
+    // Binner's bin index on the split axis alone.
     const int a = s.axis;
     const float bin_lo = b.lo[a], bin_scale = b.scale[a];
     auto left = [&](const PrimRef& p) {
