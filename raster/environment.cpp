@@ -4,6 +4,8 @@
 // number of lookups whatever its lobe width.
 #include "raster/environment.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -55,7 +57,7 @@ glm::vec3 prefilter_texel(const std::array<ImageRGBA, kCubeFaces>& previous, int
 // prefilter_texel in its order (lookup_level's face choice and projection, whose dot products
 // with the face's signed unit axes are one signed component: the same value, up to the sign
 // of a zero that the +1 of the pixel mapping removes; the bilinear weights; the sum over k
-// in order), so the result has the same bits for every texel; the taps are gathered per lane.
+// in order), so the result has the same bits for every texel.
 void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int face, int s, std::size_t first,
                        const glm::vec3* local, int count, glm::vec3* out) {
   using L = par::Lanes<8>;
@@ -107,10 +109,20 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
     const f32 tx = fx - L::to_float(x0), ty = fy - L::to_float(y0);
     const f32 wx = 1.0f - tx, wy = 1.0f - ty;
     const i32 row0 = y0 * side, row1 = y1 * side;
-    const i32 i00 = (row0 + x0) * 4, i10 = (row0 + x1) * 4, i01 = (row1 + x0) * 4, i11 = (row1 + x1) * 4;
+    const i32 taps[4] = {(row0 + x0) * 4, (row0 + x1) * 4, (row1 + x0) * 4, (row1 + x1) * 4};
+    // Each lane's tap texel loaded as one RGBA row and four lanes' rows transposed into
+    // channels: the values one load per channel would give.
+    alignas(32) float channel[4][3][8];  // [tap][channel][lane]
+    for (int q = 0; q < 4; ++q)
+      for (int h = 0; h < 8; h += 4) {
+        __m128 r[4];
+        for (int j = 0; j < 4; ++j) r[j] = _mm_loadu_ps(pixels[fi[h + j]] + taps[q][h + j]);
+        _MM_TRANSPOSE4_PS(r[0], r[1], r[2], r[3]);
+        for (int c = 0; c < 3; ++c) _mm_store_ps(&channel[q][c][h], r[c]);
+      }
     for (int c = 0; c < 3; ++c) {
-      const auto tap = [&](const i32& index) { return f32([&](auto j) { return pixels[fi[j]][index[j] + c]; }); };
-      sum[c] += (tap(i00) * wx + tap(i10) * tx) * wy + (tap(i01) * wx + tap(i11) * tx) * ty;
+      const auto tap = [&](int q) { return L::load_aligned(channel[q][c]); };
+      sum[c] += (tap(0) * wx + tap(1) * tx) * wy + (tap(2) * wx + tap(3) * tx) * ty;
     }
   }
   for (int j = 0; j < 8; ++j) out[j] = glm::vec3(sum[0][j], sum[1][j], sum[2][j]);
