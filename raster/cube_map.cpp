@@ -83,30 +83,13 @@ CubeFaceAxes face_axes(int face) {
   return a;
 }
 
-// Initialized after kFrames (same translation unit, in order).
-const std::array<CubeFaceAxes, kCubeFaces> kAxes = {face_axes(0), face_axes(1), face_axes(2),
-                                                    face_axes(3), face_axes(4), face_axes(5)};
 }  // namespace
 
-const CubeFaceAxes& cube_face_axes(int face) { return kAxes[face]; }
+// Initialized after kFrames (same translation unit, in order).
+const std::array<CubeFaceAxes, kCubeFaces> kCubeFaceAxes = {face_axes(0), face_axes(1), face_axes(2),
+                                                            face_axes(3), face_axes(4), face_axes(5)};
 
-CubeCoord cube_coord(const glm::vec3& d, int size) {
-  const glm::vec3 a = glm::abs(d);
-  int face;
-  if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
-  else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
-  else face = d.z >= 0.0f ? 4 : 5;
-  // The frame's axes are signed unit axes, so each dot product with them is one signed
-  // component: the same value (up to the sign of a zero, which the +1 below removes) for a
-  // fraction of the work — this runs for every shadow tap, map lookup and search step.
-  const CubeFaceAxes& f = kAxes[face];
-  const float depth = f.forward_sign * d[f.forward];
-  const float ndc_x = f.right_sign * d[f.right] / depth;
-  const float ndc_y = f.up_sign * d[f.up] / depth;
-  const float s = static_cast<float>(size);
-  return {face, {std::clamp((ndc_x + 1.0f) * 0.5f * s, 0.0f, s),
-                 std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
-}
+const CubeFaceAxes& cube_face_axes(int face) { return kCubeFaceAxes[face]; }
 
 unsigned cube_faces_near(const glm::vec3& p, float margin) {
   // Over the directions within angle θ of p the largest q·m is sin(asin(p·m) + θ) (up to

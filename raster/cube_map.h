@@ -3,11 +3,13 @@
 // conventions every cube lookup in speculum uses (environment, shadow and distance maps).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
@@ -26,13 +28,11 @@ constexpr int kCubeFaces = 6;  // +X, −X, +Y, −Y, +Z, −Z
 // pixels follow core/camera_rays.h, so a face image is an ordinary render of this camera.
 Camera cube_face_camera(int face, const glm::vec3& centre, float znear, float zfar);
 
-// Where direction d (any length, non-zero) lands: its face and continuous pixel
-// coordinates in [0, size]² (pixel centres at +0.5).
+// A face and continuous pixel coordinates on it in [0, size]² (pixel centres at +0.5).
 struct CubeCoord {
   int face = 0;
   glm::vec2 pixel{0.0f};
 };
-CubeCoord cube_coord(const glm::vec3& d, int size);
 // The axes of face `face`'s frame (forward, right, up): each is a signed unit axis, so a dot
 // product with it is one signed component (up to the sign of a zero).
 struct CubeFaceAxes {
@@ -40,6 +40,28 @@ struct CubeFaceAxes {
   float forward_sign = 1.0f, right_sign = 1.0f, up_sign = 1.0f;
 };
 const CubeFaceAxes& cube_face_axes(int face);
+// The same for every face, derived from the face cameras' frames at start-up.
+extern const std::array<CubeFaceAxes, kCubeFaces> kCubeFaceAxes;
+
+// Where direction d (any length, non-zero) lands. Inline: every shadow tap, map lookup,
+// prefilter tap and distance-map search step calls it.
+inline CubeCoord cube_coord(const glm::vec3& d, int size) {
+  const glm::vec3 a = glm::abs(d);
+  int face;
+  if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
+  else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
+  else face = d.z >= 0.0f ? 4 : 5;
+  // The frame's axes are signed unit axes, so each dot product with them is one signed
+  // component: the same value (up to the sign of a zero, which the +1 below removes) for a
+  // fraction of the work.
+  const CubeFaceAxes& f = kCubeFaceAxes[face];
+  const float depth = f.forward_sign * d[f.forward];
+  const float ndc_x = f.right_sign * d[f.right] / depth;
+  const float ndc_y = f.up_sign * d[f.up] / depth;
+  const float s = static_cast<float>(size);
+  return {face, {std::clamp((ndc_x + 1.0f) * 0.5f * s, 0.0f, s),
+                 std::clamp((1.0f - ndc_y) * 0.5f * s, 0.0f, s)}};
+}
 
 // Bit f set: face f may hold a direction within angle `margin` of unit direction p. Face f
 // (axis k, sign σ) holds the directions with σ p_k ≥ |p_j| for j ≠ k, the side of four great
