@@ -133,11 +133,6 @@ glm::vec4 CubeMap::colour_at(const CubeCoord& c) const {
          (img.at(x0, y1) * (1 - tx) + img.at(x1, y1) * tx) * ty;
 }
 
-float CubeMap::distance_at(const CubeCoord& c) const {
-  const int x = std::min(static_cast<int>(c.pixel.x), size - 1);
-  const int y = std::min(static_cast<int>(c.pixel.y), size - 1);
-  return distance[c.face].at(x, y);
-}
 
 bool CubeTileMask::covers(int face, int level, int x, int y) const {
   if (!active()) return true;

@@ -88,7 +88,12 @@ struct CubeMap {
   float distance_towards(const glm::vec3& d) const { return distance_at(cube_coord(d, size)); }
   // The same at a direction's cube_coord(d, size), for a caller that needs it more than once.
   glm::vec4 colour_at(const CubeCoord& c) const;
-  float distance_at(const CubeCoord& c) const;
+  // Inline: every step of a distance-map search reads one.
+  float distance_at(const CubeCoord& c) const {
+    const int x = std::min(static_cast<int>(c.pixel.x), size - 1);
+    const int y = std::min(static_cast<int>(c.pixel.y), size - 1);
+    return distance[c.face].at(x, y);
+  }
 };
 
 // Which texels of each face a map's readers can reach, in square tiles of `tile` level-0
