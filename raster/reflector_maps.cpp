@@ -254,35 +254,30 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
     float last_exponent = std::numeric_limits<float>::quiet_NaN(), margin = 0.0f;
     bool level0 = false;
     unsigned whole = 0;  // faces this chunk marked whole
+    // Marks what a lookup along d through a lobe of that exponent reads: its bilinear taps
+    // when it reads level 0 alone, else every texel within its lookup_reach.
+    const auto mark_lookup = [&](const glm::vec3& d, float exponent) {
+      if (!(exponent == last_exponent)) {
+        last_exponent = exponent;
+        margin = std::max(lookup_reach(size, level_count, exponent), 1e-3f);
+        level0 = levels_for_lobes(size, exponent) == 1;
+      }
+      const glm::vec3 r = glm::normalize(d);
+      if (level0) mark_taps(mask.tiles, mask.tile, n_tiles, size, r, whole);
+      else mark_near(mask.tiles, mask.tile, n_tiles, size, r, margin, whole);
+      return glm::vec3(0.0f);
+    };
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t i = samples[k];
       const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
-      if (s.is_refractor()) {
-        if (!refractors_read_at_surface) {  // paths through it go anywhere (faces_read keeps every face)
-          refracts.store(true, std::memory_order_relaxed);
-          break;
-        }
-        // specular_radiance's two lookups, both at level 0 alone (kSharpLookupExponent).
-        glm::vec3 n = g.normal.pixels[i];
-        const glm::vec3 v = g.view_direction(i);
-        const bool entering = glm::dot(n, v) >= 0.0f;
-        if (!entering) n = -n;
-        glm::vec3 t;
-        mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(reflect(-v, n)), whole);
-        if (refract(-v, n, entering ? s.ior : 1.0f / s.ior, t))
-          mark_taps(mask.tiles, mask.tile, n_tiles, size, glm::normalize(t), whole);
-        continue;
+      if (s.is_refractor() && !refractors_read_at_surface) {  // paths through it go anywhere (faces_read keeps every face)
+        refracts.store(true, std::memory_order_relaxed);
+        break;
       }
-      // specular_radiance's lookup: along R with the material's exponent (as faces_read).
-      if (!(s.phong_exponent == last_exponent)) {
-        last_exponent = s.phong_exponent;
-        margin = std::max(lookup_reach(size, level_count, s.phong_exponent), 1e-3f);
-        level0 = levels_for_lobes(size, s.phong_exponent) == 1;
-      }
-      const glm::vec3 r = glm::normalize(reflect(-g.view_direction(i), g.normal.pixels[i]));
-      if (level0) mark_taps(mask.tiles, mask.tile, n_tiles, size, r, whole);
-      else mark_near(mask.tiles, mask.tile, n_tiles, size, r, margin, whole);
+      // The lookups specular_radiance makes for this sample (envmap_reflect's reads): along R
+      // with the material's exponent, a refractor's along R and T sharply.
+      specular_radiance(s, g.normal.pixels[i], g.view_direction(i), mark_lookup);
     }
   });
   if (refracts.load()) for (auto& t : mask.tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
