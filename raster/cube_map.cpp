@@ -89,8 +89,6 @@ CubeFaceAxes face_axes(int face) {
 const std::array<CubeFaceAxes, kCubeFaces> kCubeFaceAxes = {face_axes(0), face_axes(1), face_axes(2),
                                                             face_axes(3), face_axes(4), face_axes(5)};
 
-const CubeFaceAxes& cube_face_axes(int face) { return kCubeFaceAxes[face]; }
-
 unsigned cube_faces_near(const glm::vec3& p, float margin) {
   // Over the directions within angle θ of p the largest q·m is sin(asin(p·m) + θ) (up to
   // θ ≤ π/2), so one of them is on m's side when p·m ≥ −sin θ: σ p_k − |p_j| ≥ −√2 sin θ.
@@ -132,7 +130,6 @@ glm::vec4 CubeMap::colour_at(const CubeCoord& c) const {
   return (img.at(x0, y0) * (1 - tx) + img.at(x1, y0) * tx) * (1 - ty) +
          (img.at(x0, y1) * (1 - tx) + img.at(x1, y1) * tx) * ty;
 }
-
 
 bool CubeTileMask::covers(int face, int level, int x, int y) const {
   if (!active()) return true;

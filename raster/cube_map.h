@@ -39,8 +39,7 @@ struct CubeFaceAxes {
   int forward = 0, right = 0, up = 0;                       // axis index 0..2
   float forward_sign = 1.0f, right_sign = 1.0f, up_sign = 1.0f;
 };
-const CubeFaceAxes& cube_face_axes(int face);
-// The same for every face, derived from the face cameras' frames at start-up.
+// Every face's axes, derived from the face cameras' frames at start-up.
 extern const std::array<CubeFaceAxes, kCubeFaces> kCubeFaceAxes;
 
 // Where direction d (any length, non-zero) lands. Inline: every shadow tap, map lookup,

@@ -63,8 +63,6 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
   using L = par::Lanes<8>;
   using f32 = L::f32;
   using i32 = L::i32;
-  const CubeFaceAxes* axes[kCubeFaces];
-  for (int f = 0; f < kCubeFaces; ++f) axes[f] = &cube_face_axes(f);
   alignas(32) float t[3][8], b[3][8], n[3][8];
   for (int j = 0; j < 8; ++j) {
     const std::size_t i = first + static_cast<std::size_t>(j);
@@ -93,7 +91,7 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
     f32 depth(0.0f), along_right(0.0f), along_up(0.0f);
     for (int f = 0; f < kCubeFaces; ++f) {
       const L::mask here = fi == f;
-      const CubeFaceAxes& a = *axes[f];
+      const CubeFaceAxes& a = kCubeFaceAxes[f];
       depth = L::select(here, a.forward_sign * d[a.forward], depth);
       along_right = L::select(here, a.right_sign * d[a.right], along_right);
       along_up = L::select(here, a.up_sign * d[a.up], along_up);

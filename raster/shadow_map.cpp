@@ -203,7 +203,7 @@ void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l
   f32 depth(0.0f), along_right(0.0f), along_up(0.0f);
   for (int f = 0; f < kCubeFaces; ++f) {
     const L::mask here = face == f;
-    const CubeFaceAxes& a = cube_face_axes(f);
+    const CubeFaceAxes& a = kCubeFaceAxes[f];
     depth = L::select(here, a.forward_sign * d[a.forward], depth);
     along_right = L::select(here, a.right_sign * d[a.right], along_right);
     along_up = L::select(here, a.up_sign * d[a.up], along_up);
