@@ -44,7 +44,6 @@ struct MaterialInfo {
   bool simple = false;         // neither: constant parameters, normals take the 8-wide path
   std::uint32_t keep_side = 0; // all ones for refractors (see resolve_sample)
   bool specular = false;       // is_specular(constant)
-  std::uint32_t slot = 0;      // the material's index: its shared entry in the surface plane
 };
 
 // Per material, for the 8-lane path: one word gathered by material index whose bits say
@@ -208,8 +207,9 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
 // The interpolation half of resolve_sample for a simple material (constant parameters, no
 // normal map): the normal step runs later over the block's lanes.
 inline void interpolate_sample(const SampleContext& c, std::size_t i, const TriangleRecord& r,
-                               const MaterialInfo& info, const StagingBlock& out,
+                               std::uint32_t mat, const StagingBlock& out,
                                detail::NormalLanes<kBlock>& lanes, std::size_t j) {
+  const MaterialInfo& info = c.materials[mat];
   const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
   const float b0 = 1.0f - b.x - b.y;
@@ -222,7 +222,7 @@ inline void interpolate_sample(const SampleContext& c, std::size_t i, const Tria
   out.object[j] = object;
   out.position[j] = p;
   out.uv[j] = lerp3(r.uv);
-  out.surface[j] = info.slot;
+  out.surface[j] = mat;  // the shared entry of an untextured material is its index
   out.reflector[j] = info.specular ? object : kNoId;
 }
 
@@ -391,7 +391,7 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
       const std::uint32_t mat = corners.material(t);
       const MaterialInfo& info = c.materials[mat];
       if (info.simple) {
-        interpolate_sample(c, i, r, info, blk, lanes, j);
+        interpolate_sample(c, i, r, mat, blk, lanes, j);
         simple[j] = true;
         normals_pending = true;
       } else {
@@ -449,7 +449,6 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
   bool any_textured = false;
   for (const Material& mat : scene.materials) {
     MaterialInfo info;
-    info.slot = static_cast<std::uint32_t>(materials.size());
     info.constant = surface_params(mat);
     info.textured = mat.base_color_texture.valid() || mat.metallic_roughness_texture.valid() ||
                     mat.emissive_texture.valid() || mat.transmission_texture.valid();
