@@ -61,6 +61,9 @@
 
 namespace speculum {
 
+template <int W>
+struct Vec3Lanes;
+
 // Material parameters at one surface point, textures already applied.
 struct SurfaceParams {
   glm::vec3 base_color{1.0f};
@@ -102,6 +105,10 @@ class LightSampler {
  public:
   explicit LightSampler(const Light& light);
   LightSample operator()(const glm::vec3& position) const;
+  // The same at W points (core/shading_lanes.h): each lane's direction and irradiance have
+  // the bits of operator()'s.
+  template <int W>
+  void sample(const Vec3Lanes<W>& position, Vec3Lanes<W>& direction, Vec3Lanes<W>& irradiance) const;
 
  private:
   const Light* light_;

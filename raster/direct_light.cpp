@@ -7,6 +7,7 @@
 
 #include "core/camera_rays.h"
 #include "core/optics.h"
+#include "core/shading_lanes.h"
 
 namespace speculum::raster {
 
@@ -64,34 +65,57 @@ glm::vec3 SurfaceShader::operator()(const SurfaceParams& s, const glm::vec3& p, 
 
 void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, const glm::vec3* n_in,
                            const glm::vec3* v, int count, glm::vec3* out) const {
+  using L = par::Lanes<8>;
+  using V = Vec3Lanes<8>;
   glm::vec3 n[8];
   BrdfAtView view[8];
+  alignas(32) float mirror_flag[8] = {};
   for (int j = 0; j < count; ++j) {
     n[j] = facing_viewer(n_in[j], v[j]);
     out[j] = s[j]->emissive;
     view[j] = brdf_at_view(brdf_params_for_punctual_light(*s[j]), n[j], v[j]);
+    mirror_flag[j] = s[j]->is_mirror_lobe() ? 1.0f : 0.0f;
   }
+  // Every light's terms eight points at a time (core/shading_lanes.h: each lane has the bits
+  // of shade_light's scalar form); lanes past `count` repeat point 0 and are dropped.
+  const V pv = V::load(p, count), nv = V::load(n, count), vv = V::load(v, count);
+  const BrdfAtViewLanes<8> views = BrdfAtViewLanes<8>::load(view, count);
+  const L::mask mirror = L::load(mirror_flag) > 0.0f;
+  const L::f32 zero(0.0f);
+  V radiance = V::load(out, count);
   for (std::size_t k = 0; k < lights_.size(); ++k) {
+    V l, irradiance;
+    lights_[k].sample(pv, l, irradiance);
+    const L::mask reached = L::first_n(count) &&
+                            !(irradiance.x == zero && irradiance.y == zero && irradiance.z == zero) &&
+                            !(dot(nv, l) <= zero);
+    if (L::none(reached)) continue;
     // The points this light reaches, in point order, and their shadow tests in one call.
-    LightSample ls[8];
-    glm::vec3 lit_p[8], lit_n[8], lit_l[8];
-    int lane[8], reached = 0;
-    for (int j = 0; j < count; ++j) {
-      ls[j] = lights_[k](p[j]);
-      if (ls[j].irradiance == glm::vec3(0.0f) || glm::dot(n[j], ls[j].direction) <= 0.0f) continue;
-      lane[reached] = j;
-      lit_p[reached] = p[j], lit_n[reached] = n[j], lit_l[reached] = ls[j].direction;
-      ++reached;
+    alignas(32) float lit[8] = {};
+    if (k < shadows_->size()) {
+      glm::vec3 lit_p[8], lit_n[8], lit_l[8];
+      glm::vec3 all_l[8];
+      l.store(all_l, 8);
+      int lane[8], reached_count = 0;
+      for (int j = 0; j < count; ++j)
+        if (reached[j]) {
+          lane[reached_count] = j;
+          lit_p[reached_count] = p[j], lit_n[reached_count] = n[j], lit_l[reached_count] = all_l[j];
+          ++reached_count;
+        }
+      float packed[8];
+      (*shadows_)[k].visibility8(lit_p, lit_n, lit_l, reached_count, packed);
+      for (int t = 0; t < reached_count; ++t) lit[lane[t]] = packed[t];
+    } else {
+      for (int j = 0; j < count; ++j) lit[j] = reached[j] ? 1.0f : 0.0f;
     }
-    if (reached == 0) continue;
-    float lit[8];
-    if (k < shadows_->size()) (*shadows_)[k].visibility8(lit_p, lit_n, lit_l, reached, lit);
-    else std::fill_n(lit, reached, 1.0f);
-    for (int t = 0; t < reached; ++t) {
-      const int j = lane[t];
-      if (lit[t] > 0.0f) out[j] += lit[t] * shade_light(*s[j], view[j], n[j], v[j], ls[j]);
-    }
+    const L::f32 lit_lanes = L::load(lit);
+    const L::mask shaded = reached && lit_lanes > zero;
+    if (L::none(shaded)) continue;
+    const V c = shade_light_lanes<8>(views, mirror, nv, vv, l, irradiance);
+    radiance = select(shaded, radiance + lit_lanes * c, radiance);
   }
+  radiance.store(out, count);
   for (int j = 0; j < count; ++j) out[j] = add_environment(out[j], *s[j], n[j], v[j], view[j], *env_);
 }
 

@@ -1,0 +1,61 @@
+// core/shading.h's per-light terms for W points at once, each lane with the bits of the
+// scalar form: LightSampler::sample (operator()'s operations in its order) and shade_light.
+#pragma once
+
+#include "core/brdf_lanes.h"
+#include "core/shading.h"
+#include "core/vec3_lanes.h"
+
+namespace speculum {
+
+template <int W>
+void LightSampler::sample(const Vec3Lanes<W>& position, Vec3Lanes<W>& direction, Vec3Lanes<W>& irradiance) const {
+  using L = par::Lanes<W>;
+  using f32 = typename L::f32;
+  const Light& light = *light_;
+  if (light.type == LightType::Directional) {
+    direction = Vec3Lanes<W>(-direction_);
+    irradiance = Vec3Lanes<W>(light.color * light.intensity);
+    return;
+  }
+  const f32 zero(0.0f), one(1.0f);
+  const Vec3Lanes<W> to_light = Vec3Lanes<W>(light.position) - position;
+  const f32 d2 = dot(to_light, to_light);
+  const auto reached = d2 > zero;  // at the light itself: no defined direction
+  const f32 d = L::sqrt(d2);
+  const Vec3Lanes<W> dir = to_light / d;
+  f32 window = one;
+  if (light.range > 0.0f) {
+    const f32 r = d / light.range;
+    const f32 r2 = r * r;
+    const f32 w = 1.0f - r2 * r2;
+    window = L::select(w < zero, zero, L::select(one < w, one, w));
+  }
+  f32 cone = one;
+  if (light.type == LightType::Spot) {
+    const f32 cd = dot(Vec3Lanes<W>(direction_), -dir);
+    const f32 x = (cd - cos_outer_) * cone_scale_;
+    const f32 a = L::select(x < zero, zero, L::select(one < x, one, x));
+    cone = a * a;
+  }
+  const f32 e = light.intensity * window * cone / d2;
+  const Vec3Lanes<W> none(zero, zero, zero);
+  direction = select(reached, dir, Vec3Lanes<W>(glm::vec3(0.0f, 1.0f, 0.0f)));
+  irradiance = select(reached, Vec3Lanes<W>(light.color) * e, none);
+}
+
+// shade_light(s, view, n, v, {l, irradiance}) per lane for lanes whose N·L > 0 (the others:
+// 0); `mirror` marks the lanes whose surface is_mirror_lobe() (no highlight).
+template <int W>
+Vec3Lanes<W> shade_light_lanes(const BrdfAtViewLanes<W>& view, const typename par::Lanes<W>::mask& mirror,
+                               const Vec3Lanes<W>& n, const Vec3Lanes<W>& v, const Vec3Lanes<W>& l,
+                               const Vec3Lanes<W>& irradiance) {
+  using f32 = typename par::Lanes<W>::f32;
+  const f32 cos_nl = dot(n, l);
+  const BrdfValueLanes<W> f = gltf_brdf_lanes(view, n, l, v);
+  const Vec3Lanes<W> brdf = select(mirror, f.diffuse, f.diffuse + f.specular);
+  const f32 zero(0.0f);
+  return select(cos_nl > zero, brdf * (cos_nl * irradiance), Vec3Lanes<W>(zero, zero, zero));
+}
+
+}  // namespace speculum

@@ -1,0 +1,130 @@
+// The eight-lane forms of the per-light shading terms (core/brdf_lanes.h,
+// core/shading_lanes.h) against their scalar forms, bit for bit, lane by lane: the GGX BRDF
+// with its albedo-table lookups, the light samplers of every light type, shade_light.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+
+#include <glm/geometric.hpp>
+
+#include "core/brdf.h"
+#include "core/brdf_lanes.h"
+#include "core/optics.h"
+#include "core/sampling.h"
+#include "core/shading.h"
+#include "core/shading_lanes.h"
+
+namespace speculum {
+namespace {
+
+using L = par::Lanes<8>;
+using V = Vec3Lanes<8>;
+
+glm::vec3 random_direction(std::uint32_t key, std::uint32_t dimension) {
+  return spherical_local(1.0f - 2.0f * random_float(key, 0, dimension, 31), random_float(key, 0, dimension + 1, 31));
+}
+
+// Scalar and lanes inputs alike: surfaces of every class, normals, viewers and lights at
+// any angle — below the horizon too, and l = −v, where the half vector falls back to n.
+struct Batch {
+  SurfaceParams s[8];
+  BrdfAtView view[8];
+  glm::vec3 n[8], v[8], l[8], p[8];
+};
+
+Batch batch(std::uint32_t i) {
+  Batch b;
+  for (int j = 0; j < 8; ++j) {
+    const std::uint32_t key = i * 8 + std::uint32_t(j);
+    SurfaceParams& s = b.s[j];
+    s.roughness = std::array<float, 6>{1.0f, 0.3f, 0.0f, 0.8f, 0.05f, 0.6f}[key % 6];
+    s.metallic = key % 4 == 1 ? 1.0f : random_float(key, 0, 0, 31);
+    s.transmission = key % 7 == 3 ? 1.0f : 0.0f;
+    s.base_color = glm::vec3(random_float(key, 0, 1, 31), 0.5f, 0.25f);
+    s.ior = key % 3 == 0 ? 1.33f : 1.5f;
+    b.n[j] = random_direction(key, 2);
+    b.v[j] = random_direction(key, 4);
+    b.l[j] = key % 13 == 5 ? -b.v[j] : random_direction(key, 6);
+    b.p[j] = 3.0f * random_direction(key, 8) * random_float(key, 0, 10, 31);
+    b.view[j] = brdf_at_view(brdf_params_for_punctual_light(s), b.n[j], b.v[j]);
+  }
+  return b;
+}
+
+TEST(BrdfLanes, EveryLaneHasTheBitsOfTheScalarBrdf) {
+  std::size_t below = 0, lit = 0;
+  for (std::uint32_t i = 0; i < 4000; ++i) {
+    const Batch b = batch(i);
+    const auto views = BrdfAtViewLanes<8>::load(b.view, 8);
+    const BrdfValueLanes<8> f = gltf_brdf_lanes(views, V::load(b.n, 8), V::load(b.l, 8), V::load(b.v, 8));
+    glm::vec3 diffuse[8], specular[8];
+    f.diffuse.store(diffuse, 8);
+    f.specular.store(specular, 8);
+    for (int j = 0; j < 8; ++j) {
+      const BrdfValue expected = gltf_brdf(b.view[j], b.n[j], b.l[j], b.v[j]);
+      ASSERT_EQ(diffuse[j], expected.diffuse) << i << " lane " << j;
+      ASSERT_EQ(specular[j], expected.specular) << i << " lane " << j;
+      (glm::dot(b.n[j], b.l[j]) <= 0.0f ? below : lit) += 1;
+    }
+  }
+  EXPECT_GT(below, 10000u);
+  EXPECT_GT(lit, 10000u);
+}
+
+TEST(BrdfLanes, AlbedoLookupHasTheBitsOfTheScalarTable) {
+  // The grid's ends and cell edges too: μ and α at 0, 1, past them, and on the cell borders.
+  alignas(32) float mu[8], alpha[8], f0[8];
+  for (std::uint32_t i = 0; i < 3000; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      const std::uint32_t key = i * 8 + std::uint32_t(j);
+      const float edge = float(key % 33) / float(kAlbedoTableSize - 1);
+      mu[j] = key % 5 == 0 ? edge : 1.2f * random_float(key, 0, 0, 7) - 0.1f;
+      alpha[j] = key % 7 == 0 ? edge * edge : 1.2f * random_float(key, 0, 1, 7) - 0.1f;
+      f0[j] = random_float(key, 0, 2, 7);
+    }
+    alignas(32) float got[8];
+    L::store(specular_albedo_lanes<8>(L::load(mu), L::load(alpha), L::load(f0)), got);
+    for (int j = 0; j < 8; ++j) ASSERT_EQ(got[j], specular_albedo(mu[j], alpha[j])(f0[j])) << i << " lane " << j;
+  }
+}
+
+TEST(BrdfLanes, LightSamplersAndShadeLightHaveTheScalarBits) {
+  // A point light with a range, an unbounded one, a spot and a directional light; points
+  // around them (one exactly at the point light: no direction, no light).
+  std::vector<Light> lights(4);
+  lights[0].type = LightType::Point, lights[0].position = {0.5f, 1.0f, -0.5f}, lights[0].range = 3.0f;
+  lights[0].intensity = 7.0f, lights[0].color = {1.0f, 0.8f, 0.6f};
+  lights[1].type = LightType::Point, lights[1].position = {-1.0f, 0.5f, 1.0f}, lights[1].intensity = 2.0f;
+  lights[2].type = LightType::Spot, lights[2].position = {0.0f, 2.0f, 0.0f}, lights[2].direction = {0.2f, -1.0f, 0.1f};
+  lights[2].inner_cone = 0.3f, lights[2].outer_cone = 0.6f, lights[2].intensity = 20.0f;
+  lights[3].type = LightType::Directional, lights[3].direction = {0.3f, -1.0f, 0.2f}, lights[3].intensity = 3.0f;
+  std::size_t reached = 0;
+  for (std::uint32_t i = 0; i < 3000; ++i) {
+    Batch b = batch(i);
+    if (i % 10 == 0) b.p[3] = lights[0].position;
+    alignas(32) float mirror_flag[8];
+    for (int j = 0; j < 8; ++j) mirror_flag[j] = b.s[j].is_mirror_lobe() ? 1.0f : 0.0f;
+    const auto views = BrdfAtViewLanes<8>::load(b.view, 8);
+    const V p = V::load(b.p, 8), n = V::load(b.n, 8), v = V::load(b.v, 8);
+    for (const Light& light : lights) {
+      const LightSampler sampler(light);
+      V dir, irradiance;
+      sampler.sample(p, dir, irradiance);
+      const V shaded = shade_light_lanes<8>(views, L::load(mirror_flag) > 0.0f, n, v, dir, irradiance);
+      glm::vec3 got_dir[8], got_irradiance[8], got_shaded[8];
+      dir.store(got_dir, 8), irradiance.store(got_irradiance, 8), shaded.store(got_shaded, 8);
+      for (int j = 0; j < 8; ++j) {
+        const LightSample expected = sampler(b.p[j]);
+        ASSERT_EQ(got_dir[j], expected.direction) << i << " lane " << j;
+        ASSERT_EQ(got_irradiance[j], expected.irradiance) << i << " lane " << j;
+        ASSERT_EQ(got_shaded[j], shade_light(b.s[j], b.view[j], b.n[j], b.v[j], expected)) << i << " lane " << j;
+        reached += expected.irradiance != glm::vec3(0.0f) && glm::dot(b.n[j], expected.direction) > 0.0f;
+      }
+    }
+  }
+  EXPECT_GT(reached, 20000u);
+}
+
+}  // namespace
+}  // namespace speculum
