@@ -15,8 +15,6 @@
 namespace speculum {
 
 namespace {
-constexpr float kMinAlpha = 1e-4f;
-
 // D with the denominator written as (N·H)² α² + sin²θ_h: near the peak 1 − (N·H)² in float
 // would cancel to 0 and leave only α² terms, so the caller passes sin²θ_h computed from
 // the cross product (exact to float precision at any angle).

@@ -40,6 +40,9 @@ namespace speculum {
 // narrower than this roughness (α = 0.03² ≈ 9e-4; the GGX peak stays below ~4e5/sr).
 constexpr float kMinPunctualRoughness = 0.03f;
 
+// The smallest α the BRDF evaluates (a smaller one is raised to it: avoids 0/0).
+constexpr float kMinAlpha = 1e-4f;
+
 // The material inputs of the BRDF (textures already applied).
 struct BrdfParams {
   glm::vec3 base_color{1.0f};

@@ -18,6 +18,7 @@ struct BrdfAtViewLanes {
   using f32 = typename par::Lanes<W>::f32;
   Vec3Lanes<W> base_color, f0;
   f32 alpha, cos_nv, diffuse_weight, dielectric_f0, one_minus_e_v, one_minus_e_avg, smith_view_root;
+  f32 scale_at_view, bias_at_view;
 
   // views[0, count); lanes past count repeat views[0].
   static BrdfAtViewLanes load(const BrdfAtView* views, int count) {
@@ -45,35 +46,115 @@ struct BrdfValueLanes {
   Vec3Lanes<W> diffuse, specular;
 };
 
-// specular_albedo(cos_nv, alpha)(f0) per lane (brdf.cpp: the table's bilinear lookup).
+namespace brdf_lanes_detail {
+
+template <int W>
+typename par::Lanes<W>::f32 clamp01(const typename par::Lanes<W>::f32& x) {
+  using L = par::Lanes<W>;
+  using f32 = typename L::f32;
+  return L::select(x < 0.0f, f32(0.0f), L::select(f32(1.0f) < x, f32(1.0f), x));
+}
+
+// brdf.cpp's grid(): the albedo table's cell of x ∈ [0, 1] (clamped below too, so a NaN
+// cannot index outside) and the fraction within it.
+template <int W>
+void grid(const typename par::Lanes<W>::f32& x, typename par::Lanes<W>::i32& cell,
+          typename par::Lanes<W>::f32& fraction) {
+  using L = par::Lanes<W>;
+  using i32 = typename L::i32;
+  const typename L::f32 f = clamp01<W>(x) * float(kAlbedoTableSize - 1);
+  cell = L::max(L::min(L::to_int(f), i32(kAlbedoTableSize - 2)), i32(0));
+  fraction = f - L::to_float(cell);
+}
+
+template <int W>
+typename par::Lanes<W>::f32 lerp(const typename par::Lanes<W>::f32& a, const typename par::Lanes<W>::f32& b,
+                                 const typename par::Lanes<W>::f32& t) {
+  return a + (b - a) * t;
+}
+
+// The table's entries as floats: {scale, bias} pairs.
+inline const float* table_fields(const SpecularAlbedo* entries) {
+  static_assert(sizeof(SpecularAlbedo) == 2 * sizeof(float));
+  return reinterpret_cast<const float*>(entries);
+}
+
+}  // namespace brdf_lanes_detail
+
+// specular_albedo(cos_nv, alpha) per lane (brdf.cpp: the table's bilinear lookup).
+template <int W>
+void specular_albedo_lanes(const typename par::Lanes<W>::f32& cos_nv, const typename par::Lanes<W>::f32& alpha,
+                           typename par::Lanes<W>::f32& scale, typename par::Lanes<W>::f32& bias) {
+  using namespace brdf_lanes_detail;
+  using L = par::Lanes<W>;
+  using f32 = typename L::f32;
+  using i32 = typename L::i32;
+  i32 j, i;
+  f32 tr, tm;
+  grid<W>(L::sqrt(clamp01<W>(alpha)), j, tr);
+  grid<W>(cos_nv, i, tm);
+  const float* fields = table_fields(albedo_table().e.data());
+  const i32 at = (j * kAlbedoTableSize + i) * 2;
+  const auto field = [&](int offset) { return L::gather(fields, at + offset); };
+  constexpr int kRow = 2 * kAlbedoTableSize;
+  scale = lerp<W>(lerp<W>(field(0), field(2), tm), lerp<W>(field(kRow), field(kRow + 2), tm), tr);
+  bias = lerp<W>(lerp<W>(field(1), field(3), tm), lerp<W>(field(kRow + 1), field(kRow + 3), tm), tr);
+}
+
+// specular_albedo(cos_nv, alpha)(f0) per lane.
 template <int W>
 typename par::Lanes<W>::f32 specular_albedo_lanes(const typename par::Lanes<W>::f32& cos_nv,
                                                   const typename par::Lanes<W>::f32& alpha,
                                                   const typename par::Lanes<W>::f32& f0) {
+  typename par::Lanes<W>::f32 scale, bias;
+  specular_albedo_lanes<W>(cos_nv, alpha, scale, bias);
+  return f0 * scale + bias;
+}
+
+// average_specular_albedo(alpha)(f0) per lane.
+template <int W>
+typename par::Lanes<W>::f32 average_specular_albedo_lanes(const typename par::Lanes<W>::f32& alpha,
+                                                          const typename par::Lanes<W>::f32& f0) {
+  using namespace brdf_lanes_detail;
+  using L = par::Lanes<W>;
+  typename L::i32 j;
+  typename L::f32 tr;
+  grid<W>(L::sqrt(clamp01<W>(alpha)), j, tr);
+  const float* fields = table_fields(albedo_table().average.data());
+  const auto field = [&](int offset) { return L::gather(fields, j * 2 + offset); };
+  return f0 * lerp<W>(field(0), field(2), tr) + lerp<W>(field(1), field(3), tr);
+}
+
+// BrdfParams as lanes.
+template <int W>
+struct BrdfParamsLanes {
+  using f32 = typename par::Lanes<W>::f32;
+  Vec3Lanes<W> base_color;
+  f32 metallic, alpha, dielectric_f0, transmission;
+};
+
+// brdf_at_view(p, n, v) per lane.
+template <int W>
+BrdfAtViewLanes<W> brdf_at_view_lanes(const BrdfParamsLanes<W>& p, const Vec3Lanes<W>& n, const Vec3Lanes<W>& v) {
+  using namespace brdf_lanes_detail;
   using L = par::Lanes<W>;
   using f32 = typename L::f32;
-  using i32 = typename L::i32;
-  const auto clamp01 = [](const f32& x) { return L::select(x < 0.0f, f32(0.0f), L::select(f32(1.0f) < x, f32(1.0f), x)); };
-  // grid(): cell index (clamped below too, so a NaN input cannot index outside) and fraction.
-  const auto grid = [&](const f32& x, i32& cell, f32& fraction) {
-    const f32 f = clamp01(x) * float(kAlbedoTableSize - 1);
-    cell = L::max(L::min(L::to_int(f), i32(kAlbedoTableSize - 2)), i32(0));
-    fraction = f - L::to_float(cell);
-  };
-  i32 j, i;
-  f32 tr, tm;
-  grid(L::sqrt(clamp01(alpha)), j, tr);
-  grid(cos_nv, i, tm);
-  const SpecularAlbedo* e = albedo_table().e.data();
-  const float* fields = reinterpret_cast<const float*>(e);  // {scale, bias} pairs
-  static_assert(sizeof(SpecularAlbedo) == 2 * sizeof(float));
-  const i32 at = (j * kAlbedoTableSize + i) * 2;
-  const auto field = [&](int offset) { return L::gather(fields, at + offset); };
-  constexpr int kRow = 2 * kAlbedoTableSize;
-  const auto lerp = [](const f32& a, const f32& b, const f32& t) { return a + (b - a) * t; };
-  const f32 scale = lerp(lerp(field(0), field(2), tm), lerp(field(kRow), field(kRow + 2), tm), tr);
-  const f32 bias = lerp(lerp(field(1), field(3), tm), lerp(field(kRow + 1), field(kRow + 3), tm), tr);
-  return f0 * scale + bias;
+  BrdfAtViewLanes<W> a;
+  a.base_color = p.base_color;
+  a.cos_nv = L::max(dot(n, v), f32(0.0f));
+  const f32 metallic = clamp01<W>(p.metallic);
+  a.alpha = L::max(p.alpha, f32(kMinAlpha));
+  a.diffuse_weight = (1.0f - metallic) * (1.0f - clamp01<W>(p.transmission));
+  a.dielectric_f0 = p.dielectric_f0;
+  specular_albedo_lanes<W>(a.cos_nv, a.alpha, a.scale_at_view, a.bias_at_view);
+  a.one_minus_e_v = 1.0f - (p.dielectric_f0 * a.scale_at_view + a.bias_at_view);
+  a.one_minus_e_avg = L::max(1.0f - average_specular_albedo_lanes<W>(a.alpha, p.dielectric_f0), f32(1e-6f));
+  const f32 nv = L::abs(a.cos_nv), a2 = a.alpha * a.alpha;
+  a.smith_view_root = L::sqrt(nv * nv * (1.0f - a2) + a2);
+  a.f0 = Vec3Lanes<W>(p.dielectric_f0 * (1.0f - metallic), p.dielectric_f0 * (1.0f - metallic),
+                      p.dielectric_f0 * (1.0f - metallic)) +
+         p.base_color * metallic;
+  return a;
 }
 
 // gltf_brdf(view, n, l, v) per lane: both lobes 0 where N·L ≤ 0, the specular 0 where

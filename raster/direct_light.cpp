@@ -65,24 +65,33 @@ glm::vec3 SurfaceShader::operator()(const SurfaceParams& s, const glm::vec3& p, 
 
 void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, const glm::vec3* n_in,
                            const glm::vec3* v, int count, glm::vec3* out) const {
+  // shade_point for eight points at once (core/brdf_lanes.h, core/shading_lanes.h: each lane
+  // has the bits of the scalar forms); lanes past `count` repeat point 0 and are dropped.
   using L = par::Lanes<8>;
   using V = Vec3Lanes<8>;
-  glm::vec3 n[8];
-  BrdfAtView view[8];
-  alignas(32) float mirror_flag[8] = {};
-  for (int j = 0; j < count; ++j) {
-    n[j] = facing_viewer(n_in[j], v[j]);
-    out[j] = s[j]->emissive;
-    view[j] = brdf_at_view(brdf_params_for_punctual_light(*s[j]), n[j], v[j]);
-    mirror_flag[j] = s[j]->is_mirror_lobe() ? 1.0f : 0.0f;
+  // The points' material parameters as lanes.
+  alignas(32) float params[11][8];
+  for (int j = 0; j < 8; ++j) {
+    const SurfaceParams& sj = *s[j < count ? j : 0];
+    const BrdfParams b = brdf_params_for_punctual_light(sj);
+    const float fields[11] = {sj.emissive.x, sj.emissive.y, sj.emissive.z, b.base_color.x, b.base_color.y,
+                              b.base_color.z, b.metallic, b.alpha, b.dielectric_f0, b.transmission,
+                              sj.is_mirror_lobe() ? 1.0f : 0.0f};
+    for (int k = 0; k < 11; ++k) params[k][j] = fields[k];
   }
-  // Every light's terms eight points at a time (core/shading_lanes.h: each lane has the bits
-  // of shade_light's scalar form); lanes past `count` repeat point 0 and are dropped.
-  const V pv = V::load(p, count), nv = V::load(n, count), vv = V::load(v, count);
-  const BrdfAtViewLanes<8> views = BrdfAtViewLanes<8>::load(view, count);
-  const L::mask mirror = L::load(mirror_flag) > 0.0f;
   const L::f32 zero(0.0f);
-  V radiance = V::load(out, count);
+  BrdfParamsLanes<8> brdf;
+  brdf.base_color = {L::load(params[3]), L::load(params[4]), L::load(params[5])};
+  brdf.metallic = L::load(params[6]), brdf.alpha = L::load(params[7]);
+  brdf.dielectric_f0 = L::load(params[8]), brdf.transmission = L::load(params[9]);
+  const L::mask mirror = L::load(params[10]) > zero;
+
+  const V pv = V::load(p, count), vv = V::load(v, count), raw_n = V::load(n_in, count);
+  const V nv = select(dot(raw_n, vv) < zero, -raw_n, raw_n);  // facing_viewer
+  glm::vec3 n[8];
+  nv.store(n, count);
+  const BrdfAtViewLanes<8> view = brdf_at_view_lanes(brdf, nv, vv);
+  V radiance(L::load(params[0]), L::load(params[1]), L::load(params[2]));
   for (std::size_t k = 0; k < lights_.size(); ++k) {
     V l, irradiance;
     lights_[k].sample(pv, l, irradiance);
@@ -93,8 +102,7 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
     // The points this light reaches, in point order, and their shadow tests in one call.
     alignas(32) float lit[8] = {};
     if (k < shadows_->size()) {
-      glm::vec3 lit_p[8], lit_n[8], lit_l[8];
-      glm::vec3 all_l[8];
+      glm::vec3 all_l[8], lit_p[8], lit_n[8], lit_l[8];
       l.store(all_l, 8);
       int lane[8], reached_count = 0;
       for (int j = 0; j < count; ++j)
@@ -112,11 +120,20 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
     const L::f32 lit_lanes = L::load(lit);
     const L::mask shaded = reached && lit_lanes > zero;
     if (L::none(shaded)) continue;
-    const V c = shade_light_lanes<8>(views, mirror, nv, vv, l, irradiance);
+    const V c = shade_light_lanes<8>(view, mirror, nv, vv, l, irradiance);
     radiance = select(shaded, radiance + lit_lanes * c, radiance);
   }
+  // add_environment: the diffuse lobe's ambient light (diffuse_albedo_over_pi(s, view) with
+  // the raw metallic and transmission, as shading.cpp has it), then the rough lobes' lookups.
+  const L::f32 metallic = L::load(params[6]), transmission = L::load(params[9]);
+  const L::f32 e = view.dielectric_f0 * view.scale_at_view + view.bias_at_view;
+  const V diffuse_albedo = brdf.base_color * ((1.0f - metallic) * (1.0f - transmission) * (1.0f - e) / kPi);
+  radiance = radiance + diffuse_albedo * env_->irradiance8(nv);
   radiance.store(out, count);
-  for (int j = 0; j < count; ++j) out[j] = add_environment(out[j], *s[j], n[j], v[j], view[j], *env_);
+  for (int j = 0; j < count; ++j)
+    if (s[j]->has_rough_specular_lobe())
+      out[j] += specular_reflectance(*s[j], glm::dot(n[j], v[j])) *
+                env_->radiance(reflect(-v[j], n[j]), s[j]->phong_exponent);
 }
 
 ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,

@@ -286,6 +286,22 @@ glm::vec3 EnvironmentMap::irradiance(const glm::vec3& n) const {
   return glm::max(e, glm::vec3(0.0f));
 }
 
+Vec3Lanes<8> EnvironmentMap::irradiance8(const Vec3Lanes<8>& n) const {
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
+  constexpr float a[9] = {kPi, 2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
+                          kPi / 4, kPi / 4, kPi / 4, kPi / 4};
+  const f32 &x = n.x, &y = n.y, &z = n.z;
+  // sh_basis's terms, in its order of operations.
+  const f32 basis[9] = {f32(0.282095f),         0.488603f * y,       0.488603f * z,
+                        0.488603f * x,          1.092548f * x * y,   1.092548f * y * z,
+                        0.315392f * (3.0f * z * z - 1.0f), 1.092548f * x * z, 0.546274f * (x * x - y * y)};
+  const f32 zero(0.0f);
+  Vec3Lanes<8> e(zero, zero, zero);
+  for (int k = 0; k < 9; ++k) e = e + Vec3Lanes<8>(sh[k]) * (a[k] * basis[k]);
+  return {L::max(e.x, zero), L::max(e.y, zero), L::max(e.z, zero)};
+}
+
 EnvironmentMap EnvironmentPass::operator()(par::NodeContext& c) const {
   return build_environment(c.executor(), scene->environment, size);
 }

@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/scene.h"
+#include "core/vec3_lanes.h"
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
 #include "raster/cube_map.h"
@@ -28,6 +29,8 @@ struct EnvironmentMap {
   glm::vec3 radiance(const glm::vec3& d, float phong_exponent) const;
   // Irradiance E(n) on a surface with unit normal n from the SH coefficients.
   glm::vec3 irradiance(const glm::vec3& n) const;
+  // irradiance() at eight normals, each lane with its bits.
+  Vec3Lanes<8> irradiance8(const Vec3Lanes<8>& n) const;
 };
 
 // Mip levels and glossy prefiltering of given level-0 faces (e.g. a rendered cube map's

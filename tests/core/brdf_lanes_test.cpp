@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
 #include <cstdint>
 
 #include <glm/geometric.hpp>
@@ -70,6 +71,42 @@ TEST(BrdfLanes, EveryLaneHasTheBitsOfTheScalarBrdf) {
   }
   EXPECT_GT(below, 10000u);
   EXPECT_GT(lit, 10000u);
+}
+
+TEST(BrdfLanes, ViewerTermsHaveTheBitsOfTheScalarForm) {
+  // Every field of BrdfAtView, for parameters past their ranges too (metallic and
+  // transmission outside [0, 1], α below the smallest the BRDF evaluates).
+  for (std::uint32_t i = 0; i < 4000; ++i) {
+    Batch b = batch(i);
+    BrdfParams params[8];
+    alignas(32) float c[8][8];
+    for (int j = 0; j < 8; ++j) {
+      params[j] = brdf_params_for_punctual_light(b.s[j]);
+      if (j == 2) params[j].metallic = 1.5f, params[j].transmission = -0.5f, params[j].alpha = 1e-6f;
+      const BrdfParams& q = params[j];
+      const float fields[8] = {q.base_color.x, q.base_color.y, q.base_color.z, q.metallic,
+                               q.alpha,        q.dielectric_f0, q.transmission, 0.0f};
+      for (int k = 0; k < 8; ++k) c[k][j] = fields[k];
+    }
+    BrdfParamsLanes<8> lanes;
+    lanes.base_color = {L::load(c[0]), L::load(c[1]), L::load(c[2])};
+    lanes.metallic = L::load(c[3]), lanes.alpha = L::load(c[4]), lanes.dielectric_f0 = L::load(c[5]);
+    lanes.transmission = L::load(c[6]);
+    const BrdfAtViewLanes<8> got = brdf_at_view_lanes(lanes, V::load(b.n, 8), V::load(b.v, 8));
+    glm::vec3 base[8], f0[8];
+    got.base_color.store(base, 8), got.f0.store(f0, 8);
+    for (int j = 0; j < 8; ++j) {
+      const BrdfAtView e = brdf_at_view(params[j], b.n[j], b.v[j]);
+      ASSERT_EQ(base[j], e.base_color) << i << " lane " << j;
+      ASSERT_EQ(f0[j], e.f0) << i << " lane " << j;
+      const float scalar[9] = {e.alpha, e.cos_nv, e.diffuse_weight, e.dielectric_f0, e.one_minus_e_v,
+                               e.one_minus_e_avg, e.smith_view_root, e.scale_at_view, e.bias_at_view};
+      const float lane[9] = {got.alpha[j], got.cos_nv[j], got.diffuse_weight[j], got.dielectric_f0[j],
+                             got.one_minus_e_v[j], got.one_minus_e_avg[j], got.smith_view_root[j],
+                             got.scale_at_view[j], got.bias_at_view[j]};
+      for (int k = 0; k < 9; ++k) ASSERT_EQ(std::bit_cast<std::uint32_t>(lane[k]), std::bit_cast<std::uint32_t>(scalar[k])) << i << " lane " << j << " field " << k;
+    }
+  }
 }
 
 TEST(BrdfLanes, AlbedoLookupHasTheBitsOfTheScalarTable) {

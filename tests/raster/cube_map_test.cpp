@@ -174,6 +174,31 @@ TEST(Environment, SkyIrradianceMatchesDirectIntegration) {
   }
 }
 
+TEST(Environment, EightIrradiancesAtOnceHaveTheBitsOfOne) {
+  // A sky with colour in every SH band (darker than zero on part of the sphere after
+  // projection: the clamp at zero is exercised), normals in every direction.
+  Environment env;
+  env.equirect = ImageRGBA(64, 32);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x)
+      env.equirect.at(x, y) = glm::vec4((x + y) % 7 == 0 ? 30.0f : 0.0f, 0.5f * float(y) / 32.0f, x < 8 ? 4.0f : 0.0f, 1.0f);
+  par::Executor ex(1);
+  const EnvironmentMap map = build_environment(ex, env, 16);
+  int clamped = 0;
+  for (std::uint32_t i = 0; i < 2000; ++i) {
+    glm::vec3 n[8], got[8];
+    for (int j = 0; j < 8; ++j)
+      n[j] = spherical_local(1.0f - 2.0f * random_float(i * 8 + j, 0, 0, 3), random_float(i * 8 + j, 0, 1, 3));
+    map.irradiance8(Vec3Lanes<8>::load(n, 8)).store(got, 8);
+    for (int j = 0; j < 8; ++j) {
+      const glm::vec3 e = map.irradiance(n[j]);
+      ASSERT_EQ(got[j], e) << i << " lane " << j;
+      clamped += e.x == 0.0f || e.y == 0.0f || e.z == 0.0f;
+    }
+  }
+  EXPECT_GT(clamped, 0);
+}
+
 // Six size² faces of uniform random radiance in [0, 4) drawn from `rng` (every level of their
 // prefiltered cascade differs).
 std::array<ImageRGBA, kCubeFaces> random_cube_faces(int size, std::mt19937& rng) {
