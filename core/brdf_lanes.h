@@ -49,7 +49,7 @@ struct BrdfValueLanes {
 namespace brdf_lanes_detail {
 
 template <int W>
-typename par::Lanes<W>::f32 clamp01(const typename par::Lanes<W>::f32& x) {
+[[gnu::always_inline]] inline typename par::Lanes<W>::f32 clamp01(const typename par::Lanes<W>::f32& x) {
   using L = par::Lanes<W>;
   using f32 = typename L::f32;
   return L::select(x < 0.0f, f32(0.0f), L::select(f32(1.0f) < x, f32(1.0f), x));
@@ -58,7 +58,7 @@ typename par::Lanes<W>::f32 clamp01(const typename par::Lanes<W>::f32& x) {
 // brdf.cpp's grid(): the albedo table's cell of x ∈ [0, 1] (clamped below too, so a NaN
 // cannot index outside) and the fraction within it.
 template <int W>
-void grid(const typename par::Lanes<W>::f32& x, typename par::Lanes<W>::i32& cell,
+[[gnu::always_inline]] inline void grid(const typename par::Lanes<W>::f32& x, typename par::Lanes<W>::i32& cell,
           typename par::Lanes<W>::f32& fraction) {
   using L = par::Lanes<W>;
   using i32 = typename L::i32;
@@ -68,13 +68,13 @@ void grid(const typename par::Lanes<W>::f32& x, typename par::Lanes<W>::i32& cel
 }
 
 template <int W>
-typename par::Lanes<W>::f32 lerp(const typename par::Lanes<W>::f32& a, const typename par::Lanes<W>::f32& b,
+[[gnu::always_inline]] inline typename par::Lanes<W>::f32 lerp(const typename par::Lanes<W>::f32& a, const typename par::Lanes<W>::f32& b,
                                  const typename par::Lanes<W>::f32& t) {
   return a + (b - a) * t;
 }
 
 // The table's entries as floats: {scale, bias} pairs.
-inline const float* table_fields(const SpecularAlbedo* entries) {
+[[gnu::always_inline]] inline const float* table_fields(const SpecularAlbedo* entries) {
   static_assert(sizeof(SpecularAlbedo) == 2 * sizeof(float));
   return reinterpret_cast<const float*>(entries);
 }
@@ -83,7 +83,7 @@ inline const float* table_fields(const SpecularAlbedo* entries) {
 
 // specular_albedo(cos_nv, alpha) per lane (brdf.cpp: the table's bilinear lookup).
 template <int W>
-void specular_albedo_lanes(const typename par::Lanes<W>::f32& cos_nv, const typename par::Lanes<W>::f32& alpha,
+[[gnu::always_inline]] inline void specular_albedo_lanes(const typename par::Lanes<W>::f32& cos_nv, const typename par::Lanes<W>::f32& alpha,
                            typename par::Lanes<W>::f32& scale, typename par::Lanes<W>::f32& bias) {
   using namespace brdf_lanes_detail;
   using L = par::Lanes<W>;
@@ -103,7 +103,7 @@ void specular_albedo_lanes(const typename par::Lanes<W>::f32& cos_nv, const type
 
 // specular_albedo(cos_nv, alpha)(f0) per lane.
 template <int W>
-typename par::Lanes<W>::f32 specular_albedo_lanes(const typename par::Lanes<W>::f32& cos_nv,
+[[gnu::always_inline]] inline typename par::Lanes<W>::f32 specular_albedo_lanes(const typename par::Lanes<W>::f32& cos_nv,
                                                   const typename par::Lanes<W>::f32& alpha,
                                                   const typename par::Lanes<W>::f32& f0) {
   typename par::Lanes<W>::f32 scale, bias;
@@ -113,7 +113,7 @@ typename par::Lanes<W>::f32 specular_albedo_lanes(const typename par::Lanes<W>::
 
 // average_specular_albedo(alpha)(f0) per lane.
 template <int W>
-typename par::Lanes<W>::f32 average_specular_albedo_lanes(const typename par::Lanes<W>::f32& alpha,
+[[gnu::always_inline]] inline typename par::Lanes<W>::f32 average_specular_albedo_lanes(const typename par::Lanes<W>::f32& alpha,
                                                           const typename par::Lanes<W>::f32& f0) {
   using namespace brdf_lanes_detail;
   using L = par::Lanes<W>;
@@ -135,7 +135,7 @@ struct BrdfParamsLanes {
 
 // brdf_at_view(p, n, v) per lane.
 template <int W>
-BrdfAtViewLanes<W> brdf_at_view_lanes(const BrdfParamsLanes<W>& p, const Vec3Lanes<W>& n, const Vec3Lanes<W>& v) {
+[[gnu::always_inline]] inline BrdfAtViewLanes<W> brdf_at_view_lanes(const BrdfParamsLanes<W>& p, const Vec3Lanes<W>& n, const Vec3Lanes<W>& v) {
   using namespace brdf_lanes_detail;
   using L = par::Lanes<W>;
   using f32 = typename L::f32;
@@ -160,7 +160,7 @@ BrdfAtViewLanes<W> brdf_at_view_lanes(const BrdfParamsLanes<W>& p, const Vec3Lan
 // gltf_brdf(view, n, l, v) per lane: both lobes 0 where N·L ≤ 0, the specular 0 where
 // N·H ≤ 0.
 template <int W>
-BrdfValueLanes<W> gltf_brdf_lanes(const BrdfAtViewLanes<W>& a, const Vec3Lanes<W>& n, const Vec3Lanes<W>& l,
+[[gnu::always_inline]] inline BrdfValueLanes<W> gltf_brdf_lanes(const BrdfAtViewLanes<W>& a, const Vec3Lanes<W>& n, const Vec3Lanes<W>& l,
                                   const Vec3Lanes<W>& v) {
   using L = par::Lanes<W>;
   using f32 = typename L::f32;

@@ -9,7 +9,7 @@
 namespace speculum {
 
 template <int W>
-void LightSampler::sample(const Vec3Lanes<W>& position, Vec3Lanes<W>& direction, Vec3Lanes<W>& irradiance) const {
+[[gnu::always_inline]] inline void LightSampler::sample(const Vec3Lanes<W>& position, Vec3Lanes<W>& direction, Vec3Lanes<W>& irradiance) const {
   using L = par::Lanes<W>;
   using f32 = typename L::f32;
   const Light& light = *light_;
@@ -47,7 +47,7 @@ void LightSampler::sample(const Vec3Lanes<W>& position, Vec3Lanes<W>& direction,
 // shade_light(s, view, n, v, {l, irradiance}) per lane for lanes whose N·L > 0 (the others:
 // 0); `mirror` marks the lanes whose surface is_mirror_lobe() (no highlight).
 template <int W>
-Vec3Lanes<W> shade_light_lanes(const BrdfAtViewLanes<W>& view, const typename par::Lanes<W>::mask& mirror,
+[[gnu::always_inline]] inline Vec3Lanes<W> shade_light_lanes(const BrdfAtViewLanes<W>& view, const typename par::Lanes<W>::mask& mirror,
                                const Vec3Lanes<W>& n, const Vec3Lanes<W>& v, const Vec3Lanes<W>& l,
                                const Vec3Lanes<W>& irradiance) {
   using f32 = typename par::Lanes<W>::f32;

@@ -2,7 +2,9 @@
 // operations in glm's own order — dot is (x·x' + y·y') + z·z', cross is glm::cross's
 // component formulas, a vector divided by a scalar divides each component — so a kernel
 // written with them gives every lane the bits of the scalar glm code it mirrors (the build
-// forbids contraction: parallel/lanes.h).
+// forbids contraction: parallel/lanes.h). The helpers here and in core/brdf_lanes.h are
+// always inlined: left to itself GCC kept several as calls that pass the lanes through
+// memory (a fifth of the direct light's samples were in them and their call overhead).
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -48,18 +50,18 @@ struct Vec3Lanes {
 };
 
 template <int W>
-typename Vec3Lanes<W>::f32 dot(const Vec3Lanes<W>& a, const Vec3Lanes<W>& b) {
+[[gnu::always_inline]] inline typename Vec3Lanes<W>::f32 dot(const Vec3Lanes<W>& a, const Vec3Lanes<W>& b) {
   return (a.x * b.x + a.y * b.y) + a.z * b.z;
 }
 
 template <int W>
-Vec3Lanes<W> cross(const Vec3Lanes<W>& a, const Vec3Lanes<W>& b) {
+[[gnu::always_inline]] inline Vec3Lanes<W> cross(const Vec3Lanes<W>& a, const Vec3Lanes<W>& b) {
   return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
 }
 
 // m ? a : b per lane.
 template <int W>
-Vec3Lanes<W> select(const typename Vec3Lanes<W>::mask& m, const Vec3Lanes<W>& a, const Vec3Lanes<W>& b) {
+[[gnu::always_inline]] inline Vec3Lanes<W> select(const typename Vec3Lanes<W>::mask& m, const Vec3Lanes<W>& a, const Vec3Lanes<W>& b) {
   using L = par::Lanes<W>;
   return {L::select(m, a.x, b.x), L::select(m, a.y, b.y), L::select(m, a.z, b.z)};
 }
