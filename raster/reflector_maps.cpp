@@ -136,6 +136,18 @@ void mark(std::vector<std::uint8_t>& t, std::size_t first, std::size_t count) {
   }
 }
 
+// Adds to `whole` the faces whose every tile is set (by any chunk): marking skips them.
+void note_full_faces(const std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, unsigned& whole) {
+  for (int f = 0; f < kCubeFaces; ++f) {
+    if ((whole >> f) & 1u) continue;
+    const std::vector<std::uint8_t>& t = tiles[f];
+    bool full = true;
+    for (std::size_t k = 0; k < t.size() && full; ++k)
+      full = std::atomic_ref<const std::uint8_t>(t[k]).load(std::memory_order_relaxed) != 0;
+    if (full) whole |= 1u << f;
+  }
+}
+
 // The angle within which lookup_level's bilinear taps lie around a direction: a texel's
 // diagonal (lookup_reach for a lobe read at level 0 alone).
 float texel_reach(int size) { return 2.0f * 1.4142136f / static_cast<float>(size); }
@@ -268,6 +280,10 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
       return glm::vec3(0.0f);
     };
     for (std::size_t k = begin; k < end; ++k) {
+      // A wide lobe's marks soon fill whole faces (every sample of a glossy floor marks
+      // most of a face): faces found full stop costing their marks' arithmetic. Maps of
+      // one-texel tiles (level 0 alone) are too large to scan this often.
+      if (mask.tile > 1 && (k - begin) % 256 == 255) note_full_faces(mask.tiles, whole);
       const std::size_t i = samples[k];
       const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
