@@ -8,6 +8,7 @@
 // ray parameter d and the direction (from o) in which the hit x + r·d is looked up.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -83,13 +84,40 @@ inline float secant_from_ratios(float d_l, float g_l, float d_p, float g_p) {
   return d_l + (d_p - d_l) * (1.0f - g_l) / denom;
 }
 
+// The linear march's samples k ∈ [first, min(first + kMarchBatch, n)) of a march of n:
+// d[j] its ray parameter (0 at k = 0, else x_len t / (1 − t) with t = k/n), g[j] the ratio
+// there and counted[j] whether reading it took a map lookup (what ratio() counts).
+constexpr int kMarchBatch = 8;
+struct MarchBatch {
+  float d[kMarchBatch], g[kMarchBatch];
+  int counted[kMarchBatch];
+};
+
+// The march computed with ratio() one sample at a time.
+template <class DistanceFn>
+struct ScalarMarch {
+  const DistanceFn& distance_towards;
+  void operator()(const glm::vec3& x, const glm::vec3& r, float x_len, int n, int first, MarchBatch& b) const {
+    for (int k = first; k < std::min(first + kMarchBatch, n); ++k) {
+      const int j = k - first;
+      const float t = float(k) / float(n);
+      b.d[j] = k == 0 ? 0.0f : x_len * t / (1.0f - t);  // |R| = 1
+      int lookups = 0;
+      b.g[j] = distance_search_detail::ratio(distance_towards, x, r, b.d[j], lookups);
+      b.counted[j] = lookups;
+    }
+  }
+};
+
 // The combined search. Order: x = o → the direct lookup along r. Linear search (when on)
 // for the first undershoot → overshoot pair, then `secant_steps` regula-falsi steps inside
 // it (without secant: the overshooting sample). Without a bracket: `parallax_steps` eq.4
 // iterations (when on), refined by plain secant steps between the last two guesses (the
 // ray start d = 0 counts as the first); with nothing on: the environment-map guess r.
-template <class DistanceFn>
-DistanceSearchResult search_distance(const DistanceFn& distance_towards, const glm::vec3& x,
+// `march` gives the linear march's ratios a batch at a time (any batch is computed before it
+// is scanned; the result and the counted lookups are those of the samples up to the bracket).
+template <class DistanceFn, class March>
+DistanceSearchResult search_distance(const DistanceFn& distance_towards, const March& march, const glm::vec3& x,
                                      const glm::vec3& r, const DistanceSearchOptions& o) {
   using namespace distance_search_detail;
   DistanceSearchResult out;
@@ -101,30 +129,34 @@ DistanceSearchResult search_distance(const DistanceFn& distance_towards, const g
     return out;
   }
   if (o.linear && o.linear_steps >= 2) {
-    float d_prev = 0.0f, g_prev = ratio(distance_towards, x, r, 0.0f, out.lookups);
     const int n = o.linear_steps;
-    for (int k = 1; k < n; ++k) {
-      const float t = float(k) / float(n);
-      const float d = x_len * t / (1.0f - t);  // |R| = 1
-      const float g = ratio(distance_towards, x, r, d, out.lookups);
-      if (g_prev < 1.0f && g >= 1.0f) {
-        out.bracketed = true;
-        float d_l = d_prev, g_l = g_prev, d_p = d, g_p = g;  // undershoot, overshoot
-        float best = d_p;
-        for (int s = 0; o.secant && s < o.secant_steps; ++s) {
-          const float d_new = secant_from_ratios(d_l, g_l, d_p, g_p);
-          best = d_new;
-          const float g_new = ratio(distance_towards, x, r, d_new, out.lookups);
-          if (g_new < 1.0f) d_l = d_new, g_l = g_new;
-          else d_p = d_new, g_p = g_new;
-          if (g_new == 1.0f) break;
+    float d_prev = 0.0f, g_prev = 0.0f;
+    MarchBatch b;
+    for (int first = 0; first < n; first += kMarchBatch) {
+      march(x, r, x_len, n, first, b);
+      for (int k = first; k < std::min(first + kMarchBatch, n); ++k) {
+        const int j = k - first;
+        out.lookups += b.counted[j];
+        const float d = b.d[j], g = b.g[j];
+        if (k > 0 && g_prev < 1.0f && g >= 1.0f) {
+          out.bracketed = true;
+          float d_l = d_prev, g_l = g_prev, d_p = d, g_p = g;  // undershoot, overshoot
+          float best = d_p;
+          for (int s = 0; o.secant && s < o.secant_steps; ++s) {
+            const float d_new = secant_from_ratios(d_l, g_l, d_p, g_p);
+            best = d_new;
+            const float g_new = ratio(distance_towards, x, r, d_new, out.lookups);
+            if (g_new < 1.0f) d_l = d_new, g_l = g_new;
+            else d_p = d_new, g_p = g_new;
+            if (g_new == 1.0f) break;
+          }
+          out.d = best;
+          out.direction = hit_direction(x, r, best);
+          return out;
         }
-        out.d = best;
-        out.direction = hit_direction(x, r, best);
-        return out;
+        d_prev = d;
+        g_prev = g;
       }
-      d_prev = d;
-      g_prev = g;
     }
   }
   if (!o.parallax || o.parallax_steps < 1) {
@@ -153,7 +185,15 @@ DistanceSearchResult search_distance(const DistanceFn& distance_towards, const g
   return out;
 }
 
-// The same in a distance cube map (nearest-texel distances); x_world in world space.
+// The same with the march one sample at a time.
+template <class DistanceFn>
+DistanceSearchResult search_distance(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r,
+                                     const DistanceSearchOptions& o) {
+  return search_distance(distance_towards, ScalarMarch<DistanceFn>{distance_towards}, x, r, o);
+}
+
+// The same in a distance cube map (nearest-texel distances); x_world in world space. The
+// linear march reads eight samples at a time in lanes (each with ratio()'s bits).
 DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_world,
                                          const glm::vec3& r, const DistanceSearchOptions& options);
 

@@ -14,6 +14,7 @@
 #include "core/sampling.h"
 #include "core/shading.h"
 #include "parallel/lanes.h"
+#include "raster/cube_coord_lanes.h"
 
 namespace speculum::raster {
 namespace {
@@ -73,33 +74,17 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
   f32 tv[3], bv[3], nv[3];
   for (int c = 0; c < 3; ++c) tv[c] = L::load(t[c]), bv[c] = L::load(b[c]), nv[c] = L::load(n[c]);
   const int side = previous[0].width;
-  const float sf = static_cast<float>(side), last = static_cast<float>(side - 1);
+  const float last = static_cast<float>(side - 1);
   const float* pixels[kCubeFaces];
   for (int f = 0; f < kCubeFaces; ++f) pixels[f] = &previous[f].pixels[0].x;
   f32 sum[3] = {f32(0.0f), f32(0.0f), f32(0.0f)};
   for (int k = 0; k < count; ++k) {
     f32 d[3];
     for (int c = 0; c < 3; ++c) d[c] = (local[k].x * tv[c] + local[k].y * bv[c]) + local[k].z * nv[c];
-    // cube_coord: the face of the largest component (ties as there), then its projection.
-    const f32 ax = L::abs(d[0]), ay = L::abs(d[1]), az = L::abs(d[2]);
-    const auto is_x = (ax >= ay) && (ax >= az);
-    const auto is_y = !is_x && (ay >= az);
-    const f32 major = L::select(is_x, d[0], L::select(is_y, d[1], d[2]));
-    const auto negative = !(major >= 0.0f);
-    i32 fi = L::select(is_x, i32(0), L::select(is_y, i32(2), i32(4)));
-    fi = L::select(negative, fi + 1, fi);
-    f32 depth(0.0f), along_right(0.0f), along_up(0.0f);
-    for (int f = 0; f < kCubeFaces; ++f) {
-      const L::mask here = fi == f;
-      const CubeFaceAxes& a = kCubeFaceAxes[f];
-      depth = L::select(here, a.forward_sign * d[a.forward], depth);
-      along_right = L::select(here, a.right_sign * d[a.right], along_right);
-      along_up = L::select(here, a.up_sign * d[a.up], along_up);
-    }
-    const f32 ndc_x = along_right / depth, ndc_y = along_up / depth;
+    const CubeCoordLanes cc = cube_coord8(d, side);
+    const i32& fi = cc.face;
+    const f32 &px = cc.x, &py = cc.y;
     const auto clamp = [](f32 v, f32 lo, f32 hi) { return L::select(v < lo, lo, L::select(hi < v, hi, v)); };
-    const f32 px = clamp((ndc_x + 1.0f) * 0.5f * sf, f32(0.0f), f32(sf));
-    const f32 py = clamp((1.0f - ndc_y) * 0.5f * sf, f32(0.0f), f32(sf));
     // bilinear_face
     const f32 fx = clamp(px - 0.5f, f32(0.0f), f32(last)), fy = clamp(py - 0.5f, f32(0.0f), f32(last));
     const i32 x0 = L::to_int(fx), y0 = L::to_int(fy);

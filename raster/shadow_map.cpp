@@ -12,6 +12,7 @@
 
 #include "core/camera_rays.h"
 #include "parallel/lanes.h"
+#include "raster/cube_coord_lanes.h"
 
 namespace speculum::raster {
 namespace {
@@ -193,24 +194,9 @@ void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l
   f32 d[3];
   for (int c = 0; c < 3; ++c) d[c] = (pv[c] + nv[c] * q) - eye[c];
   const f32 dist = L::sqrt(dot(d, d));
-  // cube_coord: the face of the largest component (ties as there), then its projection.
-  const f32 ax = L::abs(d[0]), ay = L::abs(d[1]), az = L::abs(d[2]);
-  const auto is_x = (ax >= ay) && (ax >= az);
-  const auto is_y = !is_x && (ay >= az);
-  const f32 major = L::select(is_x, d[0], L::select(is_y, d[1], d[2]));
-  i32 face = L::select(is_x, i32(0), L::select(is_y, i32(2), i32(4)));
-  face = L::select(!(major >= 0.0f), face + 1, face);
-  f32 depth(0.0f), along_right(0.0f), along_up(0.0f);
-  for (int f = 0; f < kCubeFaces; ++f) {
-    const L::mask here = face == f;
-    const CubeFaceAxes& a = kCubeFaceAxes[f];
-    depth = L::select(here, a.forward_sign * d[a.forward], depth);
-    along_right = L::select(here, a.right_sign * d[a.right], along_right);
-    along_up = L::select(here, a.up_sign * d[a.up], along_up);
-  }
-  const float s = static_cast<float>(cube.size);
-  const f32 px = clamp((along_right / depth + 1.0f) * 0.5f * s, f32(0.0f), f32(s));
-  const f32 py = clamp((1.0f - along_up / depth) * 0.5f * s, f32(0.0f), f32(s));
+  const CubeCoordLanes c = cube_coord8(d, cube.size);
+  const L::i32& face = c.face;
+  const f32 &px = c.x, &py = c.y;
   const f32 biased = dist - kDepthBias * footprint;
   const i32 cx = L::min(L::to_int(px), i32(size - 1)), cy = L::min(L::to_int(py), i32(size - 1));
   for (int j = 0; j < count; ++j)

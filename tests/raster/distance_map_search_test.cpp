@@ -4,7 +4,9 @@
 // against a brute-force ray oracle.
 #include "raster/distance_map_search.h"
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -157,6 +159,48 @@ TEST(DistanceMapSearch, AtTheReferencePointEqualsADirectCubeLookup) {
       EXPECT_EQ(res.d, f.map.distance_towards(r));
     }
   }
+}
+
+TEST(DistanceMapSearch, MarchInLanesGivesTheBitsOfTheScalarMarch) {
+  // search_distance_map marches eight samples at a time; the generic search marches one at a
+  // time with ratio(). Same d, direction, bracket and lookup count, bit for bit: origins
+  // inside and outside the room's map, at its centre too, every direction, march lengths
+  // that end inside and across batches, a map with empty texels (the environment behind a
+  // hole), and rays that leave from exactly the centre's direction.
+  RoomFixture f;
+  for (int k = 0; k < 40; ++k) f.map.distance[k % kCubeFaces].pixels[(k * 997) % f.map.distance[0].pixels.size()] = kInf;
+  const auto scalar = [&](const glm::vec3& x, const glm::vec3& r, const DistanceSearchOptions& o) {
+    return search_distance([&](const glm::vec3& d) { return f.map.distance_towards(d); }, x - f.map.centre, r, o);
+  };
+  int bracketed = 0, compared = 0;
+  const std::vector<glm::vec3> dirs = sphere_directions(300);
+  for (const int steps : {2, 5, 8, 9, 16, 23}) {
+    DistanceSearchOptions o;
+    o.linear_steps = steps;
+    for (std::size_t i = 0; i < dirs.size(); ++i) {
+      const glm::vec3 r = dirs[i];
+      const float reach = 0.1f + 3.0f * float(i % 7) / 6.0f;
+      const glm::vec3 x = f.map.centre + reach * dirs[(i * 31 + 7) % dirs.size()];
+      for (const glm::vec3 origin : {x, f.map.centre, f.map.centre + 0.5f * r}) {
+        const DistanceSearchResult a = search_distance_map(f.map, origin, r, o), b = scalar(origin, r, o);
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(a.d), std::bit_cast<std::uint32_t>(b.d)) << steps << " " << i;
+        ASSERT_EQ(a.direction, b.direction) << steps << " " << i;
+        ASSERT_EQ(a.bracketed, b.bracketed) << steps << " " << i;
+        ASSERT_EQ(a.lookups, b.lookups) << steps << " " << i;
+        bracketed += a.bracketed;
+        ++compared;
+      }
+    }
+    // A ray that passes exactly through the centre, at d = 0.5 (the middle sample of an even
+    // march): ratio() reads nothing there (l = 0), and counts no lookup.
+    for (const glm::vec3 axis : {glm::vec3(0, 0, 1), glm::vec3(-1, 0, 0), glm::vec3(0, 1, 0)}) {
+      const glm::vec3 origin = f.map.centre - 0.5f * axis;
+      const DistanceSearchResult a = search_distance_map(f.map, origin, axis, o), b = scalar(origin, axis, o);
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(a.d), std::bit_cast<std::uint32_t>(b.d)) << steps;
+      ASSERT_EQ(a.lookups, b.lookups) << steps;
+    }
+  }
+  EXPECT_GT(bracketed, compared / 3);
 }
 
 TEST(DistanceMapSearch, ErrorGrowsWithDistanceFromTheReferencePoint) {
