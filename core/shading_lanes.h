@@ -1,5 +1,6 @@
 // core/shading.h's per-light terms for W points at once, each lane with the bits of the
-// scalar form: LightSampler::sample (operator()'s operations in its order) and shade_light.
+// scalar form: LightSampler::sample (operator()'s operations in its order), shade_light and
+// the diffuse albedo.
 #pragma once
 
 #include "core/brdf_lanes.h"
@@ -56,6 +57,15 @@ template <int W>
   const Vec3Lanes<W> brdf = select(mirror, f.diffuse, f.diffuse + f.specular);
   const f32 zero(0.0f);
   return select(cos_nl > zero, brdf * (cos_nl * irradiance), Vec3Lanes<W>(zero, zero, zero));
+}
+
+// diffuse_albedo_over_pi(s, view) per lane, from the BrdfParams of s (their metallic and
+// transmission are the surface's own, unclamped, as that function reads them).
+template <int W>
+[[gnu::always_inline]] inline Vec3Lanes<W> diffuse_albedo_over_pi_lanes(const BrdfParamsLanes<W>& p,
+                                                                        const BrdfAtViewLanes<W>& view) {
+  const typename par::Lanes<W>::f32 e = view.dielectric_f0 * view.scale_at_view + view.bias_at_view;
+  return p.base_color * ((1.0f - p.metallic) * (1.0f - p.transmission) * (1.0f - e) / kPi);
 }
 
 }  // namespace speculum

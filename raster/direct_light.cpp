@@ -123,12 +123,8 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
     const V c = shade_light_lanes<8>(view, mirror, nv, vv, l, irradiance);
     radiance = select(shaded, radiance + lit_lanes * c, radiance);
   }
-  // add_environment: the diffuse lobe's ambient light (diffuse_albedo_over_pi(s, view) with
-  // the raw metallic and transmission, as shading.cpp has it), then the rough lobes' lookups.
-  const L::f32 metallic = L::load(params[6]), transmission = L::load(params[9]);
-  const L::f32 e = view.dielectric_f0 * view.scale_at_view + view.bias_at_view;
-  const V diffuse_albedo = brdf.base_color * ((1.0f - metallic) * (1.0f - transmission) * (1.0f - e) / kPi);
-  radiance = radiance + diffuse_albedo * env_->irradiance8(nv);
+  // add_environment: the diffuse lobe's ambient light, then the rough lobes' lookups.
+  radiance = radiance + diffuse_albedo_over_pi_lanes(brdf, view) * env_->irradiance8(nv);
   radiance.store(out, count);
   for (int j = 0; j < count; ++j)
     if (s[j]->has_rough_specular_lobe())

@@ -137,13 +137,13 @@ void mark(std::vector<std::uint8_t>& t, std::size_t first, std::size_t count) {
 }
 
 // Adds to `whole` the faces whose every tile is set (by any chunk): marking skips them.
-void note_full_faces(const std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, unsigned& whole) {
+void note_full_faces(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, unsigned& whole) {
   for (int f = 0; f < kCubeFaces; ++f) {
     if ((whole >> f) & 1u) continue;
-    const std::vector<std::uint8_t>& t = tiles[f];
+    std::vector<std::uint8_t>& t = tiles[f];
     bool full = true;
     for (std::size_t k = 0; k < t.size() && full; ++k)
-      full = std::atomic_ref<const std::uint8_t>(t[k]).load(std::memory_order_relaxed) != 0;
+      full = std::atomic_ref<std::uint8_t>(t[k]).load(std::memory_order_relaxed) != 0;
     if (full) whole |= 1u << f;
   }
 }
