@@ -27,10 +27,12 @@ struct CubeMarch {
     const f32 len = L::sqrt((l[0] * l[0] + l[1] * l[1]) + l[2] * l[2]);
     const L::mask reads = !(len <= 0.0f) && L::mask(k < n);
     const CubeCoordLanes c = cube_coord8(l, map.size);
-    // distance_at's texel, kept inside the map on lanes that read nothing (their l may be 0).
+    // distance_at's texel; lanes that read nothing (l = 0: their coordinates are NaN, which
+    // no float-to-int conversion may see) read texel 0 of face 0 instead.
     const i32 last(map.size - 1), zero(0);
-    const i32 tx = L::select(reads, L::max(L::min(L::to_int(c.x), last), zero), zero);
-    const i32 ty = L::select(reads, L::max(L::min(L::to_int(c.y), last), zero), zero);
+    const f32 at_x = L::select(reads, c.x, f32(0.0f)), at_y = L::select(reads, c.y, f32(0.0f));
+    const i32 tx = L::max(L::min(L::to_int(at_x), last), zero);
+    const i32 ty = L::max(L::min(L::to_int(at_y), last), zero);
     const i32 face = L::select(reads, c.face, zero);
     alignas(32) std::int32_t fx[8], px[8], py[8];
     L::store_aligned(face, fx), L::store_aligned(tx, px), L::store_aligned(ty, py);

@@ -80,6 +80,8 @@ void BM_PrefilterCascade(benchmark::State& state) {
   double texels = 0.0;
   for (int l = 1; l < kLevels; ++l) texels += 6.0 * (kSide >> l) * (kSide >> l);
   for (auto _ : state) {
+    // The call takes its level-0 faces by value: their 6 MB copy (about a millisecond) is
+    // timed with the cascade.
     EnvironmentMap map = environment_from_faces(ex, faces, false, kLevels);
     benchmark::DoNotOptimize(map.levels.data());
   }
