@@ -1,7 +1,7 @@
 // core/brdf.h's per-light BRDF for W points at once: the same operations in the same order
 // as the scalar gltf_brdf(BrdfAtView, ...) and specular_albedo, so every lane has the bits
 // of the scalar call (tests/core/brdf_lanes_test.cpp compares them). A shading pass computes
-// each point's BrdfAtView once (scalar) and evaluates the lights eight points at a time.
+// each point's viewer terms once and evaluates the lights eight points at a time.
 #pragma once
 
 #include <cstdint>
@@ -12,33 +12,13 @@
 
 namespace speculum {
 
-// BrdfAtView's fields as lanes (the ones gltf_brdf reads).
+// BrdfAtView's fields as lanes (brdf_at_view_lanes computes them).
 template <int W>
 struct BrdfAtViewLanes {
   using f32 = typename par::Lanes<W>::f32;
   Vec3Lanes<W> base_color, f0;
   f32 alpha, cos_nv, diffuse_weight, dielectric_f0, one_minus_e_v, one_minus_e_avg, smith_view_root;
   f32 scale_at_view, bias_at_view;
-
-  // views[0, count); lanes past count repeat views[0].
-  static BrdfAtViewLanes load(const BrdfAtView* views, int count) {
-    using L = par::Lanes<W>;
-    alignas(64) float c[13][W];
-    for (int j = 0; j < W; ++j) {
-      const BrdfAtView& a = views[j < count ? j : 0];
-      const float fields[13] = {a.base_color.x, a.base_color.y, a.base_color.z, a.f0.x, a.f0.y, a.f0.z, a.alpha,
-                                a.cos_nv, a.diffuse_weight, a.dielectric_f0, a.one_minus_e_v, a.one_minus_e_avg,
-                                a.smith_view_root};
-      for (int k = 0; k < 13; ++k) c[k][j] = fields[k];
-    }
-    BrdfAtViewLanes out;
-    out.base_color = {L::load(c[0]), L::load(c[1]), L::load(c[2])};
-    out.f0 = {L::load(c[3]), L::load(c[4]), L::load(c[5])};
-    out.alpha = L::load(c[6]), out.cos_nv = L::load(c[7]), out.diffuse_weight = L::load(c[8]);
-    out.dielectric_f0 = L::load(c[9]), out.one_minus_e_v = L::load(c[10]), out.one_minus_e_avg = L::load(c[11]);
-    out.smith_view_root = L::load(c[12]);
-    return out;
-  }
 };
 
 template <int W>
@@ -50,9 +30,8 @@ namespace brdf_lanes_detail {
 
 template <int W>
 [[gnu::always_inline]] inline typename par::Lanes<W>::f32 clamp01(const typename par::Lanes<W>::f32& x) {
-  using L = par::Lanes<W>;
-  using f32 = typename L::f32;
-  return L::select(x < 0.0f, f32(0.0f), L::select(f32(1.0f) < x, f32(1.0f), x));
+  using f32 = typename par::Lanes<W>::f32;
+  return par::Lanes<W>::clamp(x, f32(0.0f), f32(1.0f));
 }
 
 // brdf.cpp's grid(): the albedo table's cell of x ∈ [0, 1] (clamped below too, so a NaN
@@ -170,7 +149,7 @@ template <int W>
   const f32 sum2 = dot(sum, sum);
   const Vec3Lanes<W> h = select(sum2 > 1e-12f, sum / L::sqrt(sum2), n);
   const f32 vh = dot(v, h);
-  const f32 cos_vh = L::select(vh < zero, zero, L::select(one < vh, one, vh));
+  const f32 cos_vh = L::clamp(vh, zero, one);
 
   const f32 e_l = specular_albedo_lanes<W>(cos_nl, a.alpha, a.dielectric_f0);
   const f32 coupled = a.one_minus_e_v * (1.0f - e_l) / a.one_minus_e_avg;

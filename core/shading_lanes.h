@@ -29,14 +29,12 @@ template <int W>
   if (light.range > 0.0f) {
     const f32 r = d / light.range;
     const f32 r2 = r * r;
-    const f32 w = 1.0f - r2 * r2;
-    window = L::select(w < zero, zero, L::select(one < w, one, w));
+    window = L::clamp(1.0f - r2 * r2, zero, one);
   }
   f32 cone = one;
   if (light.type == LightType::Spot) {
     const f32 cd = dot(Vec3Lanes<W>(direction_), -dir);
-    const f32 x = (cd - cos_outer_) * cone_scale_;
-    const f32 a = L::select(x < zero, zero, L::select(one < x, one, x));
+    const f32 a = L::clamp((cd - cos_outer_) * cone_scale_, zero, one);
     cone = a * a;
   }
   const f32 e = light.intensity * window * cone / d2;

@@ -155,6 +155,12 @@ struct Lanes {
                                          const stdx::fixed_size_simd<T, W>& b) {
     return select(a < b, b, a);
   }
+  // std::clamp per lane, in its order (v < lo first, then hi < v): a NaN stays NaN.
+  template <class T>
+  static stdx::fixed_size_simd<T, W> clamp(const stdx::fixed_size_simd<T, W>& v, const stdx::fixed_size_simd<T, W>& lo,
+                                           const stdx::fixed_size_simd<T, W>& hi) {
+    return select(v < lo, lo, select(hi < v, hi, v));
+  }
   static f32 sqrt(const f32& v) { return stdx::sqrt(v); }  // correctly rounded per lane
   static f32 abs(const f32& v) { return stdx::abs(v); }
   static i32 abs(const i32& v) { return stdx::abs(v); }

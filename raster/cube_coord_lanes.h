@@ -34,9 +34,8 @@ struct CubeCoordLanes {
     along_up = L::select(here, a.up_sign * d[a.up], along_up);
   }
   const float s = static_cast<float>(size);
-  const auto clamp = [](f32 v, f32 lo, f32 hi) { return L::select(v < lo, lo, L::select(hi < v, hi, v)); };
-  return {face, clamp((along_right / depth + 1.0f) * 0.5f * s, f32(0.0f), f32(s)),
-          clamp((1.0f - along_up / depth) * 0.5f * s, f32(0.0f), f32(s))};
+  return {face, L::clamp((along_right / depth + 1.0f) * 0.5f * s, f32(0.0f), f32(s)),
+          L::clamp((1.0f - along_up / depth) * 0.5f * s, f32(0.0f), f32(s))};
 }
 
 }  // namespace speculum::raster

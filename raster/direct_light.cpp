@@ -16,14 +16,20 @@ namespace {
 // The normal shade_surface lights: refractors seen from inside light the near side.
 glm::vec3 facing_viewer(const glm::vec3& n, const glm::vec3& v) { return glm::dot(n, v) < 0.0f ? -n : n; }
 
-// shade_surface's terms after the lights: ambient light on the diffuse lobe and, on a surface
-// too rough for a reflection pass, the environment along R (core/shading.h).
-glm::vec3 add_environment(glm::vec3 radiance, const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
-                          const BrdfAtView& view, const EnvironmentMap& env) {
-  radiance += diffuse_albedo_over_pi(s, view) * env.irradiance(n);
+// On a surface too rough for a reflection pass, the environment along R (core/shading.h).
+glm::vec3 add_rough_lobe(glm::vec3 radiance, const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
+                         const EnvironmentMap& env) {
   if (s.has_rough_specular_lobe())
     radiance += specular_reflectance(s, glm::dot(n, v)) * env.radiance(reflect(-v, n), s.phong_exponent);
   return radiance;
+}
+
+// shade_surface's terms after the lights: ambient light on the diffuse lobe, then the rough
+// lobe's environment.
+glm::vec3 add_environment(glm::vec3 radiance, const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v,
+                          const BrdfAtView& view, const EnvironmentMap& env) {
+  radiance += diffuse_albedo_over_pi(s, view) * env.irradiance(n);
+  return add_rough_lobe(radiance, s, n, v, env);
 }
 
 // shade_surface with light k sampled at p by sample(k, p) (sample_light's bits).
@@ -126,10 +132,7 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
   // add_environment: the diffuse lobe's ambient light, then the rough lobes' lookups.
   radiance = radiance + diffuse_albedo_over_pi_lanes(brdf, view) * env_->irradiance8(nv);
   radiance.store(out, count);
-  for (int j = 0; j < count; ++j)
-    if (s[j]->has_rough_specular_lobe())
-      out[j] += specular_reflectance(*s[j], glm::dot(n[j], v[j])) *
-                env_->radiance(reflect(-v[j], n[j]), s[j]->phong_exponent);
+  for (int j = 0; j < count; ++j) out[j] = add_rough_lobe(out[j], *s[j], n[j], v[j], *env_);
 }
 
 ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,

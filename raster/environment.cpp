@@ -84,9 +84,8 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
     const CubeCoordLanes cc = cube_coord8(d, side);
     const i32& fi = cc.face;
     const f32 &px = cc.x, &py = cc.y;
-    const auto clamp = [](f32 v, f32 lo, f32 hi) { return L::select(v < lo, lo, L::select(hi < v, hi, v)); };
     // bilinear_face
-    const f32 fx = clamp(px - 0.5f, f32(0.0f), f32(last)), fy = clamp(py - 0.5f, f32(0.0f), f32(last));
+    const f32 fx = L::clamp(px - 0.5f, f32(0.0f), f32(last)), fy = L::clamp(py - 0.5f, f32(0.0f), f32(last));
     const i32 x0 = L::to_int(fx), y0 = L::to_int(fy);
     const i32 x1 = L::min(x0 + 1, i32(side - 1)), y1 = L::min(y0 + 1, i32(side - 1));
     const f32 tx = fx - L::to_float(x0), ty = fy - L::to_float(y0);
@@ -111,12 +110,18 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
   for (int j = 0; j < 8; ++j) out[j] = glm::vec3(sum[0][j], sum[1][j], sum[2][j]);
 }
 
-std::array<float, 9> sh_basis(const glm::vec3& d) {
-  const float x = d.x, y = d.y, z = d.z;
-  return {0.282095f,         0.488603f * y,       0.488603f * z,
+// The 9 real SH basis functions (bands 0..2) at the unit direction (x, y, z); T is float or
+// a lane type (the same operations per lane).
+template <class T>
+std::array<T, 9> sh_basis(const T& x, const T& y, const T& z) {
+  return {T(0.282095f),      0.488603f * y,       0.488603f * z,
           0.488603f * x,     1.092548f * x * y,   1.092548f * y * z,
           0.315392f * (3.0f * z * z - 1.0f), 1.092548f * x * z, 0.546274f * (x * x - y * y)};
 }
+
+// The clamped cosine's SH convolution weights per coefficient: A0 = π, A1 = 2π/3, A2 = π/4.
+constexpr float kCosineLobeSh[9] = {kPi, 2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
+                                    kPi / 4, kPi / 4, kPi / 4, kPi / 4};
 
 }  // namespace
 
@@ -203,7 +208,7 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
         const double solid_angle =
             (4.0 / (double(size) * size)) / std::pow(1.0 + u * u + v * v, 1.5);
         const glm::vec3 d = cube_direction(face, {x + 0.5f, y + 0.5f}, size);
-        const auto basis = sh_basis(d);
+        const auto basis = sh_basis(d.x, d.y, d.z);
         const glm::dvec3 L(glm::vec3(map.levels[0][face].at(x, y)));
         for (int k = 0; k < 9; ++k) acc[k] += L * (double(basis[k]) * solid_angle);
       }
@@ -262,28 +267,18 @@ glm::vec3 EnvironmentMap::radiance(const glm::vec3& d, float phong_exponent) con
 }
 
 glm::vec3 EnvironmentMap::irradiance(const glm::vec3& n) const {
-  // Convolution with the clamped cosine: A0 = π, A1 = 2π/3, A2 = π/4.
-  constexpr float a[9] = {kPi, 2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
-                          kPi / 4, kPi / 4, kPi / 4, kPi / 4};
-  const auto basis = sh_basis(n);
+  const auto basis = sh_basis(n.x, n.y, n.z);
   glm::vec3 e(0.0f);
-  for (int k = 0; k < 9; ++k) e += sh[k] * (a[k] * basis[k]);
+  for (int k = 0; k < 9; ++k) e += sh[k] * (kCosineLobeSh[k] * basis[k]);
   return glm::max(e, glm::vec3(0.0f));
 }
 
 Vec3Lanes<8> EnvironmentMap::irradiance8(const Vec3Lanes<8>& n) const {
   using L = par::Lanes<8>;
-  using f32 = L::f32;
-  constexpr float a[9] = {kPi, 2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
-                          kPi / 4, kPi / 4, kPi / 4, kPi / 4};
-  const f32 &x = n.x, &y = n.y, &z = n.z;
-  // sh_basis's terms, in its order of operations.
-  const f32 basis[9] = {f32(0.282095f),         0.488603f * y,       0.488603f * z,
-                        0.488603f * x,          1.092548f * x * y,   1.092548f * y * z,
-                        0.315392f * (3.0f * z * z - 1.0f), 1.092548f * x * z, 0.546274f * (x * x - y * y)};
-  const f32 zero(0.0f);
+  const auto basis = sh_basis(n.x, n.y, n.z);
+  const L::f32 zero(0.0f);
   Vec3Lanes<8> e(zero, zero, zero);
-  for (int k = 0; k < 9; ++k) e = e + Vec3Lanes<8>(sh[k]) * (a[k] * basis[k]);
+  for (int k = 0; k < 9; ++k) e = e + Vec3Lanes<8>(sh[k]) * (kCosineLobeSh[k] * basis[k]);
   return {L::max(e.x, zero), L::max(e.y, zero), L::max(e.z, zero)};
 }
 

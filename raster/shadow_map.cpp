@@ -182,14 +182,13 @@ void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l
   for (int c = 0; c < 3; ++c) pv[c] = L::load(in[c]), nv[c] = L::load(in[3 + c]), lv[c] = L::load(in[6 + c]);
   // glm's dot of two vec3 is (x·x' + y·y') + z·z', and length is the root of the dot.
   const auto dot = [](const f32* a, const f32* b) { return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]; };
-  const auto clamp = [](f32 v, f32 lo, f32 hi) { return L::select(v < lo, lo, L::select(hi < v, hi, v)); };
   const glm::vec3 eye = cube.centre;
   const float texel_angle = 2.0f / static_cast<float>(cube.size);
   f32 from_eye[3];
   for (int c = 0; c < 3; ++c) from_eye[c] = pv[c] - eye[c];
   const f32 footprint = L::sqrt(dot(from_eye, from_eye)) * texel_angle;
   // normal_offset
-  const f32 cos_nl = clamp(dot(nv, lv), f32(0.0f), f32(1.0f));
+  const f32 cos_nl = L::clamp(dot(nv, lv), f32(0.0f), f32(1.0f));
   const f32 q = kNormalOffset * footprint * L::sqrt(1.0f - cos_nl * cos_nl);
   f32 d[3];
   for (int c = 0; c < 3; ++c) d[c] = (pv[c] + nv[c] * q) - eye[c];

@@ -53,11 +53,31 @@ Batch batch(std::uint32_t i) {
   return b;
 }
 
+// Scalar viewer terms views[0, 8) as lanes (the inputs gltf_brdf_lanes and the scalar
+// gltf_brdf then share exactly).
+BrdfAtViewLanes<8> load_views(const BrdfAtView* views) {
+  alignas(64) float c[13][8];
+  for (int j = 0; j < 8; ++j) {
+    const BrdfAtView& a = views[j];
+    const float fields[13] = {a.base_color.x, a.base_color.y, a.base_color.z, a.f0.x, a.f0.y, a.f0.z, a.alpha,
+                              a.cos_nv, a.diffuse_weight, a.dielectric_f0, a.one_minus_e_v, a.one_minus_e_avg,
+                              a.smith_view_root};
+    for (int k = 0; k < 13; ++k) c[k][j] = fields[k];
+  }
+  BrdfAtViewLanes<8> out;
+  out.base_color = {L::load(c[0]), L::load(c[1]), L::load(c[2])};
+  out.f0 = {L::load(c[3]), L::load(c[4]), L::load(c[5])};
+  out.alpha = L::load(c[6]), out.cos_nv = L::load(c[7]), out.diffuse_weight = L::load(c[8]);
+  out.dielectric_f0 = L::load(c[9]), out.one_minus_e_v = L::load(c[10]), out.one_minus_e_avg = L::load(c[11]);
+  out.smith_view_root = L::load(c[12]);
+  return out;
+}
+
 TEST(BrdfLanes, EveryLaneHasTheBitsOfTheScalarBrdf) {
   std::size_t below = 0, lit = 0;
   for (std::uint32_t i = 0; i < 4000; ++i) {
     const Batch b = batch(i);
-    const auto views = BrdfAtViewLanes<8>::load(b.view, 8);
+    const auto views = load_views(b.view);
     const BrdfValueLanes<8> f = gltf_brdf_lanes(views, V::load(b.n, 8), V::load(b.l, 8), V::load(b.v, 8));
     glm::vec3 diffuse[8], specular[8];
     f.diffuse.store(diffuse, 8);
@@ -142,7 +162,7 @@ TEST(BrdfLanes, LightSamplersAndShadeLightHaveTheScalarBits) {
     if (i % 10 == 0) b.p[3] = lights[0].position;
     alignas(32) float mirror_flag[8];
     for (int j = 0; j < 8; ++j) mirror_flag[j] = b.s[j].is_mirror_lobe() ? 1.0f : 0.0f;
-    const auto views = BrdfAtViewLanes<8>::load(b.view, 8);
+    const auto views = load_views(b.view);
     const V p = V::load(b.p, 8), n = V::load(b.n, 8), v = V::load(b.v, 8);
     for (const Light& light : lights) {
       const LightSampler sampler(light);
