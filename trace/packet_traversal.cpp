@@ -45,6 +45,7 @@ struct Packet {
   // runs across the rays, one triangle at a time: the shear in lanes.
   bool common_shear = false;
   int kx = 0, ky = 1, kz = 2;
+  std::uint32_t offx = 0, offy = 16, offz = 32;  // byte offsets of the kx/ky/kz rows in a vertex block
   alignas(32) float okx[kMaxPacketSize], oky[kMaxPacketSize], okz[kMaxPacketSize];
   alignas(32) float sx[kMaxPacketSize], sy[kMaxPacketSize], sz[kMaxPacketSize];
   // Packet bounds for the interval node test.
@@ -153,6 +154,9 @@ bool prepare(const Ray* rays, int count, Packet& p) {
     p.sx[r] = sh.sx; p.sy[r] = sh.sy; p.sz[r] = sh.sz;
   }
   p.kx = p.shear[0].kx; p.ky = p.shear[0].ky; p.kz = p.shear[0].kz;
+  p.offx = 16u * static_cast<std::uint32_t>(p.kx);
+  p.offy = 16u * static_cast<std::uint32_t>(p.ky);
+  p.offz = 16u * static_cast<std::uint32_t>(p.kz);
   p.common_shear = true;
   for (int r = 1; r < count; ++r)
     if (p.shear[r].kx != p.kx || p.shear[r].ky != p.ky || p.shear[r].kz != p.kz) p.common_shear = false;
@@ -187,17 +191,19 @@ struct Entry {
 [[gnu::always_inline]] inline bool ray_lanes_triangle(const TrianglePack& pk, int l, Packet& p, int half,
                                                       unsigned lanes, Hit* best) {
   const int h = 8 * half;
-  const float* va[3] = {&pk.ax[l], &pk.ay[l], &pk.az[l]};
-  const float* vb[3] = {&pk.bx[l], &pk.by[l], &pk.bz[l]};
-  const float* vc[3] = {&pk.cx[l], &pk.cy[l], &pk.cz[l]};
+  // Vertex v's kx/ky/kz coordinates of triangle l: rows of the pack picked by byte offset.
+  const char* base = reinterpret_cast<const char*>(&pk) + 4 * l;
+  auto coord = [base](std::uint32_t vertex, std::uint32_t off) {
+    return _mm256_broadcast_ss(reinterpret_cast<const float*>(base + 48u * vertex + off));
+  };
   const __m256 okx = _mm256_load_ps(p.okx + h), oky = _mm256_load_ps(p.oky + h), okz = _mm256_load_ps(p.okz + h);
   const __m256 sx = _mm256_load_ps(p.sx + h), sy = _mm256_load_ps(p.sy + h), sz = _mm256_load_ps(p.sz + h);
-  const __m256 Akx = _mm256_sub_ps(_mm256_set1_ps(*va[p.kx]), okx), Aky = _mm256_sub_ps(_mm256_set1_ps(*va[p.ky]), oky),
-               Akz = _mm256_sub_ps(_mm256_set1_ps(*va[p.kz]), okz);
-  const __m256 Bkx = _mm256_sub_ps(_mm256_set1_ps(*vb[p.kx]), okx), Bky = _mm256_sub_ps(_mm256_set1_ps(*vb[p.ky]), oky),
-               Bkz = _mm256_sub_ps(_mm256_set1_ps(*vb[p.kz]), okz);
-  const __m256 Ckx = _mm256_sub_ps(_mm256_set1_ps(*vc[p.kx]), okx), Cky = _mm256_sub_ps(_mm256_set1_ps(*vc[p.ky]), oky),
-               Ckz = _mm256_sub_ps(_mm256_set1_ps(*vc[p.kz]), okz);
+  const __m256 Akx = _mm256_sub_ps(coord(0, p.offx), okx), Aky = _mm256_sub_ps(coord(0, p.offy), oky),
+               Akz = _mm256_sub_ps(coord(0, p.offz), okz);
+  const __m256 Bkx = _mm256_sub_ps(coord(1, p.offx), okx), Bky = _mm256_sub_ps(coord(1, p.offy), oky),
+               Bkz = _mm256_sub_ps(coord(1, p.offz), okz);
+  const __m256 Ckx = _mm256_sub_ps(coord(2, p.offx), okx), Cky = _mm256_sub_ps(coord(2, p.offy), oky),
+               Ckz = _mm256_sub_ps(coord(2, p.offz), okz);
   const __m256 ax = _mm256_sub_ps(Akx, _mm256_mul_ps(sx, Akz)), ay = _mm256_sub_ps(Aky, _mm256_mul_ps(sy, Akz));
   const __m256 bx = _mm256_sub_ps(Bkx, _mm256_mul_ps(sx, Bkz)), by = _mm256_sub_ps(Bky, _mm256_mul_ps(sy, Bkz));
   const __m256 cx = _mm256_sub_ps(Ckx, _mm256_mul_ps(sx, Ckz)), cy = _mm256_sub_ps(Cky, _mm256_mul_ps(sy, Ckz));

@@ -71,11 +71,6 @@ inline void prefetch_ref(const WideNode* nodes, const TrianglePack* packs, std::
   if (!(ref & kLeafBit)) _mm_prefetch(p + 192, _MM_HINT_T0);
 }
 
-struct StackEntry {
-  std::uint32_t ref;
-  float tnear;
-};
-
 }  // namespace
 
 Hit closest_hit(const Bvh& bvh, const Ray& ray, TraversalCounters* counters) {
@@ -94,60 +89,64 @@ Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit, T
     const wide::PackRay pr(r.shear);
     const WideNode* nodes = bvh.wide_nodes().data();
     const TrianglePack* packs = bvh.triangle_packs().data();
-    StackEntry stack[kTraversalStackSize];
+    // Pending children as two arrays, with room for a whole node's 8 lanes stored at once.
+    alignas(32) std::uint32_t stack_ref[kTraversalStackSize + kWideArity];
+    alignas(32) float stack_t[kTraversalStackSize + kWideArity];
     int sp = 0;
-    StackEntry cur{bvh.wide_root(), ray.tmin};
+    std::uint32_t cur = bvh.wide_root();
     while (true) {
-      if (cur.ref & kLeafBit) {
-        test_packs_closest(packs, pr, r.tmin, cur.ref, best, c);
+      if (cur & kLeafBit) {
+        test_packs_closest(packs, pr, r.tmin, cur, best, c);
       } else {
         ++c.nodes_visited;
-        const WideNode& n = nodes[cur.ref];
+        const WideNode& n = nodes[cur];
         __m256 tnv;
-        unsigned bits = wide::box_hits(n, br, best.t, tnv);
-        if (bits) {
+        const unsigned bits = wide::box_hits(n, br, best.t, tnv);
+        const int hits = __builtin_popcount(bits);
+        if (hits == 1) {  // the common case: descend without the stack
+          cur = n.child[__builtin_ctz(bits)];
+          continue;
+        }
+        if (hits == 2) {  // push the farther, descend into the nearer (no branch on the order)
           alignas(32) float tn[kWideArity];
           _mm256_store_ps(tn, tnv);
-          int k = __builtin_ctz(bits);
-          bits &= bits - 1;
-          if (!bits) {  // one child hit (the common case): descend without the stack
-            cur = {n.child[k], tn[k]};
-            continue;
+          const int k0 = __builtin_ctz(bits), k1 = __builtin_ctz(bits & (bits - 1));
+          const bool k1_nearer = tn[k1] < tn[k0];
+          const int near = k1_nearer ? k1 : k0, far = k1_nearer ? k0 : k1;
+          if (sp < stack_limit) {
+            stack_ref[sp] = n.child[far];
+            stack_t[sp++] = tn[far];
+            prefetch_ref(nodes, packs, n.child[far]);
+          } else {
+            ++c.stack_overflows;
           }
-          // Several: push all but the nearest, far-to-near, and descend into the nearest.
-          StackEntry hits[kWideArity];
-          hits[0] = {n.child[k], tn[k]};
-          int count = 1;
-          while (bits) {
-            k = __builtin_ctz(bits);
-            bits &= bits - 1;
-            const StackEntry s{n.child[k], tn[k]};
-            int j = count++;
-            while (j > 0 && hits[j - 1].tnear < s.tnear) {
-              hits[j] = hits[j - 1];
-              --j;
-            }
-            hits[j] = s;
-          }
-          for (int i = 0; i + 1 < count; ++i) {
-            if (sp == stack_limit) {
-              ++c.stack_overflows;
-              continue;
-            }
-            stack[sp++] = hits[i];
-          }
-          // The runner-up is the likely next pop: start its cache lines now (prefetching
-          // every pushed child measured no better).
-          prefetch_ref(nodes, packs, hits[count - 2].ref);
-          cur = hits[count - 1];
+          cur = n.child[near];
+          continue;
+        }
+        if (hits > 2) {
+          // Push all but the nearest, far to near, in one store of the sorted lanes; the
+          // runner-up (the likely next pop) starts its cache lines now.
+          const __m256i order = wide::children_far_to_near(bits, tnv);
+          const __m256i refs = _mm256_permutevar8x32_epi32(
+              _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)), order);
+          const __m256 tns = _mm256_permutevar8x32_ps(tnv, order);
+          const int pushed = std::min(hits - 1, stack_limit - sp);
+          c.stack_overflows += static_cast<std::uint64_t>(hits - 1 - pushed);
+          // An overflow keeps the farthest children (the lanes stored first).
+          _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack_ref + sp), refs);
+          _mm256_storeu_ps(stack_t + sp, tns);
+          cur = stack_ref[sp + hits - 1];
+          sp += pushed;
+          if (pushed > 0) prefetch_ref(nodes, packs, stack_ref[sp - 1]);
           continue;
         }
       }
       // Pop the next entry still nearer than the best hit.
       bool found = false;
       while (sp > 0) {
-        cur = stack[--sp];
-        if (cur.tnear <= best.t) {
+        --sp;
+        if (stack_t[sp] <= best.t) {
+          cur = stack_ref[sp];
           found = true;
           break;
         }

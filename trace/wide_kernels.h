@@ -109,6 +109,39 @@ struct BoxRay {
   return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(near, far, _CMP_LE_OQ)));
 }
 
+// One compare-exchange step of a sorting network on 8 unsigned lanes: each lane meets
+// its partner; the lanes in kMinLanes keep the smaller key, the others the larger.
+template <int kMinLanes>
+[[gnu::always_inline]] inline __m256i compare_exchange(__m256i x, __m256i partner) {
+  return _mm256_blend_epi32(_mm256_max_epu32(x, partner), _mm256_min_epu32(x, partner), kMinLanes);
+}
+
+// A node's entered children sorted far to near in one register, for a traversal that
+// pushes them onto a stack in one store: each key is the child's entry distance made an
+// order-preserving unsigned integer (sign flipped for positive floats, all bits for
+// negative ones) with its lane in the low 3 bits; children not entered get key 0 and sort
+// last. Dropping 3 mantissa bits only reorders children whose entries differ by less
+// than 2^-20 relative: the order is a heuristic, the closest hit does not depend on it.
+// Lanes 0..hits-1 of the result hold the entered children's lanes, farthest first.
+[[gnu::always_inline]] inline __m256i children_far_to_near(unsigned bits, __m256 tnear) {
+  const __m256i b = _mm256_castps_si256(tnear);
+  const __m256i flip = _mm256_or_si256(_mm256_srai_epi32(b, 31), _mm256_set1_epi32(INT32_MIN));
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i key = _mm256_or_si256(_mm256_andnot_si256(_mm256_set1_epi32(7), _mm256_xor_si256(b, flip)), lane);
+  const __m256i entered = _mm256_cmpgt_epi32(
+      _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+      _mm256_setzero_si256());
+  __m256i x = _mm256_and_si256(key, entered);
+  // Bitonic network of 8 (6 compare-exchange steps), larger keys to lower lanes.
+  x = compare_exchange<0xaa>(x, _mm256_shuffle_epi32(x, _MM_SHUFFLE(2, 3, 0, 1)));
+  x = compare_exchange<0xcc>(x, _mm256_shuffle_epi32(x, _MM_SHUFFLE(0, 1, 2, 3)));
+  x = compare_exchange<0xaa>(x, _mm256_shuffle_epi32(x, _MM_SHUFFLE(2, 3, 0, 1)));
+  x = compare_exchange<0xf0>(x, _mm256_permutevar8x32_epi32(x, _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0)));
+  x = compare_exchange<0xcc>(x, _mm256_shuffle_epi32(x, _MM_SHUFFLE(1, 0, 3, 2)));
+  x = compare_exchange<0xaa>(x, _mm256_shuffle_epi32(x, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm256_and_si256(x, _mm256_set1_epi32(7));
+}
+
 // A ray prepared for the pack kernel: the watertight shear (axis permutation as byte
 // offsets into a TrianglePack, shear factors and origin broadcast).
 struct PackRay {
