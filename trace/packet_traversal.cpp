@@ -126,7 +126,8 @@ bool prepare(const Ray* rays, int count, Packet& p) {
     const Ray& ray = rays[r];
     if (!wide::valid_ray(ray) || wide::has_clamped_axis(ray.direction)) return false;
     const glm::vec3& d = ray.direction;
-    const glm::vec3 dn = d / std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    // Only the coherence decision reads dn (both paths give the same hits): one division.
+    const glm::vec3 dn = d * (1.0f / std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
     dlo = glm::min(dlo, dn);
     dhi = glm::max(dhi, dn);
   }
