@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -150,9 +151,12 @@ std::vector<std::uint8_t> CubeTileMask::texels(int face) const {
   const std::vector<std::uint8_t>& t = tiles[face];
   if (t.empty()) return out;
   const int n = tiles_per_side();
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x)
-      out[static_cast<std::size_t>(y) * size + x] = t[static_cast<std::size_t>(y / tile) * n + x / tile];
+  // Row by row, each tile's byte over its run of texels (no division per texel).
+  for (int y = 0; y < size; ++y) {
+    const std::uint8_t* row = &t[static_cast<std::size_t>(y / tile) * n];
+    std::uint8_t* o = &out[static_cast<std::size_t>(y) * size];
+    for (int tx = 0, x = 0; tx < n; ++tx, x += tile) std::memset(o + x, row[tx], std::min(tile, size - x));
+  }
   return out;
 }
 
@@ -178,6 +182,9 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
   // One G-buffer for every face: its planes (about 90 bytes a texel) are allocated and
   // cleared once, not once per face on the thread that launches the face's passes.
   GBuffer g;
+  // The same for the rasterizer's bins and the visibility planes.
+  RasterWorkspace workspace;
+  VisibilityBuffer vis;
   for (int face = 0; face < kCubeFaces; ++face) {
     if (!((options.face_mask >> face) & 1u)) {
       cube.distance[face] = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
@@ -185,7 +192,7 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
       continue;
     }
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
-    VisibilityBuffer vis = render_visibility(executor, scene, cam, options.size, options.size, options.raster);
+    render_visibility(executor, scene, cam, options.size, options.size, options.raster, workspace, vis);
     // Texels no reader reaches become background: not resolved, not shaded.
     std::vector<std::uint8_t> read;
     if (options.tiles && options.tiles->active()) {

@@ -425,6 +425,16 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
   }
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   const TriangleMesh& m = scene.mesh;
+  // What each material asks of a map, once per material rather than per triangle.
+  struct MaterialReads {
+    bool specular = false, refracts = false;
+    float lobe = 1e6f;  // the Phong exponent a map is read with
+  };
+  std::vector<MaterialReads> reads(scene.materials.size());
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const SurfaceParams s = surface_params(scene.materials[i]);
+    if (is_specular(s)) reads[i] = {true, s.is_refractor(), map_lookup_exponent(scene.materials[i], s)};
+  }
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
     if (skip && o < skip->size() && (*skip)[o]) continue;
@@ -433,12 +443,11 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     Bounds b;
     for (std::uint32_t t = object.first_triangle; t < object.first_triangle + object.triangle_count;
          ++t) {
-      const Material& material = scene.materials[m.triangle_material[t]];
-      const SurfaceParams s = surface_params(material);
-      if (is_specular(s)) {
+      const MaterialReads& r = reads[m.triangle_material[t]];
+      if (r.specular) {
         specular = true;
-        refracts = refracts || s.is_refractor();
-        widest_lobe = std::min(widest_lobe, map_lookup_exponent(material, s));
+        refracts = refracts || r.refracts;
+        widest_lobe = std::min(widest_lobe, r.lobe);
       }
       for (int k = 0; k < 3; ++k) b.grow(m.positions[m.indices[3 * t + k]]);
     }
