@@ -151,6 +151,7 @@ std::vector<std::uint8_t> CubeTileMask::texels(int face) const {
   const std::vector<std::uint8_t>& t = tiles[face];
   if (t.empty()) return out;
   const int n = tiles_per_side();
+  if (tile == 1) return t;  // one texel per tile: the tiles are the texels
   // Row by row, each tile's byte over its run of texels (no division per texel).
   for (int y = 0; y < size; ++y) {
     const std::uint8_t* row = &t[static_cast<std::size_t>(y / tile) * n];
