@@ -81,6 +81,29 @@ TEST(CubeTileMask, TexelCountEqualsTheTexelsOfItsReadTiles) {
   }
 }
 
+// Each texel's byte is its tile's, for one-texel tiles and wider ones, on sides that are and
+// are not whole numbers of tiles.
+TEST(CubeTileMask, TexelsTakeTheirTilesBytes) {
+  std::mt19937 rng(11);
+  for (const int tile : {1, 2, 3, 8})
+    for (const int size : {8, 20, 37}) {
+      CubeTileMask mask;
+      mask.size = size;
+      mask.tile = tile;
+      const int n = mask.tiles_per_side();
+      mask.tiles[2].resize(static_cast<std::size_t>(n) * n);
+      for (std::uint8_t& t : mask.tiles[2]) t = rng() % 2;
+      const std::vector<std::uint8_t> texels = mask.texels(2);
+      ASSERT_EQ(texels.size(), static_cast<std::size_t>(size) * size);
+      for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x)
+          ASSERT_EQ(texels[static_cast<std::size_t>(y) * size + x],
+                    mask.tiles[2][static_cast<std::size_t>(y / tile) * n + x / tile])
+              << "tile " << tile << " size " << size << " texel " << x << "," << y;
+      EXPECT_EQ(mask.texels(0), std::vector<std::uint8_t>(static_cast<std::size_t>(size) * size, 0));
+    }
+}
+
 TEST(CubeMapDistance, EqualsOracleHitDistanceInEveryFace) {
   // A closed room around o with a torus and loose triangles in it: every texel hits.
   Scene scene;
