@@ -425,7 +425,15 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
   TileBins bins;
   VisibilityBuffer vis;
   GBuffer gb;
-  for (std::size_t c = 0; c < cameras.size(); ++c) {
+  // Largest images first: the planes above are then sized once, by the first image, and
+  // shrink for the others (growing them would value-initialize the growth on this thread).
+  // Each image writes its own range of `out`, so the order changes no byte.
+  std::vector<std::size_t> order(cameras.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return std::size_t(cameras[a].width) * cameras[a].height > std::size_t(cameras[b].width) * cameras[b].height;
+  });
+  for (const std::size_t c : order) {
     const SoffCamera& cam = cameras[c];
     if (!cam.valid) continue;
     ++st.images;
@@ -447,11 +455,10 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
     positions.resize(3 * kept.size());
     vertices.resize(3 * kept.size());
     objects.resize(kept.size());
-    if (indices.size() < 3 * kept.size()) {
-      const std::size_t old = indices.size();
-      indices.resize(3 * kept.size());
-      std::iota(indices.begin() + std::ptrdiff_t(old), indices.end(), std::uint32_t(old));
-    }
+    // 0, 1, 2, ... one index per kept vertex (grown by iota, so the kept prefix stays).
+    const std::size_t had = indices.size();
+    indices.resize(3 * kept.size());
+    if (indices.size() > had) std::iota(indices.begin() + std::ptrdiff_t(had), indices.end(), std::uint32_t(had));
     const Viewport vp{cam.width, cam.height};
     const glm::mat4 vp_matrix = cam.view_projection();
     executor.parallel_for("soff_depth_images.vertices", kept.size(), 4096, [&](std::size_t begin, std::size_t end) {
@@ -462,10 +469,11 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
       }
       make_screen_vertices(vp_matrix, &positions[3 * begin], 3 * (end - begin), vp, &vertices[3 * begin]);
     });
-    const std::vector<std::uint32_t> used(indices.begin(), indices.begin() + std::ptrdiff_t(3 * kept.size()));
-    rasterize_screen_vertices(executor, vertices, used, objects, cam.width, cam.height, {}, bins, vis);
-    for (auto& t : vis.triangle.pixels)
-      if (t != kNoId) t = kept[t];
+    rasterize_screen_vertices(executor, vertices, indices, objects, cam.width, cam.height, {}, bins, vis);
+    executor.parallel_for("soff_depth_images.ids", vis.triangle.size(), 8192, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        if (vis.triangle.pixels[i] != kNoId) vis.triangle.pixels[i] = kept[vis.triangle.pixels[i]];
+    });
     resolve_gbuffer(executor, scene, vis, cam.eye, gb);
     const std::size_t base = out.offsets[c];
     executor.parallel_for("soff_depth_images.shade", gb.object.size(), 2048, [&](std::size_t begin, std::size_t end) {
