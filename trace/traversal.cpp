@@ -126,7 +126,7 @@ Hit closest_hit_limited_stack(const Bvh& bvh, const Ray& ray, int stack_limit, T
         if (hits > 2) {
           // Push all but the nearest, far to near, in one store of the sorted lanes; the
           // runner-up (the likely next pop) starts its cache lines now.
-          const __m256i order = wide::children_far_to_near(bits, tnv);
+          const __m256i order = wide::order_far_to_near(bits, tnv);
           const __m256i refs = _mm256_permutevar8x32_epi32(
               _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)), order);
           const __m256 tns = _mm256_permutevar8x32_ps(tnv, order);

@@ -1,9 +1,10 @@
-// The two hot kernels of 8-wide BVH traversal (bvh.h) written with AVX2 intrinsics (the
-// build targets x86-64-v3): 8 child boxes against one ray, and the watertight triangle test
-// (ray_triangle.h) on a 4-triangle pack. Why not Lanes<W>: fixed_size simd emitted
-// out-of-line min/max calls and bitset masks in this loop (perf: ~1/3 of traversal time).
-// Both keep the exact operation sequence of their scalar definitions (slab test widened
-// as in Ize 2013; watertight test of Woop et al. 2013), so results are bit-identical.
+// The hot kernels of 8-wide BVH traversal (bvh.h) written with AVX2 intrinsics (the build
+// targets x86-64-v3): 8 child boxes against one ray, the order of the entered children, and
+// the watertight triangle test (ray_triangle.h) on a 4-triangle pack. Why not Lanes<W>:
+// fixed_size simd emitted out-of-line min/max calls and bitset masks in this loop (perf:
+// ~1/3 of traversal time). The two tests keep the exact operation sequence of their scalar
+// definitions (slab test widened as in Ize 2013; watertight test of Woop et al. 2013), so
+// results are bit-identical.
 #pragma once
 
 #include <immintrin.h>
@@ -123,7 +124,7 @@ template <int kMinLanes>
 // last. Dropping 3 mantissa bits only reorders children whose entries differ by less
 // than 2^-20 relative: the order is a heuristic, the closest hit does not depend on it.
 // Lanes 0..hits-1 of the result hold the entered children's lanes, farthest first.
-[[gnu::always_inline]] inline __m256i children_far_to_near(unsigned bits, __m256 tnear) {
+[[gnu::always_inline]] inline __m256i order_far_to_near(unsigned bits, __m256 tnear) {
   const __m256i b = _mm256_castps_si256(tnear);
   const __m256i flip = _mm256_or_si256(_mm256_srai_epi32(b, 31), _mm256_set1_epi32(INT32_MIN));
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);

@@ -1,5 +1,5 @@
 // The order in which the single-ray traversal pushes a node's entered children
-// (wide::children_far_to_near): every entered lane exactly once, farthest first, for every
+// (wide::order_far_to_near): every entered lane exactly once, farthest first, for every
 // set of entered lanes and entry distances of either sign, equal or a few ulps apart.
 #include <gtest/gtest.h>
 
@@ -35,7 +35,7 @@ TEST(ChildOrder, EnteredChildrenComeFarToNear) {
     for (unsigned bits = 1; bits < 256; ++bits) {
       alignas(32) std::int32_t order[kWideArity];
       _mm256_store_si256(reinterpret_cast<__m256i*>(order),
-                         wide::children_far_to_near(bits, _mm256_load_ps(tn)));
+                         wide::order_far_to_near(bits, _mm256_load_ps(tn)));
       const int hits = __builtin_popcount(bits);
       unsigned seen = 0;
       for (int i = 0; i < hits; ++i) {
