@@ -176,16 +176,17 @@ double CubeTileMask::texel_count(unsigned face_mask) const {
 }
 
 CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
-                        const CubeMapOptions& options, const CubeFaceShader& shade) {
+                        const CubeMapOptions& options, const CubeFaceShader& shade,
+                        CubeMapScratch* scratch) {
   CubeMap cube;
   cube.size = options.size;
   cube.centre = centre;
-  // One G-buffer for every face: its planes (about 90 bytes a texel) are allocated and
-  // cleared once, not once per face on the thread that launches the face's passes.
-  GBuffer g;
-  // The same for the rasterizer's bins and the visibility planes.
-  RasterWorkspace workspace;
-  VisibilityBuffer vis;
+  // One set of planes for every face (the G-buffer's are about 90 bytes a texel): allocated
+  // and cleared once, not once per face on the thread that launches the face's passes.
+  CubeMapScratch own;
+  CubeMapScratch& s = scratch ? *scratch : own;
+  GBuffer& g = s.g;
+  VisibilityBuffer& vis = s.vis;
   for (int face = 0; face < kCubeFaces; ++face) {
     if (!((options.face_mask >> face) & 1u)) {
       cube.distance[face] = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
@@ -193,7 +194,7 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
       continue;
     }
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
-    render_visibility(executor, scene, cam, options.size, options.size, options.raster, workspace, vis);
+    render_visibility(executor, scene, cam, options.size, options.size, options.raster, s.workspace, vis);
     // Texels no reader reaches become background: not resolved, not shaded.
     std::vector<std::uint8_t> read;
     if (options.tiles && options.tiles->active()) {

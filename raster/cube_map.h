@@ -151,9 +151,19 @@ struct CubeMapOptions {
   }
 };
 
+// The memory one face at a time needs (raster bins, visibility and G-buffer planes). A caller
+// that renders several maps passes one to all of them, so that each map does not allocate,
+// zero and fault in its own planes on the launching thread; every face rewrites all of it.
+struct CubeMapScratch {
+  RasterWorkspace workspace;
+  VisibilityBuffer vis;
+  GBuffer g;
+};
+
 // Renders the six faces: visibility → G-buffer → `shade` (skipped when empty: a
-// distance-only map, as for shadow maps).
+// distance-only map, as for shadow maps). Without `scratch` the map uses its own.
 CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
-                        const CubeMapOptions& options, const CubeFaceShader& shade = {});
+                        const CubeMapOptions& options, const CubeFaceShader& shade = {},
+                        CubeMapScratch* scratch = nullptr);
 
 }  // namespace speculum::raster

@@ -435,6 +435,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     const SurfaceParams s = surface_params(scene.materials[i]);
     if (is_specular(s)) reads[i] = {true, s.is_refractor(), map_lookup_exponent(scene.materials[i], s)};
   }
+  CubeMapScratch scratch;  // shared by the maps (each face rewrites it)
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     const Object& object = scene.objects[o];
     if (skip && o < skip->size() && (*skip)[o]) continue;
@@ -500,7 +501,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
         }
         return composite(executor, direct, envmap_reflect(executor, g, env));
       };
-    CubeMap cube = render_cube_map(executor, scene, centre, opt, shade);
+    CubeMap cube = render_cube_map(executor, scene, centre, opt, shade, &scratch);
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
     out.maps.push_back(sizing.colour_read ? environment_from_faces(executor, cube.colour, false, levels, opt.face_mask,
                                                                    tiles.active() ? &tiles : nullptr)

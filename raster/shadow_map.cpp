@@ -60,6 +60,7 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
   const Bounds b = scene.bounds();
   const glm::vec3 centre = b.valid() ? b.center() : glm::vec3(0.0f);
   const float radius = b.valid() ? std::max(0.5f * glm::length(b.extent()), 1e-3f) : 1.0f;
+  CubeMapScratch scratch;  // shared by the lights' cube maps
   for (const Light& light : scene.lights) {
     ShadowMap m;
     m.type = light.type;
@@ -91,7 +92,7 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
       opt.zfar = 4.0f * radius + glm::length(light.position - centre);
       if (light.type == LightType::Spot) opt.face_mask = spot_cone_faces(light, size);
       m.faces = opt.face_mask;
-      m.cube = render_cube_map(executor, scene, light.position, opt);
+      m.cube = render_cube_map(executor, scene, light.position, opt, {}, &scratch);
     }
     maps.push_back(std::move(m));
   }
