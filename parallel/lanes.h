@@ -159,8 +159,9 @@ struct Lanes {
   // Always inlined: GCC kept it as a call taking and returning lanes through memory (5 % of
   // a cube-map technique's frame).
   template <class T>
-  [[gnu::always_inline]] static stdx::fixed_size_simd<T, W> clamp(const stdx::fixed_size_simd<T, W>& v, const stdx::fixed_size_simd<T, W>& lo,
-                                           const stdx::fixed_size_simd<T, W>& hi) {
+  [[gnu::always_inline]] static stdx::fixed_size_simd<T, W> clamp(const stdx::fixed_size_simd<T, W>& v,
+                                                                 const stdx::fixed_size_simd<T, W>& lo,
+                                                                 const stdx::fixed_size_simd<T, W>& hi) {
     return select(v < lo, lo, select(hi < v, hi, v));
   }
   static f32 sqrt(const f32& v) { return stdx::sqrt(v); }  // correctly rounded per lane

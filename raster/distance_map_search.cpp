@@ -31,8 +31,7 @@ struct CubeMarch {
     // no float-to-int conversion may see) read texel 0 of face 0 instead.
     const i32 last(map.size - 1), zero(0);
     const f32 at_x = L::select(reads, c.x, f32(0.0f)), at_y = L::select(reads, c.y, f32(0.0f));
-    const i32 tx = L::max(L::min(L::to_int(at_x), last), zero);
-    const i32 ty = L::max(L::min(L::to_int(at_y), last), zero);
+    const i32 tx = L::clamp(L::to_int(at_x), zero, last), ty = L::clamp(L::to_int(at_y), zero, last);
     const i32 face = L::select(reads, c.face, zero);
     alignas(32) std::int32_t fx[8], px[8], py[8];
     L::store_aligned(face, fx), L::store_aligned(tx, px), L::store_aligned(ty, py);

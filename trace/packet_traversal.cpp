@@ -44,8 +44,7 @@ struct Packet {
   // When every ray has the same watertight axis permutation (kx, ky, kz), the leaf test
   // runs across the rays, one triangle at a time: the shear in lanes.
   bool common_shear = false;
-  int kx = 0, ky = 1, kz = 2;
-  std::uint32_t offx = 0, offy = 16, offz = 32;  // byte offsets of the kx/ky/kz rows in a vertex block
+  std::uint32_t offx = 0, offy = 0, offz = 0;  // the common kx/ky/kz rows (wide::pack_axis_offset)
   alignas(32) float okx[kMaxPacketSize], oky[kMaxPacketSize], okz[kMaxPacketSize];
   alignas(32) float sx[kMaxPacketSize], sy[kMaxPacketSize], sz[kMaxPacketSize];
   // Packet bounds for the interval node test.
@@ -154,13 +153,13 @@ bool prepare(const Ray* rays, int count, Packet& p) {
     p.okx[r] = sh.origin[sh.kx]; p.oky[r] = sh.origin[sh.ky]; p.okz[r] = sh.origin[sh.kz];
     p.sx[r] = sh.sx; p.sy[r] = sh.sy; p.sz[r] = sh.sz;
   }
-  p.kx = p.shear[0].kx; p.ky = p.shear[0].ky; p.kz = p.shear[0].kz;
-  p.offx = 16u * static_cast<std::uint32_t>(p.kx);
-  p.offy = 16u * static_cast<std::uint32_t>(p.ky);
-  p.offz = 16u * static_cast<std::uint32_t>(p.kz);
+  const RayShear& first = p.shear[0];
+  p.offx = wide::pack_axis_offset(first.kx);
+  p.offy = wide::pack_axis_offset(first.ky);
+  p.offz = wide::pack_axis_offset(first.kz);
   p.common_shear = true;
   for (int r = 1; r < count; ++r)
-    if (p.shear[r].kx != p.kx || p.shear[r].ky != p.ky || p.shear[r].kz != p.kz) p.common_shear = false;
+    if (p.shear[r].kx != first.kx || p.shear[r].ky != first.ky || p.shear[r].kz != first.kz) p.common_shear = false;
   constexpr std::uint32_t row = kWideArity * sizeof(float), hi = 3 * row;
   for (int a = 0; a < 3; ++a) {
     if (std::signbit(ilo[a]) != std::signbit(ihi[a])) return false;  // mixed signs (±0 directions)
@@ -195,7 +194,7 @@ struct Entry {
   // Vertex v's kx/ky/kz coordinates of triangle l: rows of the pack picked by byte offset.
   const char* base = reinterpret_cast<const char*>(&pk) + 4 * l;
   auto coord = [base](std::uint32_t vertex, std::uint32_t off) {
-    return _mm256_broadcast_ss(reinterpret_cast<const float*>(base + 48u * vertex + off));
+    return _mm256_broadcast_ss(reinterpret_cast<const float*>(base + wide::pack_vertex_offset(vertex) + off));
   };
   const __m256 okx = _mm256_load_ps(p.okx + h), oky = _mm256_load_ps(p.oky + h), okz = _mm256_load_ps(p.okz + h);
   const __m256 sx = _mm256_load_ps(p.sx + h), sy = _mm256_load_ps(p.sy + h), sz = _mm256_load_ps(p.sz + h);

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 
@@ -143,6 +144,13 @@ template <int kMinLanes>
   return _mm256_and_si256(x, _mm256_set1_epi32(7));
 }
 
+// Byte offsets into a TrianglePack: the block of vertex v (a, b, c: 0, 1, 2) and, within it,
+// the row of axis a (x, y, z: 0, 1, 2); lane l is 4 l bytes further.
+constexpr std::uint32_t pack_vertex_offset(std::uint32_t v) { return v * 3u * sizeof(float[4]); }
+constexpr std::uint32_t pack_axis_offset(int a) { return static_cast<std::uint32_t>(a) * sizeof(float[4]); }
+static_assert(offsetof(TrianglePack, by) == pack_vertex_offset(1) + pack_axis_offset(1));
+static_assert(offsetof(TrianglePack, cz) == pack_vertex_offset(2) + pack_axis_offset(2));
+
 // A ray prepared for the pack kernel: the watertight shear (axis permutation as byte
 // offsets into a TrianglePack, shear factors and origin broadcast).
 struct PackRay {
@@ -153,9 +161,9 @@ struct PackRay {
   explicit PackRay(const RayShear& s) : shear(&s) {
     okx = _mm_set1_ps(s.origin[s.kx]); oky = _mm_set1_ps(s.origin[s.ky]); okz = _mm_set1_ps(s.origin[s.kz]);
     sx = _mm_set1_ps(s.sx); sy = _mm_set1_ps(s.sy); sz = _mm_set1_ps(s.sz);
-    offx = static_cast<std::uint32_t>(s.kx) * 16u;
-    offy = static_cast<std::uint32_t>(s.ky) * 16u;
-    offz = static_cast<std::uint32_t>(s.kz) * 16u;
+    offx = pack_axis_offset(s.kx);
+    offy = pack_axis_offset(s.ky);
+    offz = pack_axis_offset(s.kz);
   }
 };
 
@@ -167,7 +175,7 @@ struct PackRay {
                                                       float (&t)[4], float (&u)[4], float (&v)[4]) {
   const char* base = reinterpret_cast<const char*>(&p);
   auto row = [base](std::uint32_t vertex, std::uint32_t off) {
-    return _mm_load_ps(reinterpret_cast<const float*>(base + vertex * 48u + off));
+    return _mm_load_ps(reinterpret_cast<const float*>(base + pack_vertex_offset(vertex) + off));
   };
   const __m128 Akx = _mm_sub_ps(row(0, r.offx), r.okx), Aky = _mm_sub_ps(row(0, r.offy), r.oky),
                Akz = _mm_sub_ps(row(0, r.offz), r.okz);
