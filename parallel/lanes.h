@@ -41,6 +41,11 @@
 // on W either.
 #pragma once
 
+// Masks of one width convert implicitly between element types of one size (float, int32,
+// uint32), as fixed_size masks do; must precede every inclusion of <experimental/simd>.
+#ifndef _GLIBCXX_SIMD_ENABLE_IMPLICIT_MASK_CAST
+#define _GLIBCXX_SIMD_ENABLE_IMPLICIT_MASK_CAST 1
+#endif
 #include <experimental/simd>
 
 #include <cstddef>
@@ -70,10 +75,15 @@ struct Lanes {
   static_assert(is_supported_lane_width(W), "Lanes<W>: W must be 1, 4, 8 or 16");
   static constexpr int width = W;
 
-  using f32 = stdx::fixed_size_simd<float, W>;
-  using i32 = stdx::fixed_size_simd<std::int32_t, W>;
-  using u32 = stdx::fixed_size_simd<std::uint32_t, W>;
-  // fixed_size masks of the same width convert implicitly between element types, so one
+  // The native register ABI where W lanes of T fill one (their masks stay vector masks: a
+  // fixed_size mask is a bit mask, and every compare then select went vector -> bits ->
+  // vector), fixed_size otherwise.
+  template <class T>
+  using simd = stdx::simd<T, stdx::simd_abi::deduce_t<T, W>>;
+  using f32 = simd<float>;
+  using i32 = simd<std::int32_t>;
+  using u32 = simd<std::uint32_t>;
+  // Masks of the same width convert implicitly between these element types, so one
   // mask type serves float, int and uint comparisons.
   using mask = typename f32::mask_type;
   using imask = typename i32::mask_type;
@@ -91,46 +101,46 @@ struct Lanes {
   // ---- memory ---------------------------------------------------------------------------
   template <class T>
   static auto load(const T* p) {
-    return stdx::fixed_size_simd<T, W>(p, stdx::element_aligned);
+    return simd<T>(p, stdx::element_aligned);
   }
   // p must be aligned to stdx::memory_alignment_v (alignof the simd type).
   template <class T>
   static auto load_aligned(const T* p) {
-    return stdx::fixed_size_simd<T, W>(p, stdx::vector_aligned);
+    return simd<T>(p, stdx::vector_aligned);
   }
   // Reads only p[0, count); other lanes get `fill`. Never touches memory past the stream.
   template <class T>
   static auto load_partial(const T* p, int count, T fill = T{}) {
-    return stdx::fixed_size_simd<T, W>([&](auto i) { return int(i) < count ? p[i] : fill; });
+    return simd<T>([&](auto i) { return int(i) < count ? p[i] : fill; });
   }
   // base[index[lane]] for every lane (gather is free on the GPU model).
   template <class T, class Index>
-  static auto gather(const T* base, const stdx::fixed_size_simd<Index, W>& index) {
-    return stdx::fixed_size_simd<T, W>([&](auto i) { return base[index[i]]; });
+  static auto gather(const T* base, const simd<Index>& index) {
+    return simd<T>([&](auto i) { return base[index[i]]; });
   }
   // Gathers only active lanes (inactive indices may be out of range); others get `fill`.
   template <class T, class Index, class M>
-  static auto gather(const T* base, const stdx::fixed_size_simd<Index, W>& index, const M& active,
+  static auto gather(const T* base, const simd<Index>& index, const M& active,
                      T fill = T{}) {
-    return stdx::fixed_size_simd<T, W>(
+    return simd<T>(
         [&](auto i) { return active[i] ? base[index[i]] : fill; });
   }
   template <class T>
-  static void store(const stdx::fixed_size_simd<T, W>& v, T* p) {
+  static void store(const simd<T>& v, T* p) {
     v.copy_to(p, stdx::element_aligned);
   }
   template <class T>
-  static void store_aligned(const stdx::fixed_size_simd<T, W>& v, T* p) {
+  static void store_aligned(const simd<T>& v, T* p) {
     v.copy_to(p, stdx::vector_aligned);
   }
   template <class T>
-  static void store_partial(const stdx::fixed_size_simd<T, W>& v, T* p, int count) {
+  static void store_partial(const simd<T>& v, T* p, int count) {
     if (count >= W) return store(v, p);
     for (int i = 0; i < count; ++i) p[i] = v[i];
   }
   // Writes only the active lanes to p[lane] (contiguous; not a scatter).
   template <class T, class M>
-  static void store_masked(const stdx::fixed_size_simd<T, W>& v, T* p, const M& active) {
+  static void store_masked(const simd<T>& v, T* p, const M& active) {
     for (int i = 0; i < W; ++i)
       if (active[i]) p[i] = v[i];
   }
@@ -138,30 +148,30 @@ struct Lanes {
   // ---- element-wise ---------------------------------------------------------------------
   // select(m, a, b) = m ? a : b per lane.
   template <class T, class M>
-  static stdx::fixed_size_simd<T, W> select(const M& m, const stdx::fixed_size_simd<T, W>& a,
-                                            stdx::fixed_size_simd<T, W> b) {
-    stdx::where(typename stdx::fixed_size_simd<T, W>::mask_type(m), b) = a;
+  static simd<T> select(const M& m, const simd<T>& a,
+                                            simd<T> b) {
+    stdx::where(typename simd<T>::mask_type(m), b) = a;
     return b;
   }
   // min/max are defined as the scalar `b < a ? b : a` (and `a < b ? b : a`) so that NaN
   // and ±0 behave identically for every W (hardware min picks operands differently).
   template <class T>
-  static stdx::fixed_size_simd<T, W> min(const stdx::fixed_size_simd<T, W>& a,
-                                         const stdx::fixed_size_simd<T, W>& b) {
+  static simd<T> min(const simd<T>& a,
+                                         const simd<T>& b) {
     return select(b < a, b, a);
   }
   template <class T>
-  static stdx::fixed_size_simd<T, W> max(const stdx::fixed_size_simd<T, W>& a,
-                                         const stdx::fixed_size_simd<T, W>& b) {
+  static simd<T> max(const simd<T>& a,
+                                         const simd<T>& b) {
     return select(a < b, b, a);
   }
   // std::clamp per lane, in its order (v < lo first, then hi < v): a NaN stays NaN.
   // Always inlined: GCC kept it as a call taking and returning lanes through memory (5 % of
   // a cube-map technique's frame).
   template <class T>
-  [[gnu::always_inline]] static stdx::fixed_size_simd<T, W> clamp(const stdx::fixed_size_simd<T, W>& v,
-                                                                 const stdx::fixed_size_simd<T, W>& lo,
-                                                                 const stdx::fixed_size_simd<T, W>& hi) {
+  [[gnu::always_inline]] static simd<T> clamp(const simd<T>& v,
+                                                                 const simd<T>& lo,
+                                                                 const simd<T>& hi) {
     return select(v < lo, lo, select(hi < v, hi, v));
   }
   static f32 sqrt(const f32& v) { return stdx::sqrt(v); }  // correctly rounded per lane
@@ -169,9 +179,9 @@ struct Lanes {
   static i32 abs(const i32& v) { return stdx::abs(v); }
   // f(lane value) per lane: the width-independent way to use scalar math (std::exp, ...).
   template <class T, class F>
-  static auto map(const stdx::fixed_size_simd<T, W>& v, F&& f) {
+  static auto map(const simd<T>& v, F&& f) {
     using R = std::invoke_result_t<F&, T>;
-    return stdx::fixed_size_simd<R, W>([&](auto i) { return f(T(v[i])); });
+    return simd<R>([&](auto i) { return f(T(v[i])); });
   }
   static i32 to_int(const f32& v) { return stdx::static_simd_cast<i32>(v); }  // truncates
   static f32 to_float(const i32& v) { return stdx::static_simd_cast<f32>(v); }
@@ -190,20 +200,20 @@ struct Lanes {
   // Minimum / maximum over lanes, folded in lane order with the scalar min/max above so
   // that ties, NaN and ±0 resolve like a serial loop.
   template <class T>
-  static T hmin(const stdx::fixed_size_simd<T, W>& v) {
+  static T hmin(const simd<T>& v) {
     T r = v[0];
     for (int i = 1; i < W; ++i) r = T(v[i]) < r ? T(v[i]) : r;
     return r;
   }
   template <class T>
-  static T hmax(const stdx::fixed_size_simd<T, W>& v) {
+  static T hmax(const simd<T>& v) {
     T r = v[0];
     for (int i = 1; i < W; ++i) r = r < T(v[i]) ? T(v[i]) : r;
     return r;
   }
   // Lane of the minimum; ties go to the lowest lane (the serial argmin).
   template <class T>
-  static int argmin(const stdx::fixed_size_simd<T, W>& v) {
+  static int argmin(const simd<T>& v) {
     int best = 0;
     for (int i = 1; i < W; ++i)
       if (T(v[i]) < T(v[best])) best = i;
@@ -215,8 +225,8 @@ struct Lanes {
   // in memory through its whole loop (a store and a reload per step: the fused scan kernel
   // took a third longer).
   template <class T>
-  static T hadd(const stdx::fixed_size_simd<T, W>& v) {
-    using V = stdx::fixed_size_simd<T, W>;
+  static T hadd(const simd<T>& v) {
+    using V = simd<T>;
     alignas(stdx::memory_alignment_v<V>) T lanes[W];
     v.copy_to(lanes, stdx::vector_aligned);
     T r = lanes[0];
@@ -226,13 +236,13 @@ struct Lanes {
   // acc + v[0] + v[1] + ... over active lanes, in lane order: a serial element-order fold,
   // hence identical for every W when a kernel walks its elements in order.
   template <class T, class M>
-  static T accumulate(T acc, const stdx::fixed_size_simd<T, W>& v, const M& active) {
+  static T accumulate(T acc, const simd<T>& v, const M& active) {
     for (int i = 0; i < W; ++i)
       if (active[i]) acc = acc + T(v[i]);
     return acc;
   }
   template <class T>
-  static T accumulate(T acc, const stdx::fixed_size_simd<T, W>& v) {
+  static T accumulate(T acc, const simd<T>& v) {
     for (int i = 0; i < W; ++i) acc = acc + T(v[i]);
     return acc;
   }

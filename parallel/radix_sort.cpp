@@ -28,7 +28,7 @@ constexpr unsigned kMaxDigitBits = 11;  // 2048 buckets: counts and line buffers
 template <int W, class Key, class F>
 [[gnu::always_inline]] inline void for_each_digit(const Key* keys, std::size_t b, std::size_t e,
                                                   unsigned shift, Key mask, F&& f) {
-  using V = stdx::fixed_size_simd<Key, W>;
+  using V = typename Lanes<W>::template simd<Key>;
   std::size_t i = b;
   // vector_aligned asks for the simd type's alignment: 128 bytes for 16 lanes of 64 bits.
   alignas(stdx::memory_alignment_v<V>) Key digit[W];
@@ -71,7 +71,7 @@ WriteCombine<Key>& thread_write_combine(std::size_t buckets) {
 // OR over i of keys[i] ^ keys[0]: the bits that differ between keys (0: all equal).
 template <int W, class Key>
 Key varying_bits(Executor& ex, std::string_view name, std::span<const Key> keys, std::size_t chunk) {
-  using V = stdx::fixed_size_simd<Key, W>;
+  using V = typename Lanes<W>::template simd<Key>;
   const Key first = keys[0];
   return ex.parallel_reduce(
       launch_name(name, "varying_bits"), keys.size(), chunk, Key{0},
