@@ -132,7 +132,21 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
   // add_environment: the diffuse lobe's ambient light, then the rough lobes' lookups.
   radiance = radiance + diffuse_albedo_over_pi_lanes(brdf, view) * env_->irradiance8(nv);
   radiance.store(out, count);
-  for (int j = 0; j < count; ++j) out[j] = add_rough_lobe(out[j], *s[j], n[j], v[j], *env_);
+  // add_rough_lobe on the points with a rough lobe, their environment lookups in one call.
+  glm::vec3 along[8], environment[8];
+  float exponent[8];
+  int rough_lane[8], rough = 0;
+  for (int j = 0; j < count; ++j)
+    if (s[j]->has_rough_specular_lobe()) {
+      rough_lane[rough] = j, along[rough] = reflect(-v[j], n[j]), exponent[rough] = s[j]->phong_exponent;
+      ++rough;
+    }
+  if (rough == 0) return;
+  env_->radiance8(along, exponent, rough, environment);
+  for (int t = 0; t < rough; ++t) {
+    const int j = rough_lane[t];
+    out[j] += specular_reflectance(*s[j], glm::dot(n[j], v[j])) * environment[t];
+  }
 }
 
 ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffer& g,

@@ -54,16 +54,58 @@ glm::vec3 prefilter_texel(const std::array<ImageRGBA, kCubeFaces>& previous, int
   return sum;
 }
 
+// lookup_level for eight directions at once (d: lanes of x, y, z): per lane the operations
+// of lookup_level in its order (cube_coord8 is cube_coord per lane; then bilinear_face's
+// clamp, taps and weights), so every lane has the bits of the scalar call. out: r, g, b.
+[[gnu::always_inline]] inline void lookup_level8(const std::array<ImageRGBA, kCubeFaces>& level,
+                                                 const par::Lanes<8>::f32 (&d)[3], par::Lanes<8>::f32 (&out)[3]) {
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
+  using i32 = L::i32;
+  const int side = level[0].width;
+  const float last = static_cast<float>(side - 1);
+  const CubeCoordLanes cc = cube_coord8(d, side);
+  const i32& fi = cc.face;
+  const f32 &px = cc.x, &py = cc.y;
+  // bilinear_face
+  const f32 fx = L::clamp(px - 0.5f, f32(0.0f), f32(last)), fy = L::clamp(py - 0.5f, f32(0.0f), f32(last));
+  const i32 x0 = L::to_int(fx), y0 = L::to_int(fy);
+  const i32 x1 = L::min(x0 + 1, i32(side - 1)), y1 = L::min(y0 + 1, i32(side - 1));
+  const f32 tx = fx - L::to_float(x0), ty = fy - L::to_float(y0);
+  const f32 wx = 1.0f - tx, wy = 1.0f - ty;
+  const i32 row0 = y0 * side, row1 = y1 * side;
+  const i32 taps[4] = {(row0 + x0) * 4, (row0 + x1) * 4, (row1 + x0) * 4, (row1 + x1) * 4};
+  const float* pixels[kCubeFaces];
+  for (int f = 0; f < kCubeFaces; ++f) pixels[f] = &level[f].pixels[0].x;
+  // Each lane's tap texel loaded as one RGBA row, lanes j and j + 4 in the two halves of a
+  // register, and the rows transposed into channels within the halves: the values one load
+  // per channel would give. Whole registers are stored (a 256-bit load of two 128-bit
+  // stores would wait for them to reach the cache).
+  alignas(32) float channel[4][3][8];  // [tap][channel][lane]
+  for (int q = 0; q < 4; ++q) {
+    __m256 r[4];
+    for (int j = 0; j < 4; ++j)
+      r[j] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(pixels[fi[j]] + taps[q][j])),
+                                  _mm_loadu_ps(pixels[fi[j + 4]] + taps[q][j + 4]), 1);
+    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+    const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    _mm256_store_ps(channel[q][0], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+    _mm256_store_ps(channel[q][1], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+    _mm256_store_ps(channel[q][2], _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+  }
+  for (int c = 0; c < 3; ++c) {
+    const auto tap = [&](int q) { return L::load_aligned(channel[q][c]); };
+    out[c] = (tap(0) * wx + tap(1) * tx) * wy + (tap(2) * wx + tap(3) * tx) * ty;
+  }
+}
+
 // Eight texels of one face at once, lane j = texel first + j: per lane the operations of
-// prefilter_texel in its order (lookup_level's face choice and projection, whose dot products
-// with the face's signed unit axes are one signed component: the same value, up to the sign
-// of a zero that the +1 of the pixel mapping removes; the bilinear weights; the sum over k
-// in order), so the result has the same bits for every texel.
+// prefilter_texel in its order (the lookups of lookup_level8, the sum over k in order), so
+// the result has the same bits for every texel.
 void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int face, int s, std::size_t first,
                        const glm::vec3* local, int count, glm::vec3* out) {
   using L = par::Lanes<8>;
   using f32 = L::f32;
-  using i32 = L::i32;
   alignas(32) float t[3][8], b[3][8], n[3][8];
   for (int j = 0; j < 8; ++j) {
     const std::size_t i = first + static_cast<std::size_t>(j);
@@ -73,45 +115,12 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
   }
   f32 tv[3], bv[3], nv[3];
   for (int c = 0; c < 3; ++c) tv[c] = L::load(t[c]), bv[c] = L::load(b[c]), nv[c] = L::load(n[c]);
-  const int side = previous[0].width;
-  const float last = static_cast<float>(side - 1);
-  const float* pixels[kCubeFaces];
-  for (int f = 0; f < kCubeFaces; ++f) pixels[f] = &previous[f].pixels[0].x;
   f32 sum[3] = {f32(0.0f), f32(0.0f), f32(0.0f)};
   for (int k = 0; k < count; ++k) {
-    f32 d[3];
+    f32 d[3], texel[3];
     for (int c = 0; c < 3; ++c) d[c] = (local[k].x * tv[c] + local[k].y * bv[c]) + local[k].z * nv[c];
-    const CubeCoordLanes cc = cube_coord8(d, side);
-    const i32& fi = cc.face;
-    const f32 &px = cc.x, &py = cc.y;
-    // bilinear_face
-    const f32 fx = L::clamp(px - 0.5f, f32(0.0f), f32(last)), fy = L::clamp(py - 0.5f, f32(0.0f), f32(last));
-    const i32 x0 = L::to_int(fx), y0 = L::to_int(fy);
-    const i32 x1 = L::min(x0 + 1, i32(side - 1)), y1 = L::min(y0 + 1, i32(side - 1));
-    const f32 tx = fx - L::to_float(x0), ty = fy - L::to_float(y0);
-    const f32 wx = 1.0f - tx, wy = 1.0f - ty;
-    const i32 row0 = y0 * side, row1 = y1 * side;
-    const i32 taps[4] = {(row0 + x0) * 4, (row0 + x1) * 4, (row1 + x0) * 4, (row1 + x1) * 4};
-    // Each lane's tap texel loaded as one RGBA row, lanes j and j + 4 in the two halves of a
-    // register, and the rows transposed into channels within the halves: the values one load
-    // per channel would give. Whole registers are stored (a 256-bit load of two 128-bit
-    // stores would wait for them to reach the cache).
-    alignas(32) float channel[4][3][8];  // [tap][channel][lane]
-    for (int q = 0; q < 4; ++q) {
-      __m256 r[4];
-      for (int j = 0; j < 4; ++j)
-        r[j] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(pixels[fi[j]] + taps[q][j])),
-                                    _mm_loadu_ps(pixels[fi[j + 4]] + taps[q][j + 4]), 1);
-      const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-      const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-      _mm256_store_ps(channel[q][0], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
-      _mm256_store_ps(channel[q][1], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
-      _mm256_store_ps(channel[q][2], _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
-    }
-    for (int c = 0; c < 3; ++c) {
-      const auto tap = [&](int q) { return L::load_aligned(channel[q][c]); };
-      sum[c] += (tap(0) * wx + tap(1) * tx) * wy + (tap(2) * wx + tap(3) * tx) * ty;
-    }
+    lookup_level8(previous, d, texel);
+    for (int c = 0; c < 3; ++c) sum[c] += texel[c];
   }
   for (int j = 0; j < 8; ++j) out[j] = glm::vec3(sum[0][j], sum[1][j], sum[2][j]);
 }
@@ -270,6 +279,42 @@ glm::vec3 EnvironmentMap::radiance(const glm::vec3& d, float phong_exponent) con
   const float t = level - l0;
   const glm::vec3 a = lookup_level(levels[l0], d);
   return t > 0.0f ? a * (1.0f - t) + lookup_level(levels[l1], d) * t : a;
+}
+
+void EnvironmentMap::radiance8(const glm::vec3* d, const float* phong_exponent, int count, glm::vec3* out) const {
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
+  const int last = static_cast<int>(levels.size()) - 1;
+  // radiance's level per lane; a run of equal exponents (one material) computes it once.
+  alignas(32) float level[8];
+  for (int j = 0; j < 8; ++j) {
+    const int k = j < count ? j : 0;  // lanes past `count` repeat lane 0, dropped below
+    level[j] = k > 0 && phong_exponent[k] == phong_exponent[k - 1]
+                   ? level[k - 1]
+                   : std::min(lobe_level(size, phong_exponent[k]), float(last));
+  }
+  const int l0 = static_cast<int>(level[0]);
+  bool shared = true;  // one level pair for every lane: one lookup per level in lanes
+  for (int j = 1; j < count; ++j) shared &= static_cast<int>(level[j]) == l0;
+  if (!shared) {
+    for (int j = 0; j < count; ++j) out[j] = radiance(d[j], phong_exponent[j]);
+    return;
+  }
+  alignas(32) float dir[3][8];
+  for (int j = 0; j < 8; ++j)
+    for (int c = 0; c < 3; ++c) dir[c][j] = d[j < count ? j : 0][c];
+  f32 dv[3];
+  for (int c = 0; c < 3; ++c) dv[c] = L::load_aligned(dir[c]);
+  f32 a[3];
+  lookup_level8(levels[l0], dv, a);
+  const f32 t = L::load_aligned(level) - float(l0);
+  const L::mask blend = t > 0.0f;
+  if (L::any(blend)) {
+    f32 b[3];
+    lookup_level8(levels[std::min(l0 + 1, last)], dv, b);
+    for (int c = 0; c < 3; ++c) a[c] = L::select(blend, a[c] * (1.0f - t) + b[c] * t, a[c]);
+  }
+  for (int j = 0; j < count; ++j) out[j] = glm::vec3(a[0][j], a[1][j], a[2][j]);
 }
 
 glm::vec3 EnvironmentMap::irradiance(const glm::vec3& n) const {

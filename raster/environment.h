@@ -27,6 +27,9 @@ struct EnvironmentMap {
   // Radiance arriving along -d (d: unit direction leaving the scene) through a Phong lobe of
   // exponent n (≥ 1e6: mirror): trilinear across the levels matching the lobe width.
   glm::vec3 radiance(const glm::vec3& d, float phong_exponent) const;
+  // radiance(d[j], phong_exponent[j]) for j < count (1..8), each with the scalar call's bits;
+  // directions that read the same levels are looked up together in lanes.
+  void radiance8(const glm::vec3* d, const float* phong_exponent, int count, glm::vec3* out) const;
   // Irradiance E(n) on a surface with unit normal n from the SH coefficients.
   glm::vec3 irradiance(const glm::vec3& n) const;
   // irradiance() at eight normals, each lane with its bits.

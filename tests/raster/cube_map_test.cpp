@@ -270,6 +270,41 @@ TEST(Environment, PrefilteredTexelsAreTheMeanOfTheirLobesLookups) {
   }
 }
 
+// radiance8 against radiance, bit for bit: batches of 1..8 directions (axis-aligned ones and
+// face edges among them) with one exponent, with a run of equal exponents, and with mixed
+// exponents (mirror, between levels, coarsest level, past the last level).
+TEST(Environment, EightLookupsHaveTheBitsOfOneAtATime) {
+  const int size = 32;
+  std::mt19937 rng(9);
+  par::Executor ex(2);
+  const EnvironmentMap map = environment_from_faces(ex, random_cube_faces(size, rng), false);
+  std::normal_distribution<float> g;
+  std::uniform_int_distribution<int> pick(0, 6);
+  const float exponents[7] = {1e6f, 5000.0f, 800.0f, 245.0f, 40.0f, 3.0f, 1.0f};
+  int mixed_batches = 0;
+  for (int batch = 0; batch < 3000; ++batch) {
+    const int count = 1 + batch % 8, mode = (batch / 8) % 3;
+    glm::vec3 d[8], got[8];
+    float n[8];
+    for (int j = 0; j < count; ++j) {
+      d[j] = batch % 50 == 0 && j < 3 ? glm::vec3(j == 0, j == 1, j == 2) * (j % 2 ? -1.0f : 1.0f)
+                                      : glm::normalize(glm::vec3{g(rng), g(rng), g(rng)});
+      if (batch % 37 == 0) d[j] = glm::normalize(glm::vec3(1.0f, 1.0f, g(rng)));  // face edges
+      n[j] = mode == 0 ? exponents[batch % 7] : mode == 1 ? exponents[std::min(j / 3 + batch % 5, 6)]
+                                                          : exponents[pick(rng)];
+    }
+    bool mixed = false;
+    for (int j = 1; j < count; ++j) mixed |= n[j] != n[0];
+    mixed_batches += mixed;
+    map.radiance8(d, n, count, got);
+    for (int j = 0; j < count; ++j) {
+      const glm::vec3 want = map.radiance(d[j], n[j]);
+      ASSERT_EQ(0, std::memcmp(&want, &got[j], sizeof want)) << "batch " << batch << " lane " << j << " n " << n[j];
+    }
+  }
+  EXPECT_GT(mixed_batches, 500);
+}
+
 TEST(Environment, TruncatedLevelsGiveTheSameRadianceForTheLobesTheyServe) {
   // A random-texture cube (every level differs), prefiltered fully and only to the levels
   // levels_for_lobes says exponents ≥ n need: radiance() must agree bit for bit for every
