@@ -106,11 +106,12 @@ ReflectorSample ReflectorParam::operator()(const glm::dvec3& u) const {
   double w = 0.0, r = 0.0;
   glm::dvec3 n(0.0);
   for (int k = 0; k < 4; ++k) {
-    const float rk = radius[c.face].at(xs[k], ys[k]);
+    const glm::vec4& texel = texels[c.face].at(xs[k], ys[k]);
+    const float rk = texel.w;
     if (!std::isfinite(rk) || ws[k] <= 0.0) continue;
     w += ws[k];
     r += ws[k] * rk;
-    n += ws[k] * glm::dvec3(normal[c.face].at(xs[k], ys[k]));
+    n += ws[k] * glm::dvec3(glm::vec3(texel));
   }
   if (!(w > 1e-6) || !(glm::length(n) > 0.0)) return s;
   s.valid = true;
@@ -154,27 +155,25 @@ ReflectorParams build_reflector_params(par::Executor& executor, const Scene& sce
     for (int face = 0; face < kCubeFaces; ++face) {
       const Camera cam = cube_face_camera(face, centre, range.znear, range.zfar);
       const VisibilityBuffer vis = render_visibility(executor, scene, cam, size, size, options);
-      ImageF& radius = p.radius[face];
-      Buffer2D<glm::vec3>& normal = p.normal[face];
-      radius = ImageF(size, size, std::numeric_limits<float>::infinity());
-      normal = Buffer2D<glm::vec3>(size, size, glm::vec3(0.0f));
-      executor.parallel_for("reflector_param.texels", radius.size(), 4096, [&](std::size_t begin, std::size_t end) {
+      Buffer2D<glm::vec4>& texels = p.texels[face];
+      texels = Buffer2D<glm::vec4>(size, size, glm::vec4(0.0f, 0.0f, 0.0f, std::numeric_limits<float>::infinity()));
+      executor.parallel_for("reflector_param.texels", texels.size(), 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
           const std::uint32_t t = vis.triangle.pixels[i];
           if (t == kNoId) continue;
           const glm::vec2 bc = vis.bary.pixels[i];
           const std::uint32_t* idx = &scene.mesh.indices[3 * std::size_t(t)];
-          radius.pixels[i] = glm::length(visible_position(scene.mesh, vis, i) - centre);
+          const float r = glm::length(visible_position(scene.mesh, vis, i) - centre);
           const glm::vec3 n = (1.0f - bc.x - bc.y) * scene.mesh.normals[idx[0]] + bc.x * scene.mesh.normals[idx[1]] +
                               bc.y * scene.mesh.normals[idx[2]];
           const float l = glm::length(n);
-          normal.pixels[i] = l > 0.0f ? n / l : glm::vec3(0.0f);
+          texels.pixels[i] = glm::vec4(l > 0.0f ? n / l : glm::vec3(0.0f), r);
         }
       });
     }
-    for (const ImageF& face : p.radius)
-      for (float r : face.pixels)
-        if (std::isfinite(r)) p.max_radius = std::max(p.max_radius, double(r));
+    for (const Buffer2D<glm::vec4>& face : p.texels)
+      for (const glm::vec4& texel : face.pixels)
+        if (std::isfinite(texel.w)) p.max_radius = std::max(p.max_radius, double(texel.w));
     out.reflectors.push_back(std::move(p));
   }
   return out;

@@ -54,8 +54,9 @@ struct ReflectorParam {
   bool closed = false;  // no boundary edges: seen from outside only
   int size = 0;
   double max_radius = 0.0;  // the largest finite r
-  std::array<ImageF, 6> radius;
-  std::array<Buffer2D<glm::vec3>, 6> normal;
+  // Per face, per texel: the unit normal (xyz) and r (w; +inf: no surface that way), side by
+  // side so that a lookup's four taps read two cache lines rather than four.
+  std::array<Buffer2D<glm::vec4>, 6> texels;
   ReflectorSample operator()(const glm::dvec3& u) const;
 };
 

@@ -385,9 +385,15 @@ Drawing draw_output(const par::CapturedOutput& o, par::Executor& executor) {
   } else if (const auto* params = o.as<raster::ReflectorParams>()) {
     // Vertex projection's parameterization: r(u) of each reflector as a cube cross.
     d.size = std::to_string(params->reflectors.size()) + " reflectors";
-    for (std::size_t m = 0; m < params->reflectors.size() && m < kMaxListed; ++m)
-      if (has_faces(params->reflectors[m].radius))
-        d.views.push_back(distance_cross_view("radius" + std::to_string(m), params->reflectors[m].radius));
+    for (std::size_t m = 0; m < params->reflectors.size() && m < kMaxListed; ++m) {
+      std::array<ImageF, 6> radius;  // the texels' r
+      for (std::size_t f = 0; f < radius.size(); ++f) {
+        const Buffer2D<glm::vec4>& texels = params->reflectors[m].texels[f];
+        radius[f] = ImageF(texels.width, texels.height);
+        for (std::size_t i = 0; i < texels.size(); ++i) radius[f].pixels[i] = texels.pixels[i].w;
+      }
+      if (has_faces(radius)) d.views.push_back(distance_cross_view("radius" + std::to_string(m), radius));
+    }
   } else if (const auto* layer = o.as<raster::ReflectedLayer>()) {
     d.size = dims(layer->width, layer->height);
     d.views.push_back(scalar_view("iterations", layer->iterations));
