@@ -176,6 +176,7 @@ struct Lanes {
   }
   static f32 sqrt(const f32& v) { return stdx::sqrt(v); }  // correctly rounded per lane
   static f32 abs(const f32& v) { return stdx::abs(v); }
+  static f32 floor(const f32& v) { return stdx::floor(v); }  // exact
   static i32 abs(const i32& v) { return stdx::abs(v); }
   // f(lane value) per lane: the width-independent way to use scalar math (std::exp, ...).
   template <class T, class F>

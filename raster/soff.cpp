@@ -11,6 +11,7 @@
 #include "core/optics.h"
 #include "core/shading.h"
 #include "core/sampling.h"
+#include "parallel/lanes.h"
 #include "raster/direct_light.h"
 #include "raster/specular_radiance.h"
 #include "raster/tile_binning.h"
@@ -498,6 +499,50 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
 // ---------------------------------------------------------------------------------------
 // Intersection
 
+namespace {
+
+// What soff_walk's steps share: the segment's screen endpoints and the image.
+struct WalkSegment {
+  glm::vec3 a, b;  // projected near and far endpoints (x, y pixels; z = 1/z)
+  float dx, dy;
+  int steps, w, h;
+  const float* inv_z;
+};
+
+// The ray at step k of `steps` (the near endpoint at 0) and the stored 1/z under it (0
+// outside the image).
+struct WalkStep {
+  float ray, stored;
+  bool inside;
+};
+WalkStep stored_at(const WalkSegment& g, float ray, float sx, float sy) {
+  const int ix = int(std::floor(sx)), iy = int(std::floor(sy));
+  const bool inside = ix >= 0 && iy >= 0 && ix < g.w && iy < g.h;
+  return {ray, inside ? g.inv_z[std::size_t(iy) * std::size_t(g.w) + std::size_t(ix)] : 0.0f, inside};
+}
+WalkStep walk_step(const WalkSegment& g, int k) {
+  const float s = float(k) / float(g.steps);
+  // 1/z is linear in screen space.
+  return stored_at(g, g.a.z + (g.b.z - g.a.z) * s, g.a.x + g.dx * s, g.a.y + g.dy * s);
+}
+
+// walk_step for steps k .. k + 7 in lanes: per lane walk_step's operations in its order
+// (floor is exact, and so are the integer tests), so every lane has its bits.
+void walk_steps8(const WalkSegment& g, int k, float* ray, float* stored, std::uint8_t* inside) {
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
+  using i32 = L::i32;
+  const f32 s = L::to_float(L::iota(k)) / f32(float(g.steps));
+  const f32 sx = g.a.x + g.dx * s, sy = g.a.y + g.dy * s;
+  const i32 ix = L::to_int(L::floor(sx)), iy = L::to_int(L::floor(sy));
+  const L::imask in = ix >= 0 && iy >= 0 && ix < i32(g.w) && iy < i32(g.h);
+  L::store(g.a.z + (g.b.z - g.a.z) * s, ray);
+  L::store(L::gather(g.inv_z, L::select(in, iy * g.w + ix, i32(0)), in, 0.0f), stored);
+  for (int j = 0; j < 8; ++j) inside[j] = in[j];
+}
+
+}  // namespace
+
 SoffWalkResult soff_walk(const SoffCamera& cam, const float* inv_z, const glm::vec3& p, const glm::vec3& d) {
   SoffWalkResult res;
   const float dz = glm::dot(d, cam.w);
@@ -508,27 +553,39 @@ SoffWalkResult soff_walk(const SoffCamera& cam, const float* inv_z, const glm::v
   const float zp = glm::dot(p - cam.eye, cam.w);
   const glm::vec3 start = zp < cam.near_dist ? p + d * ((cam.near_dist - zp) / dz) : p;
   const glm::vec3 end = p + d * ((cam.far_dist - zp) / dz);
-  const glm::vec3 a = cam.project(start), b = cam.project(end);
-  const float dx = b.x - a.x, dy = b.y - a.y;
-  const int w = cam.width, h = cam.height;
-  const int steps = std::max(1, int(std::ceil(std::max(std::abs(dx), std::abs(dy)))));
-  auto stored = [&](float sx, float sy, bool& inside) {
-    const int ix = int(std::floor(sx)), iy = int(std::floor(sy));
-    inside = ix >= 0 && iy >= 0 && ix < w && iy < h;
-    return inside ? inv_z[std::size_t(iy) * std::size_t(w) + std::size_t(ix)] : 0.0f;
-  };
-  bool inside = true;
-  float ray_a = a.z, di_a = stored(a.x, a.y, inside);
-  if (!inside) return res;  // Miss: the ray starts outside the frame
+  WalkSegment g;
+  g.a = cam.project(start), g.b = cam.project(end);
+  g.dx = g.b.x - g.a.x, g.dy = g.b.y - g.a.y;
+  g.w = cam.width, g.h = cam.height;
+  g.inv_z = inv_z;
+  g.steps = std::max(1, int(std::ceil(std::max(std::abs(g.dx), std::abs(g.dy)))));
+  const WalkStep first = stored_at(g, g.a.z, g.a.x, g.a.y);
+  if (!first.inside) return res;  // Miss: the ray starts outside the frame
+  float ray_a = g.a.z, di_a = first.stored;
   float prev_jump = 0.0f;
   bool hidden = false;
-  for (int k = 1; k <= steps; ++k) {
-    const float s = float(k) / float(steps);
-    const float sx = a.x + dx * s, sy = a.y + dy * s;
-    const float ray_b = a.z + (b.z - a.z) * s;  // 1/z is linear in screen space
-    const float di_b = stored(sx, sy, inside);
+  for (int k = 1; k <= g.steps;) {
+    // Eight steps at a time while none of them can end the walk or change its state (a
+    // step outside the image, or a crossing from in front to behind): those only move the
+    // ray on. The step that can is taken below, one at a time, from the same values.
+    while (g.steps - k >= 7) {
+      alignas(32) float ray[9], stored[9];
+      std::uint8_t inside[8];
+      ray[0] = ray_a, stored[0] = di_a;
+      walk_steps8(g, k, ray + 1, stored + 1, inside);
+      int stop = 0;
+      while (stop < 8 && inside[stop] && !(ray[stop] - stored[stop] > 0.0f && ray[stop + 1] - stored[stop + 1] <= 0.0f))
+        ++stop;
+      res.steps += std::uint32_t(stop);
+      k += stop;
+      if (stop > 0) prev_jump = stored[stop] - stored[stop - 1], ray_a = ray[stop], di_a = stored[stop];
+      if (stop < 8) break;
+    }
+    if (k > g.steps) break;
+    const WalkStep step = walk_step(g, k);
+    const float ray_b = step.ray, di_b = step.stored;
     ++res.steps;
-    if (!inside) break;
+    if (!step.inside) break;
     // In front: the ray is nearer than the stored surface (larger 1/z); empty pixels (0)
     // never stop it.
     const float da = ray_a - di_a, db = ray_b - di_b;
@@ -540,19 +597,21 @@ SoffWalkResult soff_walk(const SoffCamera& cam, const float* inv_z, const glm::v
       const bool silhouette = di_b > ray_a && jump > 2.0f * std::max(std::abs(prev_jump), ray_a - ray_b);
       if (!silhouette) {
         const float frac = da / (da - db);
-        const float s_hit = (float(k - 1) + frac) / float(steps);
+        const float s_hit = (float(k - 1) + frac) / float(g.steps);
         res.kind = SoffWalkResult::Hit;
-        res.sx = a.x + dx * s_hit;
-        res.sy = a.y + dy * s_hit;
-        res.inv_z = a.z + (b.z - a.z) * s_hit;
+        res.sx = g.a.x + g.dx * s_hit;
+        res.sy = g.a.y + g.dy * s_hit;
+        res.inv_z = g.a.z + (g.b.z - g.a.z) * s_hit;
         return res;
       }
-      if (!hidden) res.sx = a.x + dx * (float(k - 1) / float(steps)), res.sy = a.y + dy * (float(k - 1) / float(steps));
+      if (!hidden)
+        res.sx = g.a.x + g.dx * (float(k - 1) / float(g.steps)), res.sy = g.a.y + g.dy * (float(k - 1) / float(g.steps));
       hidden = true;
     }
     prev_jump = jump;
     ray_a = ray_b;
     di_a = di_b;
+    ++k;
   }
   res.kind = hidden ? SoffWalkResult::Disoccluded : SoffWalkResult::Miss;
   return res;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <random>
 #include <set>
 
 #include <glm/geometric.hpp>
@@ -272,6 +273,110 @@ TEST(SoffIntersect, DepthRampWalkFindsTheAnalyticCrossing) {
   const SoffWalkResult hidden =
       soff_walk(cam, occluded.data(), {0.0f, 0.0f, 1.0f}, glm::normalize(glm::vec3(0.3f, 0.0f, 1.0f)));
   EXPECT_EQ(hidden.kind, SoffWalkResult::Disoccluded);
+}
+
+// The walk's definition, one step at a time (SOFF §3.4): the oracle of the walk below.
+SoffWalkResult walk_one_step_at_a_time(const SoffCamera& cam, const float* inv_z, const glm::vec3& p,
+                                       const glm::vec3& d) {
+  SoffWalkResult res;
+  const float dz = glm::dot(d, cam.w);
+  if (!(dz > 1e-4f)) {
+    res.kind = SoffWalkResult::Unrepresentable;
+    return res;
+  }
+  const float zp = glm::dot(p - cam.eye, cam.w);
+  const glm::vec3 start = zp < cam.near_dist ? p + d * ((cam.near_dist - zp) / dz) : p;
+  const glm::vec3 end = p + d * ((cam.far_dist - zp) / dz);
+  const glm::vec3 a = cam.project(start), b = cam.project(end);
+  const float dx = b.x - a.x, dy = b.y - a.y;
+  const int w = cam.width, h = cam.height;
+  const int steps = std::max(1, int(std::ceil(std::max(std::abs(dx), std::abs(dy)))));
+  auto stored = [&](float sx, float sy, bool& inside) {
+    const int ix = int(std::floor(sx)), iy = int(std::floor(sy));
+    inside = ix >= 0 && iy >= 0 && ix < w && iy < h;
+    return inside ? inv_z[std::size_t(iy) * std::size_t(w) + std::size_t(ix)] : 0.0f;
+  };
+  bool inside = true;
+  float ray_a = a.z, di_a = stored(a.x, a.y, inside);
+  if (!inside) return res;
+  float prev_jump = 0.0f;
+  bool hidden = false;
+  for (int k = 1; k <= steps; ++k) {
+    const float s = float(k) / float(steps);
+    const float sx = a.x + dx * s, sy = a.y + dy * s;
+    const float ray_b = a.z + (b.z - a.z) * s;
+    const float di_b = stored(sx, sy, inside);
+    ++res.steps;
+    if (!inside) break;
+    const float da = ray_a - di_a, db = ray_b - di_b;
+    const float jump = di_b - di_a;
+    if (da > 0.0f && db <= 0.0f) {
+      const bool silhouette = di_b > ray_a && jump > 2.0f * std::max(std::abs(prev_jump), ray_a - ray_b);
+      if (!silhouette) {
+        const float frac = da / (da - db);
+        const float s_hit = (float(k - 1) + frac) / float(steps);
+        res.kind = SoffWalkResult::Hit;
+        res.sx = a.x + dx * s_hit;
+        res.sy = a.y + dy * s_hit;
+        res.inv_z = a.z + (b.z - a.z) * s_hit;
+        return res;
+      }
+      if (!hidden) res.sx = a.x + dx * (float(k - 1) / float(steps)), res.sy = a.y + dy * (float(k - 1) / float(steps));
+      hidden = true;
+    }
+    prev_jump = jump;
+    ray_a = ray_b;
+    di_a = di_b;
+  }
+  res.kind = hidden ? SoffWalkResult::Disoccluded : SoffWalkResult::Miss;
+  return res;
+}
+
+// soff_walk takes eight steps at a time in lanes while none can end the walk: the same
+// result, bit for bit, as the walk one step at a time, on random depth images (a tilted
+// plane with occluding boxes, holes and speckle) and rays of every kind and length.
+TEST(SoffIntersect, WalkInLanesGivesTheBitsOfTheWalkOneStepAtATime) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  int kinds[4] = {}, long_walks = 0;
+  for (int image = 0; image < 40; ++image) {
+    SoffCamera cam;
+    cam.valid = true;
+    cam.eye = glm::vec3(0.0f);
+    cam.u = {1, 0, 0}, cam.v = {0, 1, 0}, cam.w = {0, 0, 1};
+    cam.near_dist = 1.0f, cam.far_dist = 20.0f;
+    cam.l = -1, cam.r = 1, cam.b = -1, cam.t = 1;
+    cam.width = 16 + image * 5, cam.height = 16 + image * 3;
+    const int w = cam.width, h = cam.height;
+    std::vector<float> inv_z(std::size_t(w) * std::size_t(h));
+    const float tilt = 0.6f * u(rng), depth = 4.0f + 2.0f * u(rng);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const glm::vec3 d = cam.pixel_direction(float(x) + 0.5f, float(y) + 0.5f);
+        inv_z[std::size_t(y) * std::size_t(w) + std::size_t(x)] = (1.0f - tilt * d.x / d.z) / depth;
+      }
+    for (int box = 0; box < 4; ++box) {  // occluders nearer than the plane, and holes (0)
+      const int x0 = int((u(rng) + 1.0f) * 0.5f * float(w)), y0 = int((u(rng) + 1.0f) * 0.5f * float(h));
+      const float value = box == 3 ? 0.0f : 1.0f / (1.5f + u(rng));
+      for (int y = y0; y < std::min(h, y0 + h / 4); ++y)
+        for (int x = x0; x < std::min(w, x0 + w / 5); ++x) inv_z[std::size_t(y) * std::size_t(w) + std::size_t(x)] = value;
+    }
+    for (int k = 0; k < w; ++k) inv_z[std::size_t(rng() % inv_z.size())] *= 1.0f + 0.2f * u(rng);
+    for (int ray = 0; ray < 300; ++ray) {
+      const glm::vec3 o(0.8f * u(rng), 0.8f * u(rng), 1.0f + 2.0f * (u(rng) + 1.0f));
+      const glm::vec3 d = glm::normalize(glm::vec3(u(rng), u(rng), ray % 10 == 0 ? u(rng) : 1.0f + u(rng)));
+      const SoffWalkResult want = walk_one_step_at_a_time(cam, inv_z.data(), o, d);
+      const SoffWalkResult got = soff_walk(cam, inv_z.data(), o, d);
+      ASSERT_EQ(int(want.kind), int(got.kind)) << "image " << image << " ray " << ray;
+      ASSERT_EQ(want.steps, got.steps) << "image " << image << " ray " << ray;
+      for (const auto& [a, b] : {std::pair{want.sx, got.sx}, {want.sy, got.sy}, {want.inv_z, got.inv_z}})
+        ASSERT_EQ(0, std::memcmp(&a, &b, sizeof a)) << "image " << image << " ray " << ray;
+      ++kinds[want.kind];
+      long_walks += want.steps > 16;
+    }
+  }
+  for (int kind = 0; kind < 4; ++kind) EXPECT_GT(kinds[kind], 50) << "kind " << kind;
+  EXPECT_GT(long_walks, 1000);
 }
 
 // Renders `technique` on `scene` at w × h (every parameter at its default but `params`).
