@@ -230,16 +230,23 @@ TEST(SoffCameras, Eq1MakesTheFarFrameDiagonalEqualDn) {
   EXPECT_TRUE(cc.concave);
 }
 
-// SOFF §3.4 on an analytic depth image: the plane z = 3 + x seen by a camera at the origin
-// looking down +z; a ray's walk finds the analytic crossing within a pixel.
-TEST(SoffIntersect, DepthRampWalkFindsTheAnalyticCrossing) {
+// A depth-image camera at the origin looking down +z, a 90° frame on its near plane at 1,
+// far plane at 20, width × height pixels.
+SoffCamera camera_down_z(int width, int height) {
   SoffCamera cam;
   cam.valid = true;
   cam.eye = glm::vec3(0.0f);
   cam.u = {1, 0, 0}, cam.v = {0, 1, 0}, cam.w = {0, 0, 1};
   cam.near_dist = 1.0f, cam.far_dist = 20.0f;
   cam.l = -1, cam.r = 1, cam.b = -1, cam.t = 1;
-  cam.width = cam.height = 128;
+  cam.width = width, cam.height = height;
+  return cam;
+}
+
+// SOFF §3.4 on an analytic depth image: the plane z = 3 + x seen by a camera at the origin
+// looking down +z; a ray's walk finds the analytic crossing within a pixel.
+TEST(SoffIntersect, DepthRampWalkFindsTheAnalyticCrossing) {
+  const SoffCamera cam = camera_down_z(128, 128);
   std::vector<float> inv_z(128 * 128);
   // The plane z = 3 + 0.5 x, i.e. along the camera ray (X, Y, 1)·z: z = 3 / (1 − 0.5 X).
   for (int y = 0; y < 128; ++y)
@@ -340,13 +347,7 @@ TEST(SoffIntersect, WalkInLanesGivesTheBitsOfTheWalkOneStepAtATime) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   int kinds[4] = {}, long_walks = 0;
   for (int image = 0; image < 40; ++image) {
-    SoffCamera cam;
-    cam.valid = true;
-    cam.eye = glm::vec3(0.0f);
-    cam.u = {1, 0, 0}, cam.v = {0, 1, 0}, cam.w = {0, 0, 1};
-    cam.near_dist = 1.0f, cam.far_dist = 20.0f;
-    cam.l = -1, cam.r = 1, cam.b = -1, cam.t = 1;
-    cam.width = 16 + image * 5, cam.height = 16 + image * 3;
+    const SoffCamera cam = camera_down_z(16 + image * 5, 16 + image * 3);
     const int w = cam.width, h = cam.height;
     std::vector<float> inv_z(std::size_t(w) * std::size_t(h));
     const float tilt = 0.6f * u(rng), depth = 4.0f + 2.0f * u(rng);
