@@ -53,8 +53,9 @@ struct TempNode {
 };
 
 // A bin's box as SSE lanes (x, y, z, unused) so growing it is two vector min/max. SSE
-// intrinsics (the build targets x86-64-v3) rather than Lanes<4>: fixed_size simd emitted
-// out-of-line min/max calls in these loops (perf). Values are never NaN in lanes 0-2.
+// intrinsics (the build targets x86-64-v3) rather than Lanes<4>, whose min/max are the
+// scalar's NaN-exact selects; over fixed_size simd they were also out-of-line calls in these
+// loops (perf). Values are never NaN in lanes 0-2.
 struct Bin {
   __m128 lo = _mm_set1_ps(3.0e38f);
   __m128 hi = _mm_set1_ps(-3.0e38f);

@@ -1,8 +1,9 @@
 // The hot kernels of 8-wide BVH traversal (bvh.h) written with AVX2 intrinsics (the build
 // targets x86-64-v3): 8 child boxes against one ray, the order of the entered children, and
 // the watertight triangle test (ray_triangle.h) on a 4-triangle pack. Why not Lanes<W>:
-// fixed_size simd emitted out-of-line min/max calls and bitset masks in this loop (perf:
-// ~1/3 of traversal time). The two tests keep the exact operation sequence of their scalar
+// these loops need shuffles, blends on sign bits and masks as integers, which the lanes do
+// not offer (over fixed_size simd they also emitted out-of-line min/max calls, ~1/3 of
+// traversal time). The two tests keep the exact operation sequence of their scalar
 // definitions (slab test widened as in Ize 2013; watertight test of Woop et al. 2013), so
 // results are bit-identical.
 #pragma once
