@@ -120,10 +120,8 @@ struct Lanes {
   }
   // Gathers only active lanes (inactive indices may be out of range); others get `fill`.
   template <class T, class Index, class M>
-  static auto gather(const T* base, const simd<Index>& index, const M& active,
-                     T fill = T{}) {
-    return simd<T>(
-        [&](auto i) { return active[i] ? base[index[i]] : fill; });
+  static auto gather(const T* base, const simd<Index>& index, const M& active, T fill = T{}) {
+    return simd<T>([&](auto i) { return active[i] ? base[index[i]] : fill; });
   }
   template <class T>
   static void store(const simd<T>& v, T* p) {
@@ -148,30 +146,25 @@ struct Lanes {
   // ---- element-wise ---------------------------------------------------------------------
   // select(m, a, b) = m ? a : b per lane.
   template <class T, class M>
-  static simd<T> select(const M& m, const simd<T>& a,
-                                            simd<T> b) {
+  static simd<T> select(const M& m, const simd<T>& a, simd<T> b) {
     stdx::where(typename simd<T>::mask_type(m), b) = a;
     return b;
   }
   // min/max are defined as the scalar `b < a ? b : a` (and `a < b ? b : a`) so that NaN
   // and ±0 behave identically for every W (hardware min picks operands differently).
   template <class T>
-  static simd<T> min(const simd<T>& a,
-                                         const simd<T>& b) {
+  static simd<T> min(const simd<T>& a, const simd<T>& b) {
     return select(b < a, b, a);
   }
   template <class T>
-  static simd<T> max(const simd<T>& a,
-                                         const simd<T>& b) {
+  static simd<T> max(const simd<T>& a, const simd<T>& b) {
     return select(a < b, b, a);
   }
   // std::clamp per lane, in its order (v < lo first, then hi < v): a NaN stays NaN.
   // Always inlined: GCC kept it as a call taking and returning lanes through memory (5 % of
   // a cube-map technique's frame).
   template <class T>
-  [[gnu::always_inline]] static simd<T> clamp(const simd<T>& v,
-                                                                 const simd<T>& lo,
-                                                                 const simd<T>& hi) {
+  [[gnu::always_inline]] static simd<T> clamp(const simd<T>& v, const simd<T>& lo, const simd<T>& hi) {
     return select(v < lo, lo, select(hi < v, hi, v));
   }
   static f32 sqrt(const f32& v) { return stdx::sqrt(v); }  // correctly rounded per lane
