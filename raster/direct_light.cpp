@@ -156,32 +156,14 @@ ImageRGBA direct_light(par::Executor& executor, const Scene& scene, const GBuffe
   const SurfaceShader shade(scene, shadows, env);
   executor.parallel_for("direct_light.shade", out.size(), 4096,
                         [&](std::size_t begin, std::size_t end) {
-    // Covered samples are shaded eight at a time (their shadow tests share lanes).
-    std::size_t batch[8];
-    int count = 0;
-    const auto shade_batch = [&] {
-      const SurfaceParams* s[8];
-      glm::vec3 p[8], n[8], v[8], radiance[8];
-      for (int j = 0; j < count; ++j) {
-        const std::size_t i = batch[j];
-        s[j] = &g.surface[i], p[j] = g.position.pixels[i], n[j] = g.normal.pixels[i], v[j] = g.view_direction(i);
-      }
-      shade.shade8(s, p, n, v, count, radiance);
-      for (int j = 0; j < count; ++j) out.pixels[batch[j]] = glm::vec4(radiance[j], 1.0f);
-      count = 0;
-    };
-    for (std::size_t i = begin; i < end; ++i) {
-      if (read && !(*read)[i]) continue;
-      if (!g.covered(i)) {
-        const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
-        const Ray ray = primary_ray(camera, g.width, g.height, x + 0.5f, y + 0.5f);
-        out.pixels[i] = glm::vec4(env.radiance(ray.direction, 1e6f), 1.0f);
-        continue;
-      }
-      batch[count++] = i;
-      if (count == 8) shade_batch();
-    }
-    if (count > 0) shade_batch();
+    shade.shade_samples(
+        g, begin, end, [&](std::size_t i) { return !read || (*read)[i]; },
+        [&](std::size_t i, const glm::vec3& radiance) { out.pixels[i] = glm::vec4(radiance, 1.0f); },
+        [&](std::size_t i) {
+          const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
+          const Ray ray = primary_ray(camera, g.width, g.height, x + 0.5f, y + 0.5f);
+          out.pixels[i] = glm::vec4(env.radiance(ray.direction, 1e6f), 1.0f);
+        });
   });
   return out;
 }

@@ -35,6 +35,35 @@ class SurfaceShader {
   // shadow tests of the points it reaches in one ShadowMap::visibility8 call.
   void shade8(const SurfaceParams* const* s, const glm::vec3* p, const glm::vec3* n, const glm::vec3* v, int count,
               glm::vec3* out) const;
+  // The samples i in [begin, end) of `g` with wanted(i): each covered one shaded (eight at a
+  // time through shade8) and handed to shaded(i, radiance), each empty one to empty(i).
+  template <class Wanted, class Shaded, class Empty>
+  void shade_samples(const GBuffer& g, std::size_t begin, std::size_t end, const Wanted& wanted,
+                     const Shaded& shaded, const Empty& empty) const {
+    std::size_t batch[8];
+    int count = 0;
+    const auto shade_batch = [&] {
+      const SurfaceParams* s[8];
+      glm::vec3 p[8], n[8], v[8], radiance[8];
+      for (int j = 0; j < count; ++j) {
+        const std::size_t i = batch[j];
+        s[j] = &g.surface[i], p[j] = g.position.pixels[i], n[j] = g.normal.pixels[i], v[j] = g.view_direction(i);
+      }
+      shade8(s, p, n, v, count, radiance);
+      for (int j = 0; j < count; ++j) shaded(batch[j], radiance[j]);
+      count = 0;
+    };
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!wanted(i)) continue;
+      if (!g.covered(i)) {
+        empty(i);
+        continue;
+      }
+      batch[count++] = i;
+      if (count == 8) shade_batch();
+    }
+    if (count > 0) shade_batch();
+  }
 
  private:
   const Scene* scene_;

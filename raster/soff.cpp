@@ -426,6 +426,7 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
   TileBins bins;
   VisibilityBuffer vis;
   GBuffer gb;
+  const SurfaceShader shade(scene, shadows, env);  // shade_surface's bits, eight at a time
   // Largest images first: the planes above are then sized once, by the first image, and
   // shrink for the others (growing them would value-initialize the growth on this thread).
   // Each image writes its own range of `out`, so the order changes no byte.
@@ -478,18 +479,18 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
     resolve_gbuffer(executor, scene, vis, cam.eye, gb);
     const std::size_t base = out.offsets[c];
     executor.parallel_for("soff_depth_images.shade", gb.object.size(), 2048, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        if (gb.covered(i)) {
-          out.inv_z[base + i] = 1.0f / vis.depth.pixels[i];
-          out.colour[base + i] = shade_surface(scene, gb.surface[i], gb.position.pixels[i],
-                                               gb.normal.pixels[i], gb.view_direction(i), shadows, env);
-          out.surface[base + i] = gb.surface[i];
-          out.normal[base + i] = gb.normal.pixels[i];
-        } else {
-          const float sx = float(i % std::size_t(cam.width)) + 0.5f, sy = float(i / std::size_t(cam.width)) + 0.5f;
-          out.colour[base + i] = env.radiance(cam.pixel_direction(sx, sy), 1e6f);
-        }
-      }
+      shade.shade_samples(
+          gb, begin, end, [](std::size_t) { return true; },
+          [&](std::size_t i, const glm::vec3& radiance) {
+            out.inv_z[base + i] = 1.0f / vis.depth.pixels[i];
+            out.colour[base + i] = radiance;
+            out.surface[base + i] = gb.surface[i];
+            out.normal[base + i] = gb.normal.pixels[i];
+          },
+          [&](std::size_t i) {
+            const float sx = float(i % std::size_t(cam.width)) + 0.5f, sy = float(i / std::size_t(cam.width)) + 0.5f;
+            out.colour[base + i] = env.radiance(cam.pixel_direction(sx, sy), 1e6f);
+          });
     });
   }
   if (stats) *stats = st;
