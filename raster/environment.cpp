@@ -54,15 +54,24 @@ glm::vec3 prefilter_texel(const std::array<ImageRGBA, kCubeFaces>& previous, int
   return sum;
 }
 
+// One level's six faces as lookup_level8 reads them: its side and each face's first float.
+struct LevelFaces {
+  int side;
+  const float* pixels[kCubeFaces];
+  explicit LevelFaces(const std::array<ImageRGBA, kCubeFaces>& level) : side(level[0].width) {
+    for (int f = 0; f < kCubeFaces; ++f) pixels[f] = &level[f].pixels[0].x;
+  }
+};
+
 // lookup_level for eight directions at once (d: lanes of x, y, z): per lane the operations
 // of lookup_level in its order (cube_coord8 is cube_coord per lane; then bilinear_face's
 // clamp, taps and weights), so every lane has the bits of the scalar call. out: r, g, b.
-[[gnu::always_inline]] inline void lookup_level8(const std::array<ImageRGBA, kCubeFaces>& level,
-                                                 const par::Lanes<8>::f32 (&d)[3], par::Lanes<8>::f32 (&out)[3]) {
+[[gnu::always_inline]] inline void lookup_level8(const LevelFaces& level, const par::Lanes<8>::f32 (&d)[3],
+                                                 par::Lanes<8>::f32 (&out)[3]) {
   using L = par::Lanes<8>;
   using f32 = L::f32;
   using i32 = L::i32;
-  const int side = level[0].width;
+  const int side = level.side;
   const float last = static_cast<float>(side - 1);
   const CubeCoordLanes cc = cube_coord8(d, side);
   const i32& fi = cc.face;
@@ -75,8 +84,7 @@ glm::vec3 prefilter_texel(const std::array<ImageRGBA, kCubeFaces>& previous, int
   const f32 wx = 1.0f - tx, wy = 1.0f - ty;
   const i32 row0 = y0 * side, row1 = y1 * side;
   const i32 taps[4] = {(row0 + x0) * 4, (row0 + x1) * 4, (row1 + x0) * 4, (row1 + x1) * 4};
-  const float* pixels[kCubeFaces];
-  for (int f = 0; f < kCubeFaces; ++f) pixels[f] = &level[f].pixels[0].x;
+  const float* const* pixels = level.pixels;
   // Each lane's tap texel loaded as one RGBA row, lanes j and j + 4 in the two halves of a
   // register, and the rows transposed into channels within the halves: the values one load
   // per channel would give. Whole registers are stored (a 256-bit load of two 128-bit
@@ -115,11 +123,12 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
   }
   f32 tv[3], bv[3], nv[3];
   for (int c = 0; c < 3; ++c) tv[c] = L::load(t[c]), bv[c] = L::load(b[c]), nv[c] = L::load(n[c]);
+  const LevelFaces faces(previous);
   f32 sum[3] = {f32(0.0f), f32(0.0f), f32(0.0f)};
   for (int k = 0; k < count; ++k) {
     f32 d[3], texel[3];
     for (int c = 0; c < 3; ++c) d[c] = (local[k].x * tv[c] + local[k].y * bv[c]) + local[k].z * nv[c];
-    lookup_level8(previous, d, texel);
+    lookup_level8(faces, d, texel);
     for (int c = 0; c < 3; ++c) sum[c] += texel[c];
   }
   for (int j = 0; j < 8; ++j) out[j] = glm::vec3(sum[0][j], sum[1][j], sum[2][j]);
@@ -240,6 +249,12 @@ float lobe_level(int size, float phong_exponent) {
   return std::max(std::log2(lobe_angle(phong_exponent) / texel_angle(size)), 0.0f);
 }
 
+// The fractional level radiance() reads on `map` for a lobe of exponent n (clamped to the
+// levels it has).
+float read_level(const EnvironmentMap& map, float phong_exponent) {
+  return std::min(lobe_level(map.size, phong_exponent), float(static_cast<int>(map.levels.size()) - 1));
+}
+
 }  // namespace
 
 int levels_for_lobes(int size, float min_phong_exponent) {
@@ -274,7 +289,7 @@ float lookup_reach(int size, int level_count, float phong_exponent) {
 
 glm::vec3 EnvironmentMap::radiance(const glm::vec3& d, float phong_exponent) const {
   const int last = static_cast<int>(levels.size()) - 1;
-  const float level = std::min(lobe_level(size, phong_exponent), float(last));
+  const float level = read_level(*this, phong_exponent);
   const int l0 = static_cast<int>(level), l1 = std::min(l0 + 1, last);
   const float t = level - l0;
   const glm::vec3 a = lookup_level(levels[l0], d);
@@ -291,7 +306,7 @@ void EnvironmentMap::radiance8(const glm::vec3* d, const float* phong_exponent, 
     const int k = j < count ? j : 0;  // lanes past `count` repeat lane 0, dropped below
     level[j] = k > 0 && phong_exponent[k] == phong_exponent[k - 1]
                    ? level[k - 1]
-                   : std::min(lobe_level(size, phong_exponent[k]), float(last));
+                   : read_level(*this, phong_exponent[k]);
   }
   const int l0 = static_cast<int>(level[0]);
   bool shared = true;  // one level pair for every lane: one lookup per level in lanes
@@ -306,12 +321,12 @@ void EnvironmentMap::radiance8(const glm::vec3* d, const float* phong_exponent, 
   f32 dv[3];
   for (int c = 0; c < 3; ++c) dv[c] = L::load_aligned(dir[c]);
   f32 a[3];
-  lookup_level8(levels[l0], dv, a);
+  lookup_level8(LevelFaces(levels[l0]), dv, a);
   const f32 t = L::load_aligned(level) - float(l0);
   const L::mask blend = t > 0.0f;
   if (L::any(blend)) {
     f32 b[3];
-    lookup_level8(levels[std::min(l0 + 1, last)], dv, b);
+    lookup_level8(LevelFaces(levels[std::min(l0 + 1, last)]), dv, b);
     for (int c = 0; c < 3; ++c) a[c] = L::select(blend, a[c] * (1.0f - t) + b[c] * t, a[c]);
   }
   for (int j = 0; j < count; ++j) out[j] = glm::vec3(a[0][j], a[1][j], a[2][j]);

@@ -510,21 +510,24 @@ struct WalkSegment {
   const float* inv_z;
 };
 
-// The ray at step k of `steps` (the near endpoint at 0) and the stored 1/z under it (0
-// outside the image).
+// The stored 1/z at image point (sx, sy), 0 outside the image (inside says which).
+float stored_at(const WalkSegment& g, float sx, float sy, bool& inside) {
+  const int ix = int(std::floor(sx)), iy = int(std::floor(sy));
+  inside = ix >= 0 && iy >= 0 && ix < g.w && iy < g.h;
+  return inside ? g.inv_z[std::size_t(iy) * std::size_t(g.w) + std::size_t(ix)] : 0.0f;
+}
+
+// The ray's 1/z at step k of `steps` and the stored 1/z under it.
 struct WalkStep {
   float ray, stored;
   bool inside;
 };
-WalkStep stored_at(const WalkSegment& g, float ray, float sx, float sy) {
-  const int ix = int(std::floor(sx)), iy = int(std::floor(sy));
-  const bool inside = ix >= 0 && iy >= 0 && ix < g.w && iy < g.h;
-  return {ray, inside ? g.inv_z[std::size_t(iy) * std::size_t(g.w) + std::size_t(ix)] : 0.0f, inside};
-}
 WalkStep walk_step(const WalkSegment& g, int k) {
   const float s = float(k) / float(g.steps);
-  // 1/z is linear in screen space.
-  return stored_at(g, g.a.z + (g.b.z - g.a.z) * s, g.a.x + g.dx * s, g.a.y + g.dy * s);
+  WalkStep step;
+  step.ray = g.a.z + (g.b.z - g.a.z) * s;  // 1/z is linear in screen space
+  step.stored = stored_at(g, g.a.x + g.dx * s, g.a.y + g.dy * s, step.inside);
+  return step;
 }
 
 // walk_step for steps k .. k + 7 in lanes: per lane walk_step's operations in its order
@@ -560,29 +563,28 @@ SoffWalkResult soff_walk(const SoffCamera& cam, const float* inv_z, const glm::v
   g.w = cam.width, g.h = cam.height;
   g.inv_z = inv_z;
   g.steps = std::max(1, int(std::ceil(std::max(std::abs(g.dx), std::abs(g.dy)))));
-  const WalkStep first = stored_at(g, g.a.z, g.a.x, g.a.y);
-  if (!first.inside) return res;  // Miss: the ray starts outside the frame
-  float ray_a = g.a.z, di_a = first.stored;
+  bool inside = true;
+  float ray_a = g.a.z, di_a = stored_at(g, g.a.x, g.a.y, inside);
+  if (!inside) return res;  // Miss: the ray starts outside the frame
   float prev_jump = 0.0f;
   bool hidden = false;
   for (int k = 1; k <= g.steps;) {
     // Eight steps at a time while none of them can end the walk or change its state (a
     // step outside the image, or a crossing from in front to behind): those only move the
-    // ray on. The step that can is taken below, one at a time, from the same values.
-    while (g.steps - k >= 7) {
+    // ray on. The step that can is taken below, on its own, from the same values.
+    if (g.steps - k >= 7) {
       alignas(32) float ray[9], stored[9];
-      std::uint8_t inside[8];
+      std::uint8_t in[8];
       ray[0] = ray_a, stored[0] = di_a;
-      walk_steps8(g, k, ray + 1, stored + 1, inside);
+      walk_steps8(g, k, ray + 1, stored + 1, in);
       int stop = 0;
-      while (stop < 8 && inside[stop] && !(ray[stop] - stored[stop] > 0.0f && ray[stop + 1] - stored[stop + 1] <= 0.0f))
+      while (stop < 8 && in[stop] && !(ray[stop] - stored[stop] > 0.0f && ray[stop + 1] - stored[stop + 1] <= 0.0f))
         ++stop;
       res.steps += std::uint32_t(stop);
       k += stop;
       if (stop > 0) prev_jump = stored[stop] - stored[stop - 1], ray_a = ray[stop], di_a = stored[stop];
-      if (stop < 8) break;
+      if (stop == 8) continue;
     }
-    if (k > g.steps) break;
     const WalkStep step = walk_step(g, k);
     const float ray_b = step.ray, di_b = step.stored;
     ++res.steps;
