@@ -175,6 +175,25 @@ double CubeTileMask::texel_count(unsigned face_mask) const {
   return count;
 }
 
+namespace {
+
+// The flags of the texels a reader reaches on `face` (empty: every texel).
+std::vector<std::uint8_t> read_texels(const CubeMapOptions& options, int face) {
+  return options.tiles && options.tiles->active() ? options.tiles->texels(face) : std::vector<std::uint8_t>{};
+}
+
+// Resolves face `face`'s G-buffer from `vis` (the texels outside `read` already background)
+// and shades it.
+ImageRGBA shade_face(par::Executor& executor, const Scene& scene, const CubeMap& cube, const CubeMapOptions& options,
+                     int face, const VisibilityBuffer& vis, const std::vector<std::uint8_t>& read,
+                     const CubeFaceShader& shade, GBuffer& g) {
+  const Camera cam = cube_face_camera(face, cube.centre, options.znear, options.zfar);
+  resolve_gbuffer(executor, scene, vis, cube.centre, g);
+  return shade(g, cam, face, read.empty() ? nullptr : &read);
+}
+
+}  // namespace
+
 CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
                         const CubeMapOptions& options, const CubeFaceShader& shade,
                         CubeMapScratch* scratch) {
@@ -185,7 +204,6 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
   // and cleared once, not once per face on the thread that launches the face's passes.
   CubeMapScratch own;
   CubeMapScratch& s = scratch ? *scratch : own;
-  GBuffer& g = s.g;
   VisibilityBuffer& vis = s.vis;
   for (int face = 0; face < kCubeFaces; ++face) {
     if (!((options.face_mask >> face) & 1u)) {
@@ -196,14 +214,12 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
     render_visibility(executor, scene, cam, options.size, options.size, options.raster, s.workspace, vis);
     // Texels no reader reaches become background: not resolved, not shaded.
-    std::vector<std::uint8_t> read;
-    if (options.tiles && options.tiles->active()) {
-      read = options.tiles->texels(face);
+    const std::vector<std::uint8_t> read = read_texels(options, face);
+    if (!read.empty())
       executor.parallel_for("cube_map.unread", read.size(), 4096, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
           if (!read[i]) vis.triangle.pixels[i] = vis.object.pixels[i] = kNoId;
       });
-    }
     ImageF& dist = cube.distance[face];
     dist = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
     executor.parallel_for("cube_map.distance", dist.size(), 4096,
@@ -213,12 +229,47 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
                                 dist.pixels[i] = glm::length(
                                     visible_position(scene.mesh, vis, i) - centre);
                           });
+    if (options.keep_visibility) cube.visibility[face] = vis;
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
-    if (!shade) continue;
-    resolve_gbuffer(executor, scene, vis, centre, g);
-    cube.colour[face] = shade(g, cam, face, read.empty() ? nullptr : &read);
+    if (shade) cube.colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s.g);
   }
   return cube;
+}
+
+std::array<ImageRGBA, kCubeFaces> shade_cube_faces(par::Executor& executor, const Scene& scene, const CubeMap& cube,
+                                                   const CubeMapOptions& options, const CubeFaceShader& shade,
+                                                   CubeMapScratch* scratch) {
+  std::array<ImageRGBA, kCubeFaces> colour;
+  CubeMapScratch own;
+  CubeMapScratch& s = scratch ? *scratch : own;
+  for (int face = 0; face < kCubeFaces; ++face) {
+    const VisibilityBuffer& kept = cube.visibility[face];
+    if (!((options.face_mask >> face) & 1u) || kept.width == 0) {
+      colour[face] = ImageRGBA(cube.size, cube.size, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+      continue;
+    }
+    // The kept visibility with the texels no reader reaches made background (render_cube_map's
+    // mask), in the scratch planes.
+    const std::vector<std::uint8_t> read = read_texels(options, face);
+    VisibilityBuffer& vis = s.vis;
+    vis.width = kept.width, vis.height = kept.height;
+    vis.depth = kept.depth;
+    vis.bary = kept.bary;
+    vis.coverage = kept.coverage;
+    if (vis.triangle.width != kept.width || vis.triangle.height != kept.height) {
+      vis.triangle = IdBuffer(kept.width, kept.height);
+      vis.object = IdBuffer(kept.width, kept.height);
+    }
+    executor.parallel_for("cube_map.read_visibility", kept.triangle.size(), 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const bool r = read.empty() || read[i];
+        vis.triangle.pixels[i] = r ? kept.triangle.pixels[i] : kNoId;
+        vis.object.pixels[i] = r ? kept.object.pixels[i] : kNoId;
+      }
+    });
+    colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s.g);
+  }
+  return colour;
 }
 
 }  // namespace speculum::raster

@@ -80,6 +80,9 @@ struct CubeMap {
   glm::vec3 centre{0.0f};
   std::array<ImageRGBA, kCubeFaces> colour;   // may be empty (distance-only maps)
   std::array<ImageF, kCubeFaces> distance;    // |y − o|, +inf where nothing was hit
+  // Each rendered face's visibility, kept only under CubeMapOptions::keep_visibility: a map
+  // whose colour is shaded later (shade_cube_faces), once its readers are known.
+  std::array<VisibilityBuffer, kCubeFaces> visibility;
 
   // Bilinear colour towards d (clamped at face borders).
   glm::vec4 colour_towards(const glm::vec3& d) const { return colour_at(cube_coord(d, size)); }
@@ -144,6 +147,9 @@ struct CubeMapOptions {
   // Within the faces rendered, only the texels of the read tiles are resolved and shaded
   // (null or inactive: all); the others hold distance +inf and black.
   const CubeTileMask* tiles = nullptr;
+  // Keep each face's visibility in CubeMap::visibility for shade_cube_faces (no tiles: the
+  // distances stay whole).
+  bool keep_visibility = false;
 
   void set_depth_range(const CubeDepthRange& range) {
     znear = range.znear;
@@ -165,5 +171,13 @@ struct CubeMapScratch {
 CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::vec3& centre,
                         const CubeMapOptions& options, const CubeFaceShader& shade = {},
                         CubeMapScratch* scratch = nullptr);
+
+// The colour faces of a map rendered with keep_visibility, shaded now: each face of
+// `options.face_mask` from its kept visibility, only the texels of `options.tiles` (null or
+// inactive: all) — what render_cube_map with those options and `shade` gives, the same bytes.
+// Faces outside the mask are black.
+std::array<ImageRGBA, kCubeFaces> shade_cube_faces(par::Executor& executor, const Scene& scene, const CubeMap& cube,
+                                                   const CubeMapOptions& options, const CubeFaceShader& shade,
+                                                   CubeMapScratch* scratch = nullptr);
 
 }  // namespace speculum::raster

@@ -23,15 +23,63 @@ namespace {
 // kGlossySearchExponent's (under 0.7° at half maximum) are searched along R only.
 constexpr float kGlossySearchExponent = 1e4f;
 
+// The radiance arriving along d through a lobe of `exponent` at a sample with normal n, from
+// `search(direction, exponent)`: the radiance one search along `direction` finds, read
+// through a lobe of that exponent. Every user walks the same searches in the same order.
+template <class Search>
+glm::vec3 searched_lookup(const glm::vec3& n, const glm::vec3& d, float exponent, int directions, Search&& search) {
+  if (directions <= 1 || !(exponent < kGlossySearchExponent)) return search(d, exponent);
+  const Onb frame(d);
+  glm::vec3 sum(0.0f);
+  int used = 0;
+  for (int k = 0; k < directions; ++k) {
+    const glm::vec3 dk = frame.to_world(sample_phong_lobe(
+        hamersley(static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(directions)), exponent * (4.0f / 3.0f)));
+    if (glm::dot(dk, n) <= 0.0f) continue;  // below the surface: no light arrives from there
+    sum += search(dk, 4.0f * exponent);
+    ++used;
+  }
+  return used > 0 ? sum / float(used) : search(d, exponent);
+}
+
+// The map of sample i's object (-1: none, the environment instead).
+int map_of_sample(const GBuffer& g, const ReflectorMaps& maps, std::size_t i) {
+  const std::uint32_t object = g.object.pixels[i];
+  return object < maps.map_of_object.size() ? maps.map_of_object[object] : -1;
+}
+
+// One search from x along d in map m, counted in `st`: the direction its colour is read along.
+glm::vec3 search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, const glm::vec3& d,
+                         const DistanceSearchOptions& options, DistanceReflectStats& st) {
+  const DistanceSearchResult hit = search_distance_map(maps.cubes[m], x, d, options);
+  ++st.searches;
+  st.lookups += hit.lookups;
+  st.bracketed += hit.bracketed;
+  st.missed += !std::isfinite(hit.d);
+  return glm::normalize(hit.direction);
+}
+
+void add_stats(DistanceReflectStats& to, const std::vector<DistanceReflectStats>& per_chunk) {
+  for (const DistanceReflectStats& c : per_chunk) {
+    to.searches += c.searches;
+    to.lookups += c.lookups;
+    to.bracketed += c.bracketed;
+    to.missed += c.missed;
+  }
+}
+
+// Samples per chunk of the searches; distance_map_lookup reads distance_map_search's records
+// in the same chunks.
+constexpr std::size_t kChunk = 2048;
+
 }  // namespace
 
 ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
                                const EnvironmentMap& env, const ReflectorMaps& maps,
                                const DistanceSearchOptions& options, DistanceReflectStats* stats,
                                FallbackMask* fallbacks) {
-  constexpr std::size_t kChunk = 2048;
   ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
-  std::vector<DistanceReflectStats> per_chunk((out.size() + kChunk - 1) / kChunk);
+  std::vector<DistanceReflectStats> per_chunk(par::Executor::chunk_count(out.size(), kChunk));
   executor.parallel_for("distance_map_reflect.search", out.size(), kChunk,
                         [&](std::size_t begin, std::size_t end) {
     DistanceReflectStats& st = per_chunk[begin / kChunk];
@@ -39,49 +87,81 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
-      const std::uint32_t object = g.object.pixels[i];
-      const int m = object < maps.map_of_object.size() ? maps.map_of_object[object] : -1;
-      const glm::vec3 x = g.position.pixels[i];
-      // Radiance arriving along direction d from x: searched in the object's map, or the
-      // environment (at infinity) for objects without one.
-      const glm::vec3 n = g.normal.pixels[i];
-      const auto search = [&](const glm::vec3& d, float exponent) {
-        const DistanceSearchResult hit = search_distance_map(maps.cubes[m], x, d, options);
-        ++st.searches;
-        st.lookups += hit.lookups;
-        st.bracketed += hit.bracketed;
-        st.missed += !std::isfinite(hit.d);
-        return maps.maps[m].radiance(glm::normalize(hit.direction), exponent);
-      };
+      const int m = map_of_sample(g, maps, i);
+      const glm::vec3 x = g.position.pixels[i], n = g.normal.pixels[i];
+      // Radiance arriving along d from x: searched in the object's map, or the environment
+      // (at infinity) for objects without one.
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         if (m < 0) return env.radiance(d, exponent);
-        const int directions = options.lobe_directions;
-        if (directions <= 1 || !(exponent < kGlossySearchExponent)) return search(d, exponent);
-        const Onb frame(d);
-        glm::vec3 sum(0.0f);
-        int used = 0;
-        for (int k = 0; k < directions; ++k) {
-          const glm::vec3 dk = frame.to_world(sample_phong_lobe(
-              hamersley(static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(directions)), exponent * (4.0f / 3.0f)));
-          if (glm::dot(dk, n) <= 0.0f) continue;  // below the surface: no light arrives from there
-          sum += search(dk, 4.0f * exponent);
-          ++used;
-        }
-        return used > 0 ? sum / float(used) : search(d, exponent);
+        return searched_lookup(n, d, exponent, options.lobe_directions, [&](const glm::vec3& dk, float e) {
+          return maps.maps[m].radiance(search_counted(maps, m, x, dk, options, st), e);
+        });
       };
       const std::uint64_t missed_before = st.missed;
-      const glm::vec3 radiance = specular_radiance(s, n, g.view_direction(i), lookup);
-      out.pixels[i] = glm::vec4(radiance, 1.0f);
+      out.pixels[i] = glm::vec4(specular_radiance(s, n, g.view_direction(i), lookup), 1.0f);
       if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
     }
   });
-  if (stats)
-    for (const DistanceReflectStats& c : per_chunk) {
-      stats->searches += c.searches;
-      stats->lookups += c.lookups;
-      stats->bracketed += c.bracketed;
-      stats->missed += c.missed;
+  if (stats) add_stats(*stats, per_chunk);
+  return out;
+}
+
+DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
+                                     const DistanceSearchOptions& options, FallbackMask* fallbacks) {
+  DistanceSearches out;
+  const std::size_t n = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
+  out.found.resize(par::Executor::chunk_count(n, kChunk));
+  for (std::size_t m = 0; m < maps.cubes.size(); ++m)
+    out.tiles.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
+  std::vector<DistanceReflectStats> per_chunk(out.found.size());
+  executor.parallel_for("distance_map_search.search", n, kChunk, [&](std::size_t begin, std::size_t end) {
+    DistanceReflectStats& st = per_chunk[begin / kChunk];
+    std::vector<glm::vec3>& found = out.found[begin / kChunk];
+    std::vector<LookupTileMarker> markers;
+    for (std::size_t m = 0; m < maps.cubes.size(); ++m) markers.emplace_back(out.tiles[m], maps.levels[m]);
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!g.covered(i)) continue;
+      const SurfaceParams& s = g.surface[i];
+      const int m = is_specular(s) ? map_of_sample(g, maps, i) : -1;
+      if (m < 0) continue;
+      const glm::vec3 x = g.position.pixels[i], n = g.normal.pixels[i];
+      const auto lookup = [&](const glm::vec3& d, float exponent) {
+        return searched_lookup(n, d, exponent, options.lobe_directions, [&](const glm::vec3& dk, float e) {
+          found.push_back(search_counted(maps, m, x, dk, options, st));
+          markers[m].mark(found.back(), e);
+          return glm::vec3(0.0f);
+        });
+      };
+      const std::uint64_t missed_before = st.missed;
+      specular_radiance(s, n, g.view_direction(i), lookup);
+      if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
     }
+  });
+  add_stats(out.stats, per_chunk);
+  return out;
+}
+
+ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
+                              const ReflectorMaps& maps, const DistanceSearches& searches,
+                              const DistanceSearchOptions& options) {
+  ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  executor.parallel_for("distance_map_reflect.lookup", out.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    const std::vector<glm::vec3>& found = searches.found[begin / kChunk];
+    std::size_t next = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!g.covered(i)) continue;
+      const SurfaceParams& s = g.surface[i];
+      if (!is_specular(s)) continue;
+      const int m = map_of_sample(g, maps, i);
+      const glm::vec3 n = g.normal.pixels[i];
+      const auto lookup = [&](const glm::vec3& d, float exponent) {
+        if (m < 0) return env.radiance(d, exponent);
+        return searched_lookup(n, d, exponent, options.lobe_directions,
+                               [&](const glm::vec3&, float e) { return maps.maps[m].radiance(found[next++], e); });
+      };
+      out.pixels[i] = glm::vec4(specular_radiance(s, n, g.view_direction(i), lookup), 1.0f);
+    }
+  });
   return out;
 }
 
@@ -97,6 +177,33 @@ ImageRGBA DistanceMapReflectPass::operator()(par::NodeContext& c, const GBuffer&
   c.count("bracketed", st.bracketed);
   c.count("fallback_search_missed", st.missed);
   return specular;
+}
+
+DistanceSearches DistanceMapSearchPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                                  const ReflectorMaps& maps) const {
+  FallbackMask fallbacks = c.capturing() ? FallbackMask(gbuffer.width, gbuffer.height) : FallbackMask();
+  DistanceSearches found = distance_map_search(c.executor(), gbuffer, maps, search, &fallbacks);
+  c.publish("fallback", std::move(fallbacks));
+  c.count("searches", found.stats.searches);
+  c.count("distance_lookups", found.stats.lookups);
+  c.count("bracketed", found.stats.bracketed);
+  c.count("fallback_search_missed", found.stats.missed);
+  return found;
+}
+
+ReflectorMaps ReflectorColourPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                              const EnvironmentMap& environment, const ReflectorMaps& distances,
+                                              const DistanceSearches& searches) const {
+  ReflectorMaps maps = shade_reflector_maps(c.executor(), *scene, shadows, environment, distances, searches.tiles);
+  c.count("cube_maps", maps.cubes.size());
+  c.count("cube_texels", rendered_texels(maps));
+  return maps;
+}
+
+ImageRGBA DistanceMapLookupPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
+                                            const EnvironmentMap& environment, const ReflectorMaps& maps,
+                                            const DistanceSearches& searches) const {
+  return distance_map_lookup(c.executor(), gbuffer, environment, maps, searches, search);
 }
 
 }  // namespace speculum::raster

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "core/fallback_mask.h"
 #include "parallel/executor.h"
@@ -33,6 +34,23 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
                                const DistanceSearchOptions& options,
                                DistanceReflectStats* stats = nullptr, FallbackMask* fallbacks = nullptr);
 
+// distance_map_reflect in two halves, so that the maps' colour is shaded only where the
+// searches read it: distance_map_search searches the maps' distances (rendered with
+// MapSizing::keep_visibility and without colour) and records, per chunk of samples in sample
+// order, the direction each search reads colour along, and per map the tiles those reads
+// reach; shade_reflector_maps shades those tiles; distance_map_lookup reads the colour along
+// the recorded directions. The same bytes as distance_map_reflect on maps shaded whole.
+struct DistanceSearches {
+  std::vector<std::vector<glm::vec3>> found;  // per chunk of samples: each search's direction
+  std::vector<CubeTileMask> tiles;            // per map: the tiles the reads reach
+  DistanceReflectStats stats;
+};
+DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
+                                     const DistanceSearchOptions& options, FallbackMask* fallbacks = nullptr);
+ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
+                              const ReflectorMaps& maps, const DistanceSearches& searches,
+                              const DistanceSearchOptions& options);
+
 // Pass "distance_map_reflect": the specular layer searched in the reflectors' distance maps.
 struct DistanceMapReflectPass {
   static constexpr const char* description =
@@ -42,6 +60,41 @@ struct DistanceMapReflectPass {
   void parameters(par::Params& p) const { p.set("search", describe_search(search)); }
   ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const EnvironmentMap& environment,
                        const ReflectorMaps& maps) const;
+};
+
+// Pass "distance_map_search": distance_map_search over the reflectors' distances.
+struct DistanceMapSearchPass {
+  static constexpr const char* description =
+      "Parallax (eq.4) / linear (§4.1.2) / secant (eq.5) search per specular sample in its "
+      "reflector's distance cube map; records where each search reads colour, and the map tiles "
+      "those reads reach (SURVEY §4.1).";
+  DistanceSearchOptions search;
+  void parameters(par::Params& p) const { p.set("search", describe_search(search)); }
+  DistanceSearches operator()(par::NodeContext& c, const GBuffer& gbuffer, const ReflectorMaps& maps) const;
+};
+
+// Pass "reflector_cube_maps" after the searches: the maps' colour, shaded and prefiltered only
+// on the tiles the searches read (shade_reflector_maps).
+struct ReflectorColourPass {
+  static constexpr const char* description =
+      "Per specular object the colour of its cube map, shaded and prefiltered only where the "
+      "searches read it (SURVEY §3.1, §4.2).";
+  const Scene* scene = nullptr;
+  void parameters(par::Params& p) const { p.set("tiles", "read by the searches"); }
+  ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
+                           const ReflectorMaps& distances, const DistanceSearches& searches) const;
+};
+
+// Pass "distance_map_reflect" after distance_map_search: each search's colour read from the
+// shaded maps, Fresnel-weighted (distance_map_lookup).
+struct DistanceMapLookupPass {
+  static constexpr const char* description =
+      "Reads each search's hit in its reflector's prefiltered colour cube map, Fresnel-weighted "
+      "(SURVEY §4.1–4.2).";
+  DistanceSearchOptions search;
+  void parameters(par::Params& p) const { p.set("lobe_directions", search.lobe_directions); }
+  ImageRGBA operator()(par::NodeContext& c, const GBuffer& gbuffer, const EnvironmentMap& environment,
+                       const ReflectorMaps& maps, const DistanceSearches& searches) const;
 };
 
 }  // namespace speculum::raster

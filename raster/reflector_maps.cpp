@@ -212,6 +212,23 @@ void mark_taps(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int til
     mark(tiles[c.face], static_cast<std::size_t>(y) * n + x0 / tile, static_cast<std::size_t>(x1 / tile - x0 / tile + 1));
 }
 
+// A reflector map face's colour (MapFaceLayers: `kept`, may be null, receives its layers).
+CubeFaceShader reflector_face_shader(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
+                                     const EnvironmentMap& env, const FaceLight& add_light, MapFaceLayers* kept) {
+  return [&executor, &scene, &shadows, &env, &add_light, kept](const GBuffer& g, const Camera& cam, int face,
+                                                                const std::vector<std::uint8_t>* read) {
+    // Other reflectors seen in this map show the environment along their own R (and T): the
+    // first-order fallback, so a mirror seen in a mirror is never black.
+    ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env, read);
+    if (add_light) direct = add_light(g, direct);
+    if (kept) {
+      kept->specular[face] = specular_texels(g, kept->specular_texel[face]);
+      kept->direct[face] = direct;
+    }
+    return composite(executor, direct, envmap_reflect(executor, g, env));
+  };
+}
+
 }  // namespace
 
 void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin) {
@@ -252,8 +269,7 @@ GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
   return out;
 }
 
-CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
-                        int size, int level_count, bool refractors_read_at_surface) {
+CubeTileMask tile_mask_for_reads(int size, int level_count) {
   CubeTileMask mask;
   mask.size = size;
   // A map read at level 0 alone (mirror lobes) is read at each lookup's bilinear taps: texel
@@ -261,29 +277,38 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
   if (level_count == 1) mask.tile = 1;
   const int n_tiles = mask.tiles_per_side();
   for (auto& t : mask.tiles) t.assign(static_cast<std::size_t>(n_tiles) * n_tiles, 0);
+  return mask;
+}
+
+LookupTileMarker::LookupTileMarker(CubeTileMask& mask, int level_count) : mask_(mask), level_count_(level_count) {}
+
+void LookupTileMarker::mark(const glm::vec3& d, float exponent) {
+  const int size = mask_.size, n_tiles = mask_.tiles_per_side();
+  if (!(exponent == last_exponent_)) {
+    last_exponent_ = exponent;
+    margin_ = std::max(lookup_reach(size, level_count_, exponent), 1e-3f);
+    level0_ = levels_for_lobes(size, exponent) == 1;
+  }
+  // A wide lobe's marks soon fill whole faces (every sample of a glossy floor marks most of
+  // a face): faces found full stop costing their marks' arithmetic. Maps of one-texel tiles
+  // (level 0 alone) are too large to scan this often.
+  if (mask_.tile > 1 && ++marks_ % 256 == 0) note_full_faces(mask_.tiles, whole_);
+  const glm::vec3 r = glm::normalize(d);
+  if (level0_) mark_taps(mask_.tiles, mask_.tile, n_tiles, size, r, whole_);
+  else mark_near(mask_.tiles, mask_.tile, n_tiles, size, r, margin_, whole_);
+}
+
+CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
+                        int size, int level_count, bool refractors_read_at_surface) {
+  CubeTileMask mask = tile_mask_for_reads(size, level_count);
   std::atomic<bool> refracts{false};
   executor.parallel_for("reflector_cube_maps.tiles", samples.size(), 4096, [&](std::size_t begin, std::size_t end) {
-    float last_exponent = std::numeric_limits<float>::quiet_NaN(), margin = 0.0f;
-    bool level0 = false;
-    unsigned whole = 0;  // faces this chunk marked whole
-    // Marks what a lookup along d through a lobe of that exponent reads: its bilinear taps
-    // when it reads level 0 alone, else every texel within its lookup_reach.
+    LookupTileMarker marker(mask, level_count);
     const auto mark_lookup = [&](const glm::vec3& d, float exponent) {
-      if (!(exponent == last_exponent)) {
-        last_exponent = exponent;
-        margin = std::max(lookup_reach(size, level_count, exponent), 1e-3f);
-        level0 = levels_for_lobes(size, exponent) == 1;
-      }
-      const glm::vec3 r = glm::normalize(d);
-      if (level0) mark_taps(mask.tiles, mask.tile, n_tiles, size, r, whole);
-      else mark_near(mask.tiles, mask.tile, n_tiles, size, r, margin, whole);
+      marker.mark(d, exponent);
       return glm::vec3(0.0f);
     };
     for (std::size_t k = begin; k < end; ++k) {
-      // A wide lobe's marks soon fill whole faces (every sample of a glossy floor marks
-      // most of a face): faces found full stop costing their marks' arithmetic. Maps of
-      // one-texel tiles (level 0 alone) are too large to scan this often.
-      if (mask.tile > 1 && (k - begin) % 256 == 255) note_full_faces(mask.tiles, whole);
       const std::size_t i = samples[k];
       const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
@@ -488,19 +513,10 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     // Maps read for distances alone (MapSizing::colour_read false) get no shader: no face is
     // shaded or prefiltered, and they keep no tiles or layers.
     MapFaceLayers kept;
-    CubeFaceShader shade;
-    if (sizing.colour_read)
-      shade = [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* read) {
-        // Other reflectors seen in this map show the environment along their own R (and
-        // T): the first-order fallback, so a mirror seen in a mirror is never black.
-        ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env, read);
-        if (add_light) direct = add_light(g, direct);
-        if (layers) {
-          kept.specular[face] = specular_texels(g, kept.specular_texel[face]);
-          kept.direct[face] = direct;
-        }
-        return composite(executor, direct, envmap_reflect(executor, g, env));
-      };
+    opt.keep_visibility = !sizing.colour_read && sizing.keep_visibility;
+    const CubeFaceShader shade =
+        sizing.colour_read ? reflector_face_shader(executor, scene, shadows, env, add_light, layers ? &kept : nullptr)
+                           : CubeFaceShader{};
     CubeMap cube = render_cube_map(executor, scene, centre, opt, shade, &scratch);
     out.map_of_object[o] = static_cast<int>(out.cubes.size());
     out.maps.push_back(sizing.colour_read ? environment_from_faces(executor, cube.colour, false, levels, opt.face_mask,
@@ -510,7 +526,43 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     out.centres.push_back(centre);
     out.faces.push_back(opt.face_mask);
     out.tiles.push_back(sizing.colour_read ? std::move(tiles) : CubeTileMask{});
+    out.levels.push_back(levels);
     if (layers) layers->push_back(std::move(kept));
+  }
+  return out;
+}
+
+ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
+                                   const EnvironmentMap& env, const ReflectorMaps& distances,
+                                   std::vector<CubeTileMask> tiles) {
+  ReflectorMaps out;
+  out.map_of_object = distances.map_of_object;
+  out.centres = distances.centres;
+  out.levels = distances.levels;
+  const CubeDepthRange depth_range = scene_cube_depth_range(scene);
+  const FaceLight no_added_light;
+  const CubeFaceShader shade = reflector_face_shader(executor, scene, shadows, env, no_added_light, nullptr);
+  CubeMapScratch scratch;
+  for (std::size_t m = 0; m < distances.cubes.size(); ++m) {
+    const CubeMap& from = distances.cubes[m];
+    CubeMapOptions opt;
+    opt.size = from.size;
+    opt.set_depth_range(depth_range);
+    opt.tiles = &tiles[m];
+    opt.face_mask = 0;
+    for (int f = 0; f < kCubeFaces; ++f)
+      if (((distances.faces[m] >> f) & 1u) &&
+          std::find(tiles[m].tiles[f].begin(), tiles[m].tiles[f].end(), std::uint8_t(1)) != tiles[m].tiles[f].end())
+        opt.face_mask |= 1u << f;
+    CubeMap cube;
+    cube.size = from.size;
+    cube.centre = from.centre;
+    cube.distance = from.distance;
+    cube.colour = shade_cube_faces(executor, scene, from, opt, shade, &scratch);
+    out.maps.push_back(environment_from_faces(executor, cube.colour, false, distances.levels[m], opt.face_mask, &tiles[m]));
+    out.cubes.push_back(std::move(cube));
+    out.faces.push_back(opt.face_mask);
+    out.tiles.push_back(std::move(tiles[m]));
   }
   return out;
 }

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "core/scene.h"
@@ -30,6 +31,7 @@ struct ReflectorMaps {
   std::vector<unsigned> faces;        // bit f: face f rendered (the others black, never read)
   std::vector<CubeTileMask> tiles;    // per map: within those faces, the tiles rendered
                                       // (inactive: all; the others black, never read)
+  std::vector<int> levels;            // per map: the levels its colour is prefiltered to
   const EnvironmentMap* for_object(std::uint32_t object) const {
     if (object >= map_of_object.size() || map_of_object[object] < 0) return nullptr;
     return &maps[map_of_object[object]];
@@ -81,6 +83,10 @@ struct MapSizing {
   // caustics' photons, SURVEY §6.1), no face is resolved or shaded and nothing is prefiltered:
   // the cubes hold distances alone.
   bool colour_read = true;
+  // With colour_read false: each map keeps its faces' visibility, so that its colour can be
+  // shaded afterwards by shade_reflector_maps, on the texels its readers turned out to read
+  // (a distance-map search knows where it reads colour only once it has searched).
+  bool keep_visibility = false;
 };
 
 // Bit f set: face f of a map centred at `centre` is read by the camera samples `samples` of
@@ -102,6 +108,29 @@ void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin);
 // tile. Exposed for tests.
 CubeTileMask tiles_read(par::Executor& executor, const GBuffer& camera_view, const std::vector<std::uint32_t>& samples,
                         int size, int level_count, bool refractors_read_at_surface = false);
+
+// An empty mask for the reads of a map of side `size` (a power of two) with `level_count`
+// levels: one-texel tiles when level 0 alone is read (bilinear taps), else kTile.
+CubeTileMask tile_mask_for_reads(int size, int level_count);
+
+// Marks in a mask (from tile_mask_for_reads) what lookups EnvironmentMap::radiance(d, n) on
+// the map read: the bilinear taps of a lookup that reads level 0 alone, else every texel
+// within lookup_reach of d. One marker per thread (it keeps per-call state); any number of
+// markers may mark one mask at once: a tile is only ever set, so the mask is the same
+// whatever marked what.
+class LookupTileMarker {
+ public:
+  LookupTileMarker(CubeTileMask& mask, int level_count);
+  void mark(const glm::vec3& d, float phong_exponent);  // d: any length, non-zero
+
+ private:
+  CubeTileMask& mask_;
+  int level_count_;
+  float last_exponent_ = std::numeric_limits<float>::quiet_NaN(), margin_ = 0.0f;
+  bool level0_ = false;
+  unsigned whole_ = 0;  // faces found marked whole
+  unsigned marks_ = 0;
+};
 
 // 1 for each object with a specular sample in `camera_view` (what `skip_unseen` keeps).
 std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& camera_view);
@@ -132,6 +161,15 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
                                     const std::vector<std::uint8_t>* skip = nullptr,
                                     const MapSizing& sizing = {},
                                     std::vector<MapFaceLayers>* layers = nullptr);
+
+// The colour of maps rendered with MapSizing::keep_visibility (`distances`), shaded and
+// prefiltered only over `tiles` (one mask per map, from tile_mask_for_reads, marked by the
+// readers): per read texel the same bytes as render_reflector_maps with colour. The maps keep
+// `distances`' distances, centres and objects; faces with no read tile are left black, and
+// no visibility is kept.
+ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
+                                   const EnvironmentMap& env, const ReflectorMaps& distances,
+                                   std::vector<CubeTileMask> tiles);
 
 // The covered specular samples of `g`, compacted to one row in sample order; `texel`
 // receives their indices in g.

@@ -22,10 +22,17 @@ DistanceSearchOptions distance_search_options(const FrameSettings& f) {
 
 FrameOutputs add_distance_map_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   const SurfaceResources s = add_surface_passes(g, scene, f);
-  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, camera_read_maps(false, distance_search_options(f).lobe_directions)},
-                    s.shadow_maps, s.environment, s.gbuffer);
-  auto specular = g.add("distance_map_reflect", DistanceMapReflectPass{distance_search_options(f)},
-                        s.gbuffer, s.environment, maps);
+  const DistanceSearchOptions search = distance_search_options(f);
+  // The maps' distances first; their colour only where the searches turn out to read it.
+  MapSizing distances_only = camera_read_maps(false, search.lobe_directions);
+  distances_only.colour_read = false;
+  distances_only.keep_visibility = true;
+  auto distances = g.add("reflector_distance_maps",
+                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, distances_only},
+                         s.shadow_maps, s.environment, s.gbuffer);
+  auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, distances);
+  auto maps = g.add("reflector_cube_maps", ReflectorColourPass{scene}, s.shadow_maps, s.environment, distances, searches);
+  auto specular = g.add("distance_map_reflect", DistanceMapLookupPass{search}, s.gbuffer, s.environment, maps, searches);
   return add_output_passes(g, f, s.direct, specular);
 }
 
