@@ -184,7 +184,8 @@ TEST(ReflectorMaps, ColourShadedWhereSearchesReadChangesNoSample) {
       searched.lobe_directions = search.lobe_directions;
       const ReflectorMaps whole =
           render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g, ReflectorSelection::all, {}, nullptr, searched);
-      MapSizing distances_only = searched;
+      MapSizing distances_only;  // every face, as the distance-map technique renders them
+      distances_only.skip_unseen = true;
       distances_only.colour_read = false;
       distances_only.keep_visibility = true;
       const ReflectorMaps distances = render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g,
