@@ -191,15 +191,6 @@ DistanceSearches DistanceMapSearchPass::operator()(par::NodeContext& c, const GB
   return found;
 }
 
-ReflectorMaps ReflectorColourPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
-                                              const EnvironmentMap& environment, const ReflectorMaps& distances,
-                                              const DistanceSearches& searches) const {
-  ReflectorMaps maps = shade_reflector_maps(c.executor(), *scene, shadows, environment, distances, searches.tiles);
-  c.count("cube_maps", maps.cubes.size());
-  c.count("cube_texels", rendered_texels(maps));
-  return maps;
-}
-
 ImageRGBA DistanceMapLookupPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
                                             const EnvironmentMap& environment, const ReflectorMaps& maps,
                                             const DistanceSearches& searches) const {

@@ -73,18 +73,6 @@ struct DistanceMapSearchPass {
   DistanceSearches operator()(par::NodeContext& c, const GBuffer& gbuffer, const ReflectorMaps& maps) const;
 };
 
-// Pass "reflector_cube_maps" after the searches: the maps' colour, shaded and prefiltered only
-// on the tiles the searches read (shade_reflector_maps).
-struct ReflectorColourPass {
-  static constexpr const char* description =
-      "Per specular object the colour of its cube map, shaded and prefiltered only where the "
-      "searches read it (SURVEY §3.1, §4.2).";
-  const Scene* scene = nullptr;
-  void parameters(par::Params& p) const { p.set("tiles", "read by the searches"); }
-  ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
-                           const ReflectorMaps& distances, const DistanceSearches& searches) const;
-};
-
 // Pass "distance_map_reflect" after distance_map_search: each search's colour read from the
 // shaded maps, Fresnel-weighted (distance_map_lookup).
 struct DistanceMapLookupPass {

@@ -63,7 +63,9 @@ std::vector<PlanarMirror> find_planar_mirrors(const Scene& scene, float toleranc
 
 namespace {
 
-struct Recursion {
+// Phase one of the recursion: every view rendered, lit and searched, depth-first in mirror
+// order (which views fit max_views does not depend on threads).
+struct ViewRecursion {
   par::Executor& executor;
   const Scene& scene;
   const std::vector<PlanarMirror>& mirrors;
@@ -71,88 +73,118 @@ struct Recursion {
   const EnvironmentMap& env;
   const ReflectorMaps* curved;
   PlanarMirrorSettings settings;
-  PlanarMirrorStats stats;
-  DistanceReflectStats search;  // the curved reflectors' searches, in every view
+  PlanarMirrorViews& out;
   std::vector<std::uint8_t> is_mirror;  // per object id: 1 for the planar mirrors
 
-  // Radiance of a mirrored view: the whole per-view pipeline (visibility → G-buffer →
-  // direct light → specular layer) for `camera` in the clipped scene.
-  ImageRGBA view_radiance(const Scene& view_scene, const Camera& camera, int level) {
-    ++stats.mirrored_views;
-    const VisibilityBuffer vis =
-        render_visibility(executor, view_scene, camera, settings.width, settings.height);
-    const GBuffer g = resolve_gbuffer(executor, view_scene, vis, camera.eye);
-    ImageRGBA radiance = direct_light(executor, view_scene, g, camera, shadows, env);
-    const ImageRGBA specular = reflect(g, camera, level);
-    executor.parallel_for("planar_mirror.add_layers", radiance.size(), 4096,
-                          [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i)
-        radiance.pixels[i] = glm::vec4(glm::vec3(radiance.pixels[i]) + glm::vec3(specular.pixels[i]), 1.0f);
-    });
-    return radiance;
-  }
-
-  // The specular layer of a view at recursion `level` (0: the camera's own view).
-  ImageRGBA reflect(const GBuffer& g, const Camera& camera, int level) {
-    ImageRGBA specular = curved ? distance_map_reflect(executor, g, env, *curved, DistanceSearchOptions{}, &search)
-                                : envmap_reflect(executor, g, env);
+  // Adds view `v`'s searches and, below `settings.depth`, the mirrored views of the mirrors
+  // it sees. `g` is the view's G-buffer (views[v].g, or the camera's for view 0).
+  void add(std::size_t v, const GBuffer& g, const Camera& camera, int level) {
+    if (curved) {
+      out.views[v].searches = distance_map_search(executor, g, *curved, DistanceSearchOptions{});
+      merge_reads(out.tiles, out.views[v].searches.tiles);
+      out.stats.search_missed += out.views[v].searches.stats.missed;
+    }
     if (level >= settings.depth) {
       // The mirrors seen here are not rendered again: they keep the environment lookup.
       for (const std::uint32_t object : g.object.pixels)
-        stats.depth_exhausted += object < is_mirror.size() && is_mirror[object];
-      return specular;
+        out.stats.depth_exhausted += object < is_mirror.size() && is_mirror[object];
+      return;
     }
-    for (const PlanarMirror& mirror : mirrors) {
+    for (std::size_t k = 0; k < mirrors.size(); ++k) {
+      const PlanarMirror& mirror = mirrors[k];
       // Skip mirrors this view does not see (no mirrored render for them).
-      bool seen = false;
-      for (std::size_t i = 0; i < g.object.size() && !seen; ++i) seen = g.object.pixels[i] == mirror.object;
-      if (!seen) continue;
-      if (stats.mirrored_views >= static_cast<std::uint64_t>(settings.max_views)) {
-        ++stats.views_over_budget;  // a bound that is hit is counted, never silent
+      std::uint64_t samples = 0;
+      for (const std::uint32_t object : g.object.pixels) samples += object == mirror.object;
+      if (samples == 0) continue;
+      if (out.stats.mirrored_views >= static_cast<std::uint64_t>(settings.max_views)) {
+        ++out.stats.views_over_budget;  // a bound that is hit is counted, never silent
         continue;
       }
-      const ImageRGBA mirrored = view_radiance(mirror.clipped_for(camera.eye),
-                                               mirrored_camera(camera, mirror.plane), level + 1);
-      const int w = g.width;
-      std::uint64_t samples = 0;
-      std::vector<std::uint64_t> per_row(static_cast<std::size_t>(g.height), 0);
-      executor.parallel_for("planar_mirror.composite_mirror", static_cast<std::size_t>(g.height), 8,
-                            [&](std::size_t begin, std::size_t end) {
-        for (std::size_t y = begin; y < end; ++y)
-          for (int x = 0; x < w; ++x) {
-            const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-            if (g.object.pixels[i] != mirror.object) continue;
-            // The mirrored camera sees the reflected rays left-right mirrored.
-            const glm::vec3 l(mirrored.at(w - 1 - x, static_cast<int>(y)));
-            const float cos_nv = std::abs(glm::dot(g.normal.pixels[i], g.view_direction(i)));
-            specular.pixels[i] = glm::vec4(specular_reflectance(g.surface[i], cos_nv) * l, 1.0f);
-            ++per_row[y];
-          }
-      });
-      for (const std::uint64_t n : per_row) samples += n;
-      stats.mirror_samples += samples;
+      ++out.stats.mirrored_views;
+      out.stats.mirror_samples += samples;
+      // The mirrored view: visibility → G-buffer → direct light, in the scene clipped at
+      // the mirror's plane.
+      const Scene& view_scene = mirror.clipped_for(camera.eye);
+      const Camera mirrored = mirrored_camera(camera, mirror.plane);
+      const std::size_t child = out.views.size();
+      out.views[v].mirrored.push_back({k, child});
+      out.views.emplace_back();
+      PlanarMirrorView& view = out.views[child];
+      const VisibilityBuffer vis = render_visibility(executor, view_scene, mirrored, settings.width, settings.height);
+      view.g = resolve_gbuffer(executor, view_scene, vis, mirrored.eye);
+      view.direct = direct_light(executor, view_scene, view.g, mirrored, shadows, env);
+      add(child, out.views[child].g, mirrored, level + 1);
     }
-    return specular;
   }
 };
 
+// Phase two: view `v`'s specular layer from the shaded maps, each mirror's samples replaced by
+// F × its mirrored view's radiance (direct light + specular layer).
+ImageRGBA compose(par::Executor& executor, const PlanarMirrorViews& views, std::size_t v, const GBuffer& g,
+                  const std::vector<PlanarMirror>& mirrors, const EnvironmentMap& env, const ReflectorMaps* curved) {
+  ImageRGBA specular = curved ? distance_map_lookup(executor, g, env, *curved, views.views[v].searches, DistanceSearchOptions{})
+                              : envmap_reflect(executor, g, env);
+  for (const auto& [k, child] : views.views[v].mirrored) {
+    const PlanarMirrorView& view = views.views[child];
+    ImageRGBA mirrored = compose(executor, views, child, view.g, mirrors, env, curved);
+    executor.parallel_for("planar_mirror.add_layers", mirrored.size(), 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        mirrored.pixels[i] = glm::vec4(glm::vec3(view.direct.pixels[i]) + glm::vec3(mirrored.pixels[i]), 1.0f);
+    });
+    const std::uint32_t object = mirrors[k].object;
+    const int w = g.width;
+    executor.parallel_for("planar_mirror.composite_mirror", static_cast<std::size_t>(g.height), 8,
+                          [&](std::size_t begin, std::size_t end) {
+      for (std::size_t y = begin; y < end; ++y)
+        for (int x = 0; x < w; ++x) {
+          const std::size_t i = y * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+          if (g.object.pixels[i] != object) continue;
+          // The mirrored camera sees the reflected rays left-right mirrored.
+          const glm::vec3 l(mirrored.at(w - 1 - x, static_cast<int>(y)));
+          const float cos_nv = std::abs(glm::dot(g.normal.pixels[i], g.view_direction(i)));
+          specular.pixels[i] = glm::vec4(specular_reflectance(g.surface[i], cos_nv) * l, 1.0f);
+        }
+    });
+  }
+  return specular;
+}
+
 }  // namespace
+
+PlanarMirrorViews planar_mirror_views(par::Executor& executor, const Scene& scene,
+                                      const std::vector<PlanarMirror>& mirrors, const GBuffer& g,
+                                      const Camera& camera, const std::vector<ShadowMap>& shadows,
+                                      const EnvironmentMap& env, const ReflectorMaps* curved,
+                                      const PlanarMirrorSettings& settings) {
+  PlanarMirrorViews out;
+  out.views.emplace_back();
+  if (curved)
+    for (std::size_t m = 0; m < curved->cubes.size(); ++m)
+      out.tiles.push_back(tile_mask_for_reads(curved->cubes[m].size, curved->levels[m]));
+  PlanarMirrorSettings s = settings;
+  s.width = g.width;
+  s.height = g.height;
+  ViewRecursion r{executor, scene, mirrors, shadows, env, curved, s, out, std::vector<std::uint8_t>(scene.objects.size(), 0)};
+  for (const PlanarMirror& mirror : mirrors)
+    if (mirror.object < r.is_mirror.size()) r.is_mirror[mirror.object] = 1;
+  r.add(0, g, camera, 0);
+  return out;
+}
+
+ImageRGBA planar_mirror_compose(par::Executor& executor, const PlanarMirrorViews& views, const GBuffer& g,
+                                const std::vector<PlanarMirror>& mirrors, const EnvironmentMap& env,
+                                const ReflectorMaps* curved) {
+  return compose(executor, views, 0, g, mirrors, env, curved);
+}
 
 ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
                                 const std::vector<PlanarMirror>& mirrors, const GBuffer& g,
                                 const Camera& camera, const std::vector<ShadowMap>& shadows,
                                 const EnvironmentMap& env, const ReflectorMaps* curved,
                                 const PlanarMirrorSettings& settings, PlanarMirrorStats* stats) {
-  PlanarMirrorSettings s = settings;
-  s.width = g.width;
-  s.height = g.height;
-  Recursion r{executor, scene, mirrors, shadows, env, curved, s, {}, {}, std::vector<std::uint8_t>(scene.objects.size(), 0)};
-  for (const PlanarMirror& mirror : mirrors)
-    if (mirror.object < r.is_mirror.size()) r.is_mirror[mirror.object] = 1;
-  ImageRGBA specular = r.reflect(g, camera, 0);
-  r.stats.search_missed = r.search.missed;
-  if (stats) *stats = r.stats;
-  return specular;
+  const PlanarMirrorViews views = planar_mirror_views(executor, scene, mirrors, g, camera, shadows, env, curved, settings);
+  if (stats) *stats = views.stats;
+  return planar_mirror_compose(executor, views, g, mirrors, env, curved);
 }
 
 PlanarMirrors PlanarMirrorsPass::operator()(par::NodeContext& c) const {
@@ -161,21 +193,27 @@ PlanarMirrors PlanarMirrorsPass::operator()(par::NodeContext& c) const {
   return mirrors;
 }
 
-ImageRGBA PlanarMirrorReflectPass::operator()(par::NodeContext& c, const PlanarMirrors& mirrors,
-                                             const GBuffer& gbuffer, const ShadowMaps& shadows,
-                                             const EnvironmentMap& environment,
-                                             const ReflectorMaps* curved_reflectors) const {
+PlanarMirrorViews PlanarMirrorViewsPass::operator()(par::NodeContext& c, const PlanarMirrors& mirrors,
+                                                    const GBuffer& gbuffer, const ShadowMaps& shadows,
+                                                    const EnvironmentMap& environment,
+                                                    const ReflectorMaps& curved_reflectors) const {
   PlanarMirrorSettings settings;
   settings.depth = depth;
-  PlanarMirrorStats stats;
-  ImageRGBA specular = planar_mirror_reflect(c.executor(), *scene, mirrors, gbuffer, camera, shadows,
-                                             environment, curved_reflectors, settings, &stats);
-  c.count("mirrored_views", stats.mirrored_views);
-  c.count("mirror_samples", stats.mirror_samples);
-  c.count("views_over_budget", stats.views_over_budget);
-  c.count("fallback_depth_exhausted", stats.depth_exhausted);
-  c.count("fallback_search_missed", stats.search_missed);
-  return specular;
+  PlanarMirrorViews views = planar_mirror_views(c.executor(), *scene, mirrors, gbuffer, camera, shadows, environment,
+                                                &curved_reflectors, settings);
+  c.count("mirrored_views", views.stats.mirrored_views);
+  c.count("mirror_samples", views.stats.mirror_samples);
+  c.count("views_over_budget", views.stats.views_over_budget);
+  c.count("fallback_depth_exhausted", views.stats.depth_exhausted);
+  c.count("fallback_search_missed", views.stats.search_missed);
+  return views;
+}
+
+ImageRGBA PlanarMirrorComposePass::operator()(par::NodeContext& c, const PlanarMirrorViews& views,
+                                              const GBuffer& gbuffer, const PlanarMirrors& mirrors,
+                                              const EnvironmentMap& environment,
+                                              const ReflectorMaps& curved_reflectors) const {
+  return planar_mirror_compose(c.executor(), views, gbuffer, mirrors, environment, &curved_reflectors);
 }
 
 }  // namespace speculum::raster

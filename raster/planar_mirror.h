@@ -5,12 +5,15 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/scene.h"
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
+#include "raster/distance_map_reflect.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
 #include "raster/mirrored_camera.h"
@@ -62,13 +65,40 @@ struct PlanarMirrorStats {
 // `depth` levels; beyond it the environment lookup); every other specular sample, in the
 // camera's view and in every mirrored view, gets the distance-map search (SURVEY §4.2) in
 // its own cube map in `curved` when it has one, else the environment lookup of envmap_reflect.
-// `shadows` and `env` are the original scene's.
+// `shadows` and `env` are the original scene's. planar_mirror_views then
+// planar_mirror_compose with the same maps.
 ImageRGBA planar_mirror_reflect(par::Executor& executor, const Scene& scene,
                                 const std::vector<PlanarMirror>& mirrors, const GBuffer& g,
                                 const Camera& camera, const std::vector<ShadowMap>& shadows,
                                 const EnvironmentMap& env, const ReflectorMaps* curved,
                                 const PlanarMirrorSettings& settings,
                                 PlanarMirrorStats* stats = nullptr);
+
+// planar_mirror_reflect in two halves, so that the curved reflectors' maps are shaded only
+// where some view's searches read them. The views of the recursion, views[0] the camera's:
+// each mirrored view's G-buffer and direct light, and every view's searches in `curved` (its
+// distances are all they read).
+struct PlanarMirrorView {
+  GBuffer g;                 // mirrored views (the camera's is the caller's)
+  ImageRGBA direct;          // mirrored views: direct light
+  DistanceSearches searches; // with curved maps: this view's searches
+  std::vector<std::pair<std::size_t, std::size_t>> mirrored;  // (mirror index, view index)
+};
+struct PlanarMirrorViews {
+  std::deque<PlanarMirrorView> views;  // a deque: adding a view moves none of the others
+  std::vector<CubeTileMask> tiles;  // per curved map: the tiles any view's searches read
+  PlanarMirrorStats stats;
+};
+PlanarMirrorViews planar_mirror_views(par::Executor& executor, const Scene& scene,
+                                      const std::vector<PlanarMirror>& mirrors, const GBuffer& g,
+                                      const Camera& camera, const std::vector<ShadowMap>& shadows,
+                                      const EnvironmentMap& env, const ReflectorMaps* curved,
+                                      const PlanarMirrorSettings& settings);
+// The specular layer of the camera's view from `views` (of the same `g` and `mirrors`), the
+// searches read in `curved` (the same maps, or their colour shaded over views.tiles).
+ImageRGBA planar_mirror_compose(par::Executor& executor, const PlanarMirrorViews& views, const GBuffer& g,
+                                const std::vector<PlanarMirror>& mirrors, const EnvironmentMap& env,
+                                const ReflectorMaps* curved);
 
 using PlanarMirrors = std::vector<PlanarMirror>;
 
@@ -81,19 +111,30 @@ struct PlanarMirrorsPass {
   PlanarMirrors operator()(par::NodeContext& c) const;
 };
 
-// Pass "planar_mirror_reflect": the specular layer by reflected cameras, recursively.
-struct PlanarMirrorReflectPass {
+// Pass "planar_mirror_views": the recursion's views, rendered, lit and searched.
+struct PlanarMirrorViewsPass {
   static constexpr const char* description =
-      "Each planar mirror's samples get F × the view of the camera reflected about the mirror "
-      "plane (scene clipped at the plane), recursively to depth k; other specular samples search "
-      "their own distance map, or look up the environment (SURVEY §5, §4.2).";
+      "Per planar mirror the view of the camera reflected about its plane (scene clipped at the "
+      "plane), recursively to depth k, each lit; every view's curved specular samples search "
+      "their own distance map (SURVEY §5, §4.2).";
   const Scene* scene = nullptr;
   Camera camera;
   int depth = 3;
   void parameters(par::Params& p) const { p.set("depth", depth); }
-  ImageRGBA operator()(par::NodeContext& c, const PlanarMirrors& mirrors, const GBuffer& gbuffer,
-                       const ShadowMaps& shadows, const EnvironmentMap& environment,
-                       const ReflectorMaps* curved_reflectors) const;
+  PlanarMirrorViews operator()(par::NodeContext& c, const PlanarMirrors& mirrors, const GBuffer& gbuffer,
+                               const ShadowMaps& shadows, const EnvironmentMap& environment,
+                               const ReflectorMaps& curved_reflectors) const;
+};
+
+// Pass "planar_mirror_reflect": the specular layer: each mirror's samples get F × its view's
+// radiance, the other specular samples their searches' colour.
+struct PlanarMirrorComposePass {
+  static constexpr const char* description =
+      "Each planar mirror's samples get F × its reflected view's radiance, recursively; other "
+      "specular samples read their searches' hits in the shaded maps (SURVEY §5, §4.2).";
+  ImageRGBA operator()(par::NodeContext& c, const PlanarMirrorViews& views, const GBuffer& gbuffer,
+                       const PlanarMirrors& mirrors, const EnvironmentMap& environment,
+                       const ReflectorMaps& curved_reflectors) const;
 };
 
 }  // namespace speculum::raster

@@ -298,6 +298,15 @@ void LookupTileMarker::mark(const glm::vec3& d, float exponent) {
   else mark_near(mask_.tiles, mask_.tile, n_tiles, size, r, margin_, whole_);
 }
 
+void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask>& from) {
+  for (std::size_t m = 0; m < into.size() && m < from.size(); ++m)
+    for (int f = 0; f < kCubeFaces; ++f) {
+      std::vector<std::uint8_t>& to = into[m].tiles[f];
+      const std::vector<std::uint8_t>& marked = from[m].tiles[f];
+      for (std::size_t k = 0; k < to.size() && k < marked.size(); ++k) to[k] |= marked[k];
+    }
+}
+
 CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::vector<std::uint32_t>& samples,
                         int size, int level_count, bool refractors_read_at_surface) {
   CubeTileMask mask = tile_mask_for_reads(size, level_count);

@@ -132,6 +132,9 @@ class LookupTileMarker {
   unsigned marks_ = 0;
 };
 
+// Marks in `into` every tile marked in `from` (masks of the same maps, in map order).
+void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask>& from);
+
 // 1 for each object with a specular sample in `camera_view` (what `skip_unseen` keeps).
 std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& camera_view);
 
@@ -198,6 +201,26 @@ struct ReflectorCubeMapsPass {
   }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows,
                            const EnvironmentMap& environment, const GBuffer& gbuffer) const;
+};
+
+// Pass "reflector_cube_maps" after the searches: the colour of maps rendered with
+// keep_visibility, shaded and prefiltered only on the tiles the searches read
+// (shade_reflector_maps). `Reads` is what recorded them: any type with the per-map
+// `tiles` (DistanceSearches, PlanarMirrorViews).
+template <class Reads>
+struct ReflectorColourPass {
+  static constexpr const char* description =
+      "Per specular object the colour of its cube map, shaded and prefiltered only where the "
+      "searches read it (SURVEY §3.1, §4.2).";
+  const Scene* scene = nullptr;
+  void parameters(par::Params& p) const { p.set("tiles", "read by the searches"); }
+  ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
+                           const ReflectorMaps& distances, const Reads& reads) const {
+    ReflectorMaps maps = shade_reflector_maps(c.executor(), *scene, shadows, environment, distances, reads.tiles);
+    c.count("cube_maps", maps.cubes.size());
+    c.count("cube_texels", rendered_texels(maps));
+    return maps;
+  }
 };
 
 }  // namespace speculum::raster

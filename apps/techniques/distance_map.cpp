@@ -34,7 +34,7 @@ FrameOutputs add_distance_map_passes(par::Graph& g, const Scene* scene, const Fr
                          ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, distances_only},
                          s.shadow_maps, s.environment, s.gbuffer);
   auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, distances);
-  auto maps = g.add("reflector_cube_maps", ReflectorColourPass{scene}, s.shadow_maps, s.environment, distances, searches);
+  auto maps = g.add("reflector_cube_maps", ReflectorColourPass<DistanceSearches>{scene}, s.shadow_maps, s.environment, distances, searches);
   auto specular = g.add("distance_map_reflect", DistanceMapLookupPass{search}, s.gbuffer, s.environment, maps, searches);
   return add_output_passes(g, f, s.direct, specular);
 }

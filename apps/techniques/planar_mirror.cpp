@@ -16,13 +16,20 @@ FrameOutputs add_planar_mirror_passes(par::Graph& g, const Scene* scene, const F
   const SurfaceResources s = add_surface_passes(g, scene, f, notes);
   auto mirrors = g.add("planar_mirrors", PlanarMirrorsPass{scene});
   // Curved and glossy reflectors are not planar mirrors: they get the distance-map search in
-  // cube maps of their own (SURVEY §4.2), in the camera's view and in every mirrored one.
-  auto curved = g.add("reflector_cube_maps",
-                      ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors, MapSizing{}},
-                      s.shadow_maps, s.environment, s.gbuffer);
-  auto specular = g.add("planar_mirror_reflect",
-                        PlanarMirrorReflectPass{scene, f.camera, static_cast<int>(f.param("depth"))},
-                        mirrors, s.gbuffer, s.shadow_maps, s.environment, curved);
+  // cube maps of their own (SURVEY §4.2), in the camera's view and in every mirrored one —
+  // their distances first, their colour only where the searches of all views read it.
+  MapSizing distances_only;
+  distances_only.colour_read = false;
+  distances_only.keep_visibility = true;
+  auto distances = g.add("reflector_distance_maps",
+                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors, distances_only},
+                         s.shadow_maps, s.environment, s.gbuffer);
+  auto views = g.add("planar_mirror_views", PlanarMirrorViewsPass{scene, f.camera, static_cast<int>(f.param("depth"))},
+                     mirrors, s.gbuffer, s.shadow_maps, s.environment, distances);
+  auto curved = g.add("reflector_cube_maps", ReflectorColourPass<PlanarMirrorViews>{scene}, s.shadow_maps,
+                      s.environment, distances, views);
+  auto specular = g.add("planar_mirror_reflect", PlanarMirrorComposePass{}, views, s.gbuffer, mirrors, s.environment,
+                        curved);
   return add_output_passes(g, f, s.direct, specular);
 }
 

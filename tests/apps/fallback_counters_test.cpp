@@ -37,10 +37,10 @@ TEST(FallbackCounters, PlanarMirrorDepthExhaustedIsWhatTheNextDepthRenders) {
   for (int k = 0; k <= 2; ++k) {
     SCOPED_TRACE(k);
     const FrameResult at = render(s, "planar-mirror", "depth", k), next = render(s, "planar-mirror", "depth", k + 1);
-    const double exhausted = node_counter(at, "planar_mirror_reflect", "fallback_depth_exhausted");
+    const double exhausted = node_counter(at, "planar_mirror_views", "fallback_depth_exhausted");
     EXPECT_GT(exhausted, 0.0);  // the corridor's mirrors face each other: every depth stops somewhere
-    EXPECT_EQ(exhausted, node_counter(next, "planar_mirror_reflect", "mirror_samples") -
-                             node_counter(at, "planar_mirror_reflect", "mirror_samples"));
+    EXPECT_EQ(exhausted, node_counter(next, "planar_mirror_views", "mirror_samples") -
+                             node_counter(at, "planar_mirror_views", "mirror_samples"));
   }
 }
 

@@ -15,6 +15,7 @@
 #include "core/camera_rays.h"
 #include "core/optics.h"
 #include "core/scene_loader.h"
+#include "raster/shadow_map.h"
 #include "raster_test_scenes.h"
 #include "trace/reference_tracer.h"
 
@@ -291,6 +292,43 @@ TEST(PlanarMirror, MirrorsThatSeeEachOtherStopAtTheViewBudget) {
   run(two, 8, PlanarMirrorSettings{}.max_views, deep);
   EXPECT_EQ(deep.mirrored_views, static_cast<std::uint64_t>(PlanarMirrorSettings{}.max_views));
   EXPECT_GT(deep.views_over_budget, 0u);
+}
+
+// The curved reflectors' maps shaded only where the searches of every view (the camera's and
+// the mirrored ones) read them give the same specular layer, byte for byte, as complete maps,
+// with fewer texels shaded.
+TEST(PlanarMirror, CurvedMapsShadedWhereTheViewsSearchChangeNoSample) {
+  par::Executor ex(2);
+  for (const char* name : {"living-room", "mirror-corridor"}) {
+    SCOPED_TRACE(name);
+    const Scene s = load_scene(name);
+    const Camera c = s.cameras.front();
+    const GBuffer g = resolve_gbuffer(ex, s, render_visibility(ex, s, c, 128, 96), c.eye);
+    const EnvironmentMap env = build_environment(ex, s.environment);
+    const ShadowMaps shadows = render_shadow_maps(ex, s, 128);
+    const auto mirrors = find_planar_mirrors(s);
+    ASSERT_FALSE(mirrors.empty());
+    PlanarMirrorSettings settings;
+    settings.depth = 2;
+    const ReflectorMaps whole =
+        render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::not_planar_mirrors);
+    ASSERT_FALSE(whole.cubes.empty());
+    PlanarMirrorStats whole_stats;
+    const ImageRGBA expected = planar_mirror_reflect(ex, s, mirrors, g, c, shadows, env, &whole, settings, &whole_stats);
+    MapSizing distances_only;
+    distances_only.colour_read = false;
+    distances_only.keep_visibility = true;
+    const ReflectorMaps distances = render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::not_planar_mirrors,
+                                                          {}, nullptr, distances_only);
+    const PlanarMirrorViews views = planar_mirror_views(ex, s, mirrors, g, c, shadows, env, &distances, settings);
+    EXPECT_GT(views.stats.mirrored_views, 0u);
+    EXPECT_EQ(views.stats.mirrored_views, whole_stats.mirrored_views);
+    EXPECT_EQ(views.stats.mirror_samples, whole_stats.mirror_samples);
+    const ReflectorMaps shaded = shade_reflector_maps(ex, s, shadows, env, distances, views.tiles);
+    EXPECT_LT(rendered_texels(shaded), rendered_texels(whole));
+    const ImageRGBA got = planar_mirror_compose(ex, views, g, mirrors, env, &shaded);
+    EXPECT_EQ(0, std::memcmp(expected.pixels.data(), got.pixels.data(), expected.size() * sizeof(glm::vec4)));
+  }
 }
 
 }  // namespace
