@@ -707,15 +707,25 @@ CausticMaps CausticMapPass::operator()(par::NodeContext& c, const CausticPhotons
   return m;
 }
 
-ReflectorMaps CausticReflectorMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
-                                                   const EnvironmentMap& environment, const GBuffer& gbuffer,
-                                                   const CausticMaps& caustics) const {
-  ReflectorMaps maps = render_reflector_maps(
-      c.executor(), *scene, shadows, environment, size, &gbuffer, ReflectorSelection::all,
-      [&](const GBuffer& face, const ImageRGBA& direct) {
-        return gather_caustics(c.executor(), face, caustics, direct, tolerance);
-      },
-      nullptr, sizing);
+ReflectorMaps shade_caustic_reflector_maps(par::Executor& executor, const Scene& scene,
+                                           const std::vector<ShadowMap>& shadows, const EnvironmentMap& env,
+                                           const ReflectorMaps& distances, const DistanceSearches& searches,
+                                           const CausticMaps& caustics, float tolerance) {
+  std::vector<CubeTileMask> tiles = searches.tiles;
+  for (std::size_t m = 0; m < tiles.size() && m < distances.refracts.size(); ++m)
+    if (distances.refracts[m]) tiles[m].mark_all();
+  return shade_reflector_maps(executor, scene, shadows, env, distances, std::move(tiles),
+                              [&](const GBuffer& face, const ImageRGBA& direct) {
+                                return gather_caustics(executor, face, caustics, direct, tolerance);
+                              });
+}
+
+ReflectorMaps CausticReflectorColourPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                                     const EnvironmentMap& environment, const ReflectorMaps& distances,
+                                                     const DistanceSearches& searches,
+                                                     const CausticMaps& caustics) const {
+  ReflectorMaps maps =
+      shade_caustic_reflector_maps(c.executor(), *scene, shadows, environment, distances, searches, caustics, tolerance);
   c.count("cube_maps", static_cast<double>(maps.cubes.size()));
   c.count("cube_texels", rendered_texels(maps));
   return maps;

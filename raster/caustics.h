@@ -48,6 +48,7 @@
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
 #include "raster/cube_map.h"
+#include "raster/distance_map_reflect.h"
 #include "raster/distance_map_search.h"
 #include "raster/gbuffer.h"
 #include "raster/reflector_maps.h"
@@ -170,23 +171,28 @@ struct CausticMapPass {
   CausticMaps operator()(par::NodeContext& c, const CausticPhotons& photons) const;
 };
 
-// Pass "caustic_reflector_maps": the reflector cube maps rendered again with the caustics
-// gathered on their faces, so reflections and refractions show them.
-struct CausticReflectorMapsPass {
+// The caustics technique's lit maps: the colour of `distances` (rendered with
+// MapSizing::keep_visibility) with the caustics gathered on the faces, shaded only on the
+// tiles `searches` read — a refractor's map whole, since paths through it read it anywhere.
+ReflectorMaps shade_caustic_reflector_maps(par::Executor& executor, const Scene& scene,
+                                           const std::vector<ShadowMap>& shadows, const EnvironmentMap& env,
+                                           const ReflectorMaps& distances, const DistanceSearches& searches,
+                                           const CausticMaps& caustics, float tolerance);
+
+// Pass "caustic_reflector_maps" after the camera's searches: the same maps' colour, shaded only
+// where the searches read it (shade_reflector_maps with the caustics on the faces); a
+// refractor's map whole, since paths through it (the refraction pass) read it anywhere.
+struct CausticReflectorColourPass {
   static constexpr const char* description =
-      "Per specular object the colour + distance cube map again, its faces' direct light "
-      "completed by the caustic maps: caustics seen in reflections and through refractors (SURVEY §6.3.3).";
+      "Per specular object the colour of its cube map, its faces' direct light completed by the "
+      "caustic maps, shaded only where the camera's searches read it (refractors' whole): caustics "
+      "seen in reflections and through refractors (SURVEY §6.3.3).";
   const Scene* scene = nullptr;
-  int size = 256;
   float tolerance = 0.05f;
-  MapSizing sizing;  // what the frame reads of them (render_reflector_maps)
-  void parameters(par::Params& p) const {
-    p.set("size", size);
-    p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
-    p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all" : "read by searches");
-  }
+  void parameters(par::Params& p) const { p.set("tiles", "read by the searches; refractors' all"); }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
-                           const GBuffer& gbuffer, const CausticMaps& caustics) const;
+                           const ReflectorMaps& distances, const DistanceSearches& searches,
+                           const CausticMaps& caustics) const;
 };
 
 // Pass "caustic_gather".

@@ -109,6 +109,10 @@ struct CubeTileMask {
   std::array<std::vector<std::uint8_t>, kCubeFaces> tiles;  // tiles_per_side()² per face, 1: read
 
   bool active() const { return size > 0; }
+  // Every tile of every face read (the tiles sized already).
+  void mark_all() {
+    for (auto& t : tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
+  }
   int tiles_per_side() const { return (size + tile - 1) / tile; }
   // Level-`level` texel (x, y) of `face` (a side of size >> level) overlaps a read tile.
   bool covers(int face, int level, int x, int y) const;

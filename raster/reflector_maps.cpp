@@ -536,6 +536,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     out.faces.push_back(opt.face_mask);
     out.tiles.push_back(sizing.colour_read ? std::move(tiles) : CubeTileMask{});
     out.levels.push_back(levels);
+    out.refracts.push_back(refracts ? 1 : 0);
     if (layers) layers->push_back(std::move(kept));
   }
   return out;
@@ -543,14 +544,14 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
 
 ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
                                    const EnvironmentMap& env, const ReflectorMaps& distances,
-                                   std::vector<CubeTileMask> tiles) {
+                                   std::vector<CubeTileMask> tiles, const FaceLight& add_light) {
   ReflectorMaps out;
   out.map_of_object = distances.map_of_object;
   out.centres = distances.centres;
   out.levels = distances.levels;
+  out.refracts = distances.refracts;
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
-  const FaceLight no_added_light;
-  const CubeFaceShader shade = reflector_face_shader(executor, scene, shadows, env, no_added_light, nullptr);
+  const CubeFaceShader shade = reflector_face_shader(executor, scene, shadows, env, add_light, nullptr);
   CubeMapScratch scratch;
   for (std::size_t m = 0; m < distances.cubes.size(); ++m) {
     const CubeMap& from = distances.cubes[m];

@@ -32,6 +32,8 @@ struct ReflectorMaps {
   std::vector<CubeTileMask> tiles;    // per map: within those faces, the tiles rendered
                                       // (inactive: all; the others black, never read)
   std::vector<int> levels;            // per map: the levels its colour is prefiltered to
+  std::vector<std::uint8_t> refracts; // per map: 1 when its object refracts (paths through it
+                                      // read its map anywhere)
   const EnvironmentMap* for_object(std::uint32_t object) const {
     if (object >= map_of_object.size() || map_of_object[object] < 0) return nullptr;
     return &maps[map_of_object[object]];
@@ -170,9 +172,10 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
 // readers): per read texel the same bytes as render_reflector_maps with colour. The maps keep
 // `distances`' distances, centres and objects; faces with no read tile are left black, and
 // no visibility is kept.
+// `add_light` as for render_reflector_maps.
 ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
                                    const EnvironmentMap& env, const ReflectorMaps& distances,
-                                   std::vector<CubeTileMask> tiles);
+                                   std::vector<CubeTileMask> tiles, const FaceLight& add_light = {});
 
 // The covered specular samples of `g`, compacted to one row in sample order; `texel`
 // receives their indices in g.

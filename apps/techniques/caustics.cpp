@@ -21,9 +21,11 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   search.linear = search.linear_steps >= 2;
   search.secant_steps = static_cast<int>(f.param("secant_steps"));
   const SurfaceResources s = add_surface_passes(g, scene, f);
-  // The photons search these maps' distances only; what reflections read are the lit maps below.
+  // The photons search these maps' distances only, and so do the camera's searches; what
+  // reflections read is the lit maps' colour below, shaded where those searches read it.
   MapSizing distances_only;
   distances_only.colour_read = false;
+  distances_only.keep_visibility = true;
   auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, distances_only},
                     s.shadow_maps, s.environment, s.gbuffer)
                   .describe("Distance cube map around each specular object, itself left out: what the "
@@ -48,12 +50,13 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   auto caustic_maps = g.add("caustic_map", CausticMapPass{scene, mo}, photons);
   const float tolerance = static_cast<float>(f.param("tolerance"));
   auto lit = g.add("caustic_gather", CausticGatherPass{tolerance}, s.gbuffer, caustic_maps, s.direct);
-  // What reflections and refractions look up: the maps again, with the caustics on them.
-  // Only the camera's samples read them (searched along R, refractors' maps whole).
-  auto lit_maps = g.add("caustic_reflector_maps",
-                        CausticReflectorMapsPass{scene, f.cube_map_size, tolerance, camera_read_maps(false, search.lobe_directions)},
-                        s.shadow_maps, s.environment, s.gbuffer, caustic_maps);
-  auto reflected = g.add("distance_map_reflect", DistanceMapReflectPass{search}, s.gbuffer, s.environment, lit_maps);
+  // What reflections and refractions look up: the maps' colour with the caustics on it, where
+  // the camera's searches read it (refractors' maps whole: the refraction pass reads them).
+  auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, maps);
+  auto lit_maps = g.add("caustic_reflector_maps", CausticReflectorColourPass{scene, tolerance}, s.shadow_maps,
+                        s.environment, maps, searches, caustic_maps);
+  auto reflected = g.add("distance_map_reflect", DistanceMapLookupPass{search}, s.gbuffer, s.environment, lit_maps,
+                         searches);
   RefractionOptions ro;
   ro.method = RefractionMethod::DistanceImpostor;
   ro.environment_search = search;

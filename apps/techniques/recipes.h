@@ -18,7 +18,8 @@ FrameOutputs add_envmap_passes(par::Graph& graph, const Scene* scene, const Fram
 FrameOutputs add_reference_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // specular-reference: surface passes → specular_trace (exact specular layer) → output passes.
 FrameOutputs add_specular_reference_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
-// distance-map (SURVEY §4.1–4.2): reflector_cube_maps → distance_map_reflect.
+// distance-map (SURVEY §4.1–4.2): reflector_distance_maps → distance_map_search →
+//   reflector_cube_maps (colour where the searches read) → distance_map_reflect.
 FrameOutputs add_distance_map_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // multi-reflection (SURVEY §4.3): multi_reflection_maps → distance_map_reflect.
 FrameOutputs add_multi_reflection_passes(par::Graph& graph, const Scene* scene,
@@ -29,11 +30,12 @@ FrameOutputs add_layered_distance_map_passes(par::Graph& graph, const Scene* sce
 // refraction (SURVEY §4.4): reflector_cube_maps → envmap_reflect → [back_faces,
 // refractor_thickness | refractor_impostors] → refraction.
 FrameOutputs add_refraction_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
-// caustics (SURVEY §6): reflector_cube_maps, refractor_impostors → caustic_photons →
-// caustic_map → caustic_gather (direct + caustics), caustic_reflector_maps → distance_map_reflect
-// → refraction.
+// caustics (SURVEY §6): reflector_cube_maps (distances), refractor_impostors → caustic_photons →
+// caustic_map → caustic_gather (direct + caustics); distance_map_search → caustic_reflector_maps
+// (colour where read) → distance_map_reflect → refraction.
 FrameOutputs add_caustics_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
-// planar-mirror (SURVEY §5): planar_mirrors → planar_mirror_reflect.
+// planar-mirror (SURVEY §5): planar_mirrors, reflector_distance_maps → planar_mirror_views →
+//   reflector_cube_maps (colour where the views' searches read) → planar_mirror_reflect.
 FrameOutputs add_planar_mirror_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
 // vertex-projection (ROGER ch.2): reflector_cube_maps → envmap_reflect (fallback); tessellate,
 // reflector_param → vertex_project → reflected_triangles → vertex_projection_shade.

@@ -19,6 +19,7 @@
 #include "core/shading.h"
 #include "core/scene_loader.h"
 #include "parallel/executor.h"
+#include "raster/distance_map_reflect.h"
 #include "raster/environment.h"
 #include "raster/shadow_map.h"
 #include "trace/bvh.h"
@@ -655,6 +656,48 @@ TEST(Caustics, ReflectorMapsShowTheCausticWhereItLies) {
   EXPECT_GT(added, 1.0);
   EXPECT_GT(bright, 5) << misplaced;
   EXPECT_EQ(misplaced, 0);
+}
+
+// The lit maps shaded where the camera's searches read them give the camera's reflections the
+// same bytes as lit maps shaded whole, and a refractor's map (read anywhere by the refraction
+// pass's paths) is whole: every texel of every face the same as the whole render's.
+TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
+  par::Executor ex(2);
+  const Scene s = load_scene("living-room");
+  const Camera cam = s.cameras.front();
+  const GBuffer g = camera_gbuffer(ex, s, cam, 128, 96);
+  const EnvironmentMap env = build_environment(ex, s.environment, 8);
+  const std::vector<ShadowMap> shadows = render_shadow_maps(ex, s, 128);
+  const PhotonRun r = shoot(ex, s, 64);
+  const CausticMaps caustics = build_caustic_maps(ex, s, r.photons, CausticMapOptions{});
+  const auto gather = [&](const GBuffer& face, const ImageRGBA& direct) {
+    return gather_caustics(ex, face, caustics, direct, 0.05f);
+  };
+  const ReflectorMaps whole = render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, gather);
+  MapSizing distances_only;
+  distances_only.colour_read = false;
+  distances_only.keep_visibility = true;
+  const ReflectorMaps distances =
+      render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, {}, nullptr, distances_only);
+  const DistanceSearchOptions search;
+  const DistanceSearches found = distance_map_search(ex, g, distances, search);
+  const ReflectorMaps lit = shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, caustics, 0.05f);
+  EXPECT_LT(rendered_texels(lit), rendered_texels(whole));
+  const ImageRGBA expected = distance_map_reflect(ex, g, env, whole, search);
+  const ImageRGBA got = distance_map_lookup(ex, g, env, lit, found, search);
+  EXPECT_EQ(0, std::memcmp(expected.pixels.data(), got.pixels.data(), expected.size() * sizeof(glm::vec4)));
+  int refractor_maps = 0;
+  for (std::size_t m = 0; m < lit.cubes.size(); ++m) {
+    if (!lit.refracts[m]) continue;
+    ++refractor_maps;
+    for (int f = 0; f < kCubeFaces; ++f) {
+      const ImageRGBA& a = whole.cubes[m].colour[f];
+      const ImageRGBA& b = lit.cubes[m].colour[f];
+      ASSERT_EQ(a.size(), b.size());
+      EXPECT_EQ(0, std::memcmp(a.pixels.data(), b.pixels.data(), a.size() * sizeof(glm::vec4))) << "map " << m << " face " << f;
+    }
+  }
+  EXPECT_EQ(refractor_maps, 1);  // the glass ball
 }
 
 }  // namespace
