@@ -109,6 +109,13 @@ struct CubeTileMask {
   std::array<std::vector<std::uint8_t>, kCubeFaces> tiles;  // tiles_per_side()² per face, 1: read
 
   bool active() const { return size > 0; }
+  // Bit f: face f has a read tile.
+  unsigned faces() const {
+    unsigned mask = 0;
+    for (int f = 0; f < kCubeFaces; ++f)
+      if (std::find(tiles[f].begin(), tiles[f].end(), std::uint8_t(1)) != tiles[f].end()) mask |= 1u << f;
+    return mask;
+  }
   // Every tile of every face read (the tiles sized already).
   void mark_all() {
     for (auto& t : tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));

@@ -107,18 +107,21 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
 }
 
 DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
-                                     const DistanceSearchOptions& options, FallbackMask* fallbacks) {
+                                     const DistanceSearchOptions& options, FallbackMask* fallbacks,
+                                     std::vector<CubeTileMask>* mark_into) {
   DistanceSearches out;
   const std::size_t n = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
   out.found.resize(par::Executor::chunk_count(n, kChunk));
-  for (std::size_t m = 0; m < maps.cubes.size(); ++m)
-    out.tiles.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
+  if (!mark_into)
+    for (std::size_t m = 0; m < maps.cubes.size(); ++m)
+      out.tiles.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
+  std::vector<CubeTileMask>& tiles = mark_into ? *mark_into : out.tiles;
   std::vector<DistanceReflectStats> per_chunk(out.found.size());
   executor.parallel_for("distance_map_search.search", n, kChunk, [&](std::size_t begin, std::size_t end) {
     DistanceReflectStats& st = per_chunk[begin / kChunk];
     std::vector<glm::vec3>& found = out.found[begin / kChunk];
     std::vector<LookupTileMarker> markers;
-    for (std::size_t m = 0; m < maps.cubes.size(); ++m) markers.emplace_back(out.tiles[m], maps.levels[m]);
+    for (std::size_t m = 0; m < maps.cubes.size(); ++m) markers.emplace_back(tiles[m], maps.levels[m]);
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface[i];

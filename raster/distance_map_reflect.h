@@ -45,8 +45,11 @@ struct DistanceSearches {
   std::vector<CubeTileMask> tiles;            // per map: the tiles the reads reach
   DistanceReflectStats stats;
 };
+// `mark_into` (may be null): the reads' tiles are marked there (masks of `maps`, from
+// tile_mask_for_reads) instead of in the result's own `tiles`, which then stay empty.
 DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
-                                     const DistanceSearchOptions& options, FallbackMask* fallbacks = nullptr);
+                                     const DistanceSearchOptions& options, FallbackMask* fallbacks = nullptr,
+                                     std::vector<CubeTileMask>* mark_into = nullptr);
 ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
                               const ReflectorMaps& maps, const DistanceSearches& searches,
                               const DistanceSearchOptions& options);

@@ -5,6 +5,7 @@
 
 #include "raster/composite.h"
 #include "raster/direct_light.h"
+#include "raster/envmap_reflect.h"
 
 namespace speculum::raster {
 
@@ -123,6 +124,152 @@ ReflectorMaps render_multi_reflection_maps(par::Executor& executor, const Scene&
     }
   for (int k = 2; k <= rounds; ++k)
     maps = rerender_reflector_maps(executor, scene, shadows, env, maps, options, stats, &layers, &needed[k]);
+  return maps;
+}
+
+ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, const Scene& scene,
+                                                      const std::vector<ShadowMap>& shadows,
+                                                      const EnvironmentMap& env, const ReflectorMaps& distances,
+                                                      const DistanceSearches& camera, int rounds,
+                                                      const DistanceSearchOptions& options,
+                                                      DistanceReflectStats* stats) {
+  const std::size_t count = distances.cubes.size();
+  DistanceSearchOptions face_search = options;  // as rerender_reflector_maps searches
+  face_search.lobe_directions = 1;
+  const CubeDepthRange depth_range = scene_cube_depth_range(scene);
+  CubeMapScratch scratch;
+  const auto face_options = [&](std::size_t m, const CubeTileMask* tiles) {
+    CubeMapOptions opt;
+    opt.size = distances.cubes[m].size;
+    opt.set_depth_range(depth_range);
+    opt.face_mask = distances.faces[m] & (tiles ? tiles->faces() : 0x3fu);
+    opt.tiles = tiles;
+    return opt;
+  };
+  // Each face's specular texels (the reflectors it shows), compacted, with their texel indices.
+  std::vector<MapFaceLayers> layers(count);
+  for (std::size_t m = 0; m < count; ++m)
+    shade_cube_faces(executor, scene, distances.cubes[m], face_options(m, nullptr),
+                     [&](const GBuffer& g, const Camera&, int face, const std::vector<std::uint8_t>*) {
+                       layers[m].specular[face] = specular_texels(g, layers[m].specular_texel[face]);
+                       return ImageRGBA{};
+                     },
+                     &scratch);
+  // From the last round back: read[k][m] the tiles of round k's map m that are read (the
+  // camera reads the last round), and the searches round k's texels on them make in round k − 1.
+  std::vector<std::vector<CubeTileMask>> read(static_cast<std::size_t>(rounds) + 1);
+  read[rounds] = camera.tiles;
+  struct FaceSearches {
+    GBuffer texels;  // the face's specular texels, those on unread tiles uncovered
+    DistanceSearches found;
+  };
+  std::vector<std::vector<std::array<FaceSearches, kCubeFaces>>> searched(
+      static_cast<std::size_t>(rounds) + 1, std::vector<std::array<FaceSearches, kCubeFaces>>(count));
+  DistanceReflectStats st;
+  for (int k = rounds; k >= 2; --k) {
+    for (std::size_t m = 0; m < count; ++m)
+      read[k - 1].push_back(tile_mask_for_reads(distances.cubes[m].size, distances.levels[m]));
+    for (std::size_t m = 0; m < count; ++m)
+      for (int f = 0; f < kCubeFaces; ++f) {
+        const GBuffer& all = layers[m].specular[f];
+        const std::vector<std::uint32_t>& texel = layers[m].specular_texel[f];
+        if (texel.empty() || !((distances.faces[m] >> f) & 1u)) continue;
+        FaceSearches& s = searched[k][m][f];
+        s.texels = all;
+        const int size = distances.cubes[m].size;
+        bool any = false;
+        for (std::size_t j = 0; j < texel.size(); ++j) {
+          const int x = static_cast<int>(texel[j] % std::uint32_t(size)), y = static_cast<int>(texel[j] / std::uint32_t(size));
+          if (read[k][m].covers(f, 0, x, y)) any = true;
+          else s.texels.object.pixels[j] = kNoId;
+        }
+        if (!any) {
+          s.texels = GBuffer{};
+          continue;
+        }
+        s.found = distance_map_search(executor, s.texels, distances, face_search, nullptr, &read[k - 1]);
+        st.searches += s.found.stats.searches;
+        st.lookups += s.found.stats.lookups;
+        st.bracketed += s.found.stats.bracketed;
+        st.missed += s.found.stats.missed;
+      }
+  }
+  // Round 1, and the direct light of every tile any round reads (the same in every round).
+  std::vector<CubeTileMask> any_round = read[1];
+  for (int k = 2; k <= rounds; ++k) merge_reads(any_round, read[k]);
+  std::vector<std::array<ImageRGBA, kCubeFaces>> direct(count);
+  ReflectorMaps maps;
+  maps.map_of_object = distances.map_of_object;
+  for (std::size_t m = 0; m < count; ++m) {
+    const std::array<ImageRGBA, kCubeFaces> colour = shade_cube_faces(
+        executor, scene, distances.cubes[m], face_options(m, &any_round[m]),
+        [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* texels) {
+          direct[m][face] = direct_light(executor, scene, g, cam, shadows, env, texels);
+          // Other reflectors seen in round 1's maps show the environment (render_reflector_maps).
+          return composite(executor, direct[m][face], envmap_reflect(executor, g, env));
+        },
+        &scratch);
+    maps.maps.push_back(environment_from_faces(executor, colour, false, distances.levels[m],
+                                               distances.faces[m] & read[1][m].faces(), &read[1][m]));
+    maps.cubes.emplace_back().colour = colour;
+  }
+  // Rounds 2 ..: the direct light plus what round k's searches find in round k − 1's maps.
+  for (int k = 2; k <= rounds; ++k) {
+    ReflectorMaps next;
+    next.map_of_object = distances.map_of_object;
+    for (std::size_t m = 0; m < count; ++m) {
+      const int size = distances.cubes[m].size;
+      const unsigned faces = distances.faces[m] & read[k][m].faces();
+      CubeMap& cube = next.cubes.emplace_back();
+      for (int f = 0; f < kCubeFaces; ++f) {
+        ImageRGBA specular(size, size, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+        if (!((faces >> f) & 1u) || direct[m][f].size() == 0) {
+          cube.colour[f] = std::move(specular);
+          continue;
+        }
+        const FaceSearches& s = searched[k][m][f];
+        if (s.texels.width > 0) {
+          const ImageRGBA seen = distance_map_lookup(executor, s.texels, env, maps, s.found, face_search);
+          const std::vector<std::uint32_t>& texel = layers[m].specular_texel[f];
+          for (std::size_t j = 0; j < texel.size(); ++j) specular.pixels[texel[j]] = seen.pixels[j];
+        }
+        cube.colour[f] = composite(executor, direct[m][f], specular);
+      }
+      next.maps.push_back(environment_from_faces(executor, cube.colour, false, distances.levels[m], faces, &read[k][m]));
+    }
+    maps = std::move(next);
+  }
+  for (std::size_t m = 0; m < count; ++m) {
+    maps.cubes[m].size = distances.cubes[m].size;
+    maps.cubes[m].centre = distances.cubes[m].centre;
+    maps.cubes[m].distance = distances.cubes[m].distance;
+    maps.faces.push_back(distances.faces[m] & read[rounds][m].faces());
+  }
+  maps.centres = distances.centres;
+  maps.levels = distances.levels;
+  maps.refracts = distances.refracts;
+  maps.tiles = std::move(read[rounds]);
+  if (stats) {
+    stats->searches += st.searches;
+    stats->lookups += st.lookups;
+    stats->bracketed += st.bracketed;
+    stats->missed += st.missed;
+  }
+  return maps;
+}
+
+ReflectorMaps MultiReflectionWhereReadPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
+                                                       const EnvironmentMap& environment,
+                                                       const ReflectorMaps& distances,
+                                                       const DistanceSearches& camera) const {
+  DistanceReflectStats st;
+  ReflectorMaps maps = render_multi_reflection_maps_where_read(c.executor(), *scene, shadows, environment, distances,
+                                                               camera, rounds, search, &st);
+  c.count("cube_maps", maps.cubes.size());
+  c.count("cube_texels", rendered_texels(maps));
+  c.count("searches", st.searches);
+  c.count("distance_lookups", st.lookups);
+  c.count("fallback_search_missed", st.missed);
   return maps;
 }
 

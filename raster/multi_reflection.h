@@ -42,6 +42,35 @@ ReflectorMaps render_multi_reflection_maps(par::Executor& executor, const Scene&
                                            const DistanceSearchOptions& options,
                                            DistanceReflectStats* stats = nullptr);
 
+// render_multi_reflection_maps shaded only where read: `distances` (all reflectors' maps,
+// rendered with MapSizing::keep_visibility) and the camera's searches in them (`camera`, from
+// distance_map_search) give, from the last round back, the tiles each round's maps are read
+// on — the camera's, then those the specular texels on round k's read tiles reach with their
+// searches in round k − 1 — and each round is shaded and prefiltered on its tiles alone, the
+// direct light once on every tile any round reads. distance_map_lookup(camera) on the result
+// gives the bytes distance_map_reflect gives on render_multi_reflection_maps(rounds).
+// `stats` counts the searches made (those of texels no round reads are not).
+ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, const Scene& scene,
+                                                      const std::vector<ShadowMap>& shadows,
+                                                      const EnvironmentMap& env, const ReflectorMaps& distances,
+                                                      const DistanceSearches& camera, int rounds,
+                                                      const DistanceSearchOptions& options,
+                                                      DistanceReflectStats* stats = nullptr);
+
+// Pass "multi_reflection_maps" after the camera's searches (render_multi_reflection_maps_where_read).
+struct MultiReflectionWhereReadPass {
+  static constexpr const char* description =
+      "Per specular object a colour cube map, re-rendered in rounds with the others' current maps, "
+      "one bounce per round, each round shaded only where the next one (or the camera) reads it "
+      "(SURVEY §4.3).";
+  const Scene* scene = nullptr;
+  int rounds = 3;
+  DistanceSearchOptions search;
+  void parameters(par::Params& p) const { p.set("rounds", rounds).set("tiles", "read by the next round's searches"); }
+  ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
+                           const ReflectorMaps& distances, const DistanceSearches& camera) const;
+};
+
 // Pass "multi_reflection_maps": the reflector maps after `rounds` rounds (SURVEY §4.3); with
 // `lagged`, one round per frame on the previous frame's maps (the bounce depth grows by one
 // per frame), or a first round when there is no previous frame.

@@ -508,10 +508,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     CubeTileMask tiles;
     if (!samples_of.empty() && sizing.reads == MapSizing::Reads::direction && std::has_single_bit(unsigned(side))) {
       tiles = tiles_read(executor, *camera_view, samples_of[o], side, levels, sizing.refractors_read_at_surface);
-      opt.face_mask = 0;
-      for (int f = 0; f < kCubeFaces; ++f)
-        if (std::find(tiles.tiles[f].begin(), tiles.tiles[f].end(), std::uint8_t(1)) != tiles.tiles[f].end())
-          opt.face_mask |= 1u << f;
+      opt.face_mask = tiles.faces();
       opt.tiles = &tiles;
     } else if (!samples_of.empty()) {
       opt.face_mask = faces_read(executor, *camera_view, samples_of[o], centre, side, levels, sizing);
@@ -559,11 +556,7 @@ ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, 
     opt.size = from.size;
     opt.set_depth_range(depth_range);
     opt.tiles = &tiles[m];
-    opt.face_mask = 0;
-    for (int f = 0; f < kCubeFaces; ++f)
-      if (((distances.faces[m] >> f) & 1u) &&
-          std::find(tiles[m].tiles[f].begin(), tiles[m].tiles[f].end(), std::uint8_t(1)) != tiles[m].tiles[f].end())
-        opt.face_mask |= 1u << f;
+    opt.face_mask = distances.faces[m] & tiles[m].faces();
     CubeMap cube;
     cube.size = from.size;
     cube.centre = from.centre;

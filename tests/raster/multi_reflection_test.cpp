@@ -2,6 +2,7 @@
 // against the reference tracer (error thresholds stated), bounce depth per round, the
 // frame-lagged edge equal to in-frame rounds, and thread-count independence.
 #include <cstring>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -130,6 +131,38 @@ TEST(MultiReflection, SameBytesForOneAndTwoThreads) {
   two_rounds.params["rounds"] = 2;
   EXPECT_TRUE(same_bytes(render_display(s, "distance-map", f, 1), render_display(s, "distance-map", f, 2)));
   EXPECT_TRUE(same_bytes(render_display(s, "multi-reflection", two_rounds, 1), render_display(s, "multi-reflection", two_rounds, 2)));
+}
+
+// The rounds shaded only where the next round (or the camera) reads them give the camera's
+// specular layer the bytes of rounds shaded whole, for one to three rounds, with fewer
+// texels shaded and fewer searches made.
+TEST(MultiReflection, RoundsShadedWhereReadGiveTheBytesOfWholeRounds) {
+  par::Executor ex(2);
+  for (const char* name : {"living-room", "sphere-in-room"}) {
+    const Scene s = name == std::string("sphere-in-room") ? two_mirror_room() : load_scene(name);
+    const Camera cam = s.cameras.front();
+    const ShadowMaps shadows = render_shadow_maps(ex, s, 128);
+    const EnvironmentMap env = build_environment(ex, s.environment);
+    const GBuffer g = resolve_gbuffer(ex, s, render_visibility(ex, s, cam, 96, 72), cam.eye);
+    const DistanceSearchOptions search;
+    MapSizing distances_only;
+    distances_only.colour_read = false;
+    distances_only.keep_visibility = true;
+    const ReflectorMaps distances =
+        render_reflector_maps(ex, s, shadows, env, 32, &g, ReflectorSelection::all, {}, nullptr, distances_only);
+    const DistanceSearches camera = distance_map_search(ex, g, distances, search);
+    for (int rounds = 1; rounds <= 3; ++rounds) {
+      SCOPED_TRACE(std::string(name) + ", rounds " + std::to_string(rounds));
+      DistanceReflectStats whole_stats, read_stats;
+      const ReflectorMaps whole = render_multi_reflection_maps(ex, s, shadows, env, 32, &g, rounds, search, &whole_stats);
+      const ReflectorMaps where_read =
+          render_multi_reflection_maps_where_read(ex, s, shadows, env, distances, camera, rounds, search, &read_stats);
+      EXPECT_TRUE(same_bytes(distance_map_reflect(ex, g, env, whole, search),
+                             distance_map_lookup(ex, g, env, where_read, camera, search)));
+      EXPECT_LT(rendered_texels(where_read), 6.0 * 32 * 32 * double(where_read.cubes.size()));
+      if (rounds > 1) EXPECT_LE(read_stats.searches, whole_stats.searches);
+    }
+  }
 }
 
 }  // namespace
