@@ -146,15 +146,36 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
     opt.tiles = tiles;
     return opt;
   };
-  // Each face's specular texels (the reflectors it shows), compacted, with their texel indices.
+  // Each face's specular texels (the reflectors it shows), compacted, with their texel indices:
+  // resolved only where the visible material can be specular (specular, or textured: a texture
+  // may make it so at some texels).
+  std::vector<std::uint8_t> may_be_specular(scene.materials.size(), 0);
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& mat = scene.materials[i];
+    may_be_specular[i] = is_specular(surface_params(mat)) || mat.base_color_texture.valid() ||
+                         mat.metallic_roughness_texture.valid() || mat.emissive_texture.valid() ||
+                         mat.transmission_texture.valid();
+  }
   std::vector<MapFaceLayers> layers(count);
-  for (std::size_t m = 0; m < count; ++m)
-    shade_cube_faces(executor, scene, distances.cubes[m], face_options(m, nullptr),
+  for (std::size_t m = 0; m < count; ++m) {
+    CubeTileMask candidates = tile_mask_for_reads(distances.cubes[m].size, 1);  // one texel a tile
+    for (int f = 0; f < kCubeFaces; ++f) {
+      const IdBuffer& triangle = distances.cubes[m].visibility[f].triangle;
+      std::vector<std::uint8_t>& texels = candidates.tiles[f];
+      executor.parallel_for("multi_reflection_maps.candidates", triangle.size(), 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const std::uint32_t t = triangle.pixels[i];
+          texels[i] = t != kNoId && may_be_specular[scene.mesh.triangle_material[t]];
+        }
+      });
+    }
+    shade_cube_faces(executor, scene, distances.cubes[m], face_options(m, &candidates),
                      [&](const GBuffer& g, const Camera&, int face, const std::vector<std::uint8_t>*) {
                        layers[m].specular[face] = specular_texels(g, layers[m].specular_texel[face]);
                        return ImageRGBA{};
                      },
                      &scratch);
+  }
   // From the last round back: read[k][m] the tiles of round k's map m that are read (the
   // camera reads the last round), and the searches round k's texels on them make in round k − 1.
   std::vector<std::vector<CubeTileMask>> read(static_cast<std::size_t>(rounds) + 1);
