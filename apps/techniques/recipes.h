@@ -21,7 +21,9 @@ FrameOutputs add_specular_reference_passes(par::Graph& graph, const Scene* scene
 // distance-map (SURVEY §4.1–4.2): reflector_distance_maps → distance_map_search →
 //   reflector_cube_maps (colour where the searches read) → distance_map_reflect.
 FrameOutputs add_distance_map_passes(par::Graph& graph, const Scene* scene, const FrameSettings& settings);
-// multi-reflection (SURVEY §4.3): multi_reflection_maps → distance_map_reflect.
+// multi-reflection (SURVEY §4.3): reflector_distance_maps → distance_map_search →
+//   multi_reflection_maps (each round where the next reads it) → distance_map_reflect;
+//   lagged=1: multi_reflection_maps (previous frame's maps) → distance_map_reflect.
 FrameOutputs add_multi_reflection_passes(par::Graph& graph, const Scene* scene,
                                          const FrameSettings& settings);
 // layered-distance-map (SURVEY §4.5): layered_distance_map → layered_reflect.
