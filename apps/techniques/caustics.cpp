@@ -23,10 +23,8 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   const SurfaceResources s = add_surface_passes(g, scene, f);
   // The photons search these maps' distances only, and so do the camera's searches; what
   // reflections read is the lit maps' colour below, shaded where those searches read it.
-  MapSizing distances_only;
-  distances_only.colour_read = false;
-  distances_only.keep_visibility = true;
-  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, distances_only},
+  auto maps = g.add("reflector_cube_maps",
+                    ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(false)},
                     s.shadow_maps, s.environment, s.gbuffer)
                   .describe("Distance cube map around each specular object, itself left out: what the "
                             "photons leaving a generator search (SURVEY §4.1, §6.1).");

@@ -23,15 +23,9 @@ DistanceSearchOptions distance_search_options(const FrameSettings& f) {
 FrameOutputs add_distance_map_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   const SurfaceResources s = add_surface_passes(g, scene, f);
   const DistanceSearchOptions search = distance_search_options(f);
-  // The maps' distances first, on every face (bounding the faces the searches can reach costs
-  // more than rendering the few it leaves out); their colour only where the searches turn out
-  // to read it.
-  MapSizing distances_only = camera_read_maps(false, search.lobe_directions);
-  distances_only.reads = MapSizing::Reads::anywhere;
-  distances_only.colour_read = false;
-  distances_only.keep_visibility = true;
+  // The maps' distances first; their colour only where the searches turn out to read it.
   auto distances = g.add("reflector_distance_maps",
-                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, distances_only},
+                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(true)},
                          s.shadow_maps, s.environment, s.gbuffer);
   auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, distances);
   auto maps = g.add("reflector_cube_maps", ReflectorColourPass<DistanceSearches>{scene}, s.shadow_maps, s.environment, distances, searches);

@@ -49,6 +49,18 @@ inline raster::MapSizing camera_read_maps(bool by_direction, int lobe_directions
   return m;
 }
 
+// Maps searched before their colour is shaded (shade_reflector_maps, where the searches
+// read): their distances alone, on every face (bounding the faces searches reach costs more
+// than rendering the few it leaves out), each face's visibility kept. `skip_unseen`: no map
+// for a reflector the camera does not see (when only the camera's samples search them).
+inline raster::MapSizing searched_distance_maps(bool skip_unseen) {
+  raster::MapSizing m;
+  m.skip_unseen = skip_unseen;
+  m.colour_read = false;
+  m.keep_visibility = true;
+  return m;
+}
+
 // composite (direct + specular) → resolve (k×k) → tonemap.
 FrameOutputs add_output_passes(par::Graph& graph, const FrameSettings& settings,
                                const par::Resource<ImageRGBA>& direct,

@@ -18,11 +18,10 @@ FrameOutputs add_planar_mirror_passes(par::Graph& g, const Scene* scene, const F
   // Curved and glossy reflectors are not planar mirrors: they get the distance-map search in
   // cube maps of their own (SURVEY §4.2), in the camera's view and in every mirrored one —
   // their distances first, their colour only where the searches of all views read it.
-  MapSizing distances_only;
-  distances_only.colour_read = false;
-  distances_only.keep_visibility = true;
+  // (Reflectors the camera does not see may be seen in a mirror: every one gets a map.)
   auto distances = g.add("reflector_distance_maps",
-                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors, distances_only},
+                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors,
+                                               searched_distance_maps(false)},
                          s.shadow_maps, s.environment, s.gbuffer);
   auto views = g.add("planar_mirror_views", PlanarMirrorViewsPass{scene, f.camera, static_cast<int>(f.param("depth"))},
                      mirrors, s.gbuffer, s.shadow_maps, s.environment, distances);
