@@ -229,7 +229,14 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
                                 dist.pixels[i] = glm::length(
                                     visible_position(scene.mesh, vis, i) - centre);
                           });
-    if (options.keep_visibility) cube.visibility[face] = vis;
+    if (options.keep_visibility) {  // what resolving reads (not the depths)
+      VisibilityBuffer& kept = cube.visibility[face];
+      kept.width = vis.width, kept.height = vis.height;
+      kept.triangle = vis.triangle;
+      kept.object = vis.object;
+      kept.bary = vis.bary;
+      kept.coverage = vis.coverage;
+    }
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
     if (shade) cube.colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s.g);
   }
@@ -253,7 +260,7 @@ std::array<ImageRGBA, kCubeFaces> shade_cube_faces(par::Executor& executor, cons
     const std::vector<std::uint8_t> read = read_texels(options, face);
     VisibilityBuffer& vis = s.vis;
     vis.width = kept.width, vis.height = kept.height;
-    vis.depth = kept.depth;
+    vis.depth = ImageF{};  // not kept: resolving does not read it
     vis.bary = kept.bary;
     vis.coverage = kept.coverage;
     if (vis.triangle.width != kept.width || vis.triangle.height != kept.height) {

@@ -80,8 +80,9 @@ struct CubeMap {
   glm::vec3 centre{0.0f};
   std::array<ImageRGBA, kCubeFaces> colour;   // may be empty (distance-only maps)
   std::array<ImageF, kCubeFaces> distance;    // |y − o|, +inf where nothing was hit
-  // Each rendered face's visibility, kept only under CubeMapOptions::keep_visibility: a map
-  // whose colour is shaded later (shade_cube_faces), once its readers are known.
+  // Each rendered face's visibility (all but the depths, which resolving does not read), kept
+  // only under CubeMapOptions::keep_visibility: a map whose colour is shaded later
+  // (shade_cube_faces), once its readers are known.
   std::array<VisibilityBuffer, kCubeFaces> visibility;
 
   // Bilinear colour towards d (clamped at face borders).

@@ -63,7 +63,7 @@ void add_frame_options(CLI::App& cmd, FrameOptions& o) {
   // The maxima bound memory: living-room (the built-in scene with most reflectors) peaks
   // near 2.1 GB at --cube-size 1024 (7.8 GB at 2048) and 1.7 GB at --shadow-size 4096 (6.2 GB
   // at 8192).
-  cmd.add_option("--cube-size", o.cube_map_size, "Side of the per-reflector cube maps (~2 GB for many reflectors at 1024); envmap, refraction and vertex-projection size each map from its reflector's footprint on screen, up to this")
+  cmd.add_option("--cube-size", o.cube_map_size, "Side of the per-reflector cube maps (~2 GB for many reflectors at 1024; distance-map, planar-mirror, caustics and multi-reflection hold about half as much again, each face's visibility, until their searches have run); envmap, refraction and vertex-projection size each map from its reflector's footprint on screen, up to this")
       ->check(CLI::Range(1, 1024))->capture_default_str();
   cmd.add_option("--shadow-size", o.shadow_map_size, "Side of the shadow maps")
       ->check(CLI::Range(1, 4096))->capture_default_str();
