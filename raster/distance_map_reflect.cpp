@@ -59,13 +59,19 @@ glm::vec3 search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, c
   return glm::normalize(hit.direction);
 }
 
+// Chunks' counts summed in chunk order.
 void add_stats(DistanceReflectStats& to, const std::vector<DistanceReflectStats>& per_chunk) {
-  for (const DistanceReflectStats& c : per_chunk) {
-    to.searches += c.searches;
-    to.lookups += c.lookups;
-    to.bracketed += c.bracketed;
-    to.missed += c.missed;
-  }
+  for (const DistanceReflectStats& c : per_chunk) to += c;
+}
+
+// What a node that searches publishes: the samples whose search missed (when inspected) and
+// the searches' counters.
+void publish_searches(par::NodeContext& c, const DistanceReflectStats& st, FallbackMask&& fallbacks) {
+  c.publish("fallback", std::move(fallbacks));
+  c.count("searches", st.searches);
+  c.count("distance_lookups", st.lookups);
+  c.count("bracketed", st.bracketed);
+  c.count("fallback_search_missed", st.missed);
 }
 
 // Samples per chunk of the searches; distance_map_lookup reads distance_map_search's records
@@ -136,6 +142,8 @@ DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, 
         });
       };
       const std::uint64_t missed_before = st.missed;
+      // Its value is not needed here: it makes the lookups (R, and T for a refractor) in the
+      // order distance_map_lookup replays them.
       specular_radiance(s, n, g.view_direction(i), lookup);
       if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
     }
@@ -174,11 +182,7 @@ ImageRGBA DistanceMapReflectPass::operator()(par::NodeContext& c, const GBuffer&
   DistanceReflectStats st;
   FallbackMask fallbacks = c.capturing() ? FallbackMask(gbuffer.width, gbuffer.height) : FallbackMask();
   ImageRGBA specular = distance_map_reflect(c.executor(), gbuffer, environment, maps, search, &st, &fallbacks);
-  c.publish("fallback", std::move(fallbacks));
-  c.count("searches", st.searches);
-  c.count("distance_lookups", st.lookups);
-  c.count("bracketed", st.bracketed);
-  c.count("fallback_search_missed", st.missed);
+  publish_searches(c, st, std::move(fallbacks));
   return specular;
 }
 
@@ -186,11 +190,7 @@ DistanceSearches DistanceMapSearchPass::operator()(par::NodeContext& c, const GB
                                                   const ReflectorMaps& maps) const {
   FallbackMask fallbacks = c.capturing() ? FallbackMask(gbuffer.width, gbuffer.height) : FallbackMask();
   DistanceSearches found = distance_map_search(c.executor(), gbuffer, maps, search, &fallbacks);
-  c.publish("fallback", std::move(fallbacks));
-  c.count("searches", found.stats.searches);
-  c.count("distance_lookups", found.stats.lookups);
-  c.count("bracketed", found.stats.bracketed);
-  c.count("fallback_search_missed", found.stats.missed);
+  publish_searches(c, found.stats, std::move(fallbacks));
   return found;
 }
 

@@ -23,6 +23,10 @@ struct DistanceReflectStats {
   std::uint64_t lookups = 0;   // distance-map reads over all searches
   std::uint64_t bracketed = 0; // searches whose linear search found an undershoot/overshoot pair
   std::uint64_t missed = 0;    // searches that found no surface: read along the ray (environment)
+  DistanceReflectStats& operator+=(const DistanceReflectStats& o) {
+    searches += o.searches, lookups += o.lookups, bracketed += o.bracketed, missed += o.missed;
+    return *this;
+  }
 };
 
 // The specular layer (zero on diffuse samples). Works on any G-buffer, including a cube

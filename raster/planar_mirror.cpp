@@ -80,8 +80,8 @@ struct ViewRecursion {
   // it sees. `g` is the view's G-buffer (views[v].g, or the camera's for view 0).
   void add(std::size_t v, const GBuffer& g, const Camera& camera, int level) {
     if (curved) {
-      out.views[v].searches = distance_map_search(executor, g, *curved, DistanceSearchOptions{});
-      merge_reads(out.tiles, out.views[v].searches.tiles);
+      // Every view's reads marked in the one set of masks the maps are shaded on.
+      out.views[v].searches = distance_map_search(executor, g, *curved, DistanceSearchOptions{}, nullptr, &out.tiles);
       out.stats.search_missed += out.views[v].searches.stats.missed;
     }
     if (level >= settings.depth) {
