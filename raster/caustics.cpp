@@ -726,8 +726,7 @@ ReflectorMaps CausticReflectorColourPass::operator()(par::NodeContext& c, const 
                                                      const CausticMaps& caustics) const {
   ReflectorMaps maps =
       shade_caustic_reflector_maps(c.executor(), *scene, shadows, environment, distances, searches, caustics, tolerance);
-  c.count("cube_maps", static_cast<double>(maps.cubes.size()));
-  c.count("cube_texels", rendered_texels(maps));
+  count_maps(c, maps);
   return maps;
 }
 

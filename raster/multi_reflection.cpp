@@ -138,14 +138,6 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
   face_search.lobe_directions = 1;
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   CubeMapScratch scratch;
-  const auto face_options = [&](std::size_t m, const CubeTileMask* tiles) {
-    CubeMapOptions opt;
-    opt.size = distances.cubes[m].size;
-    opt.set_depth_range(depth_range);
-    opt.face_mask = distances.faces[m] & (tiles ? tiles->faces() : 0x3fu);
-    opt.tiles = tiles;
-    return opt;
-  };
   // Each face's specular texels (the reflectors it shows), compacted, with their texel indices:
   // resolved only where the visible material can be specular (specular, or textured: a texture
   // may make it so at some texels).
@@ -169,7 +161,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
         }
       });
     }
-    shade_cube_faces(executor, scene, distances.cubes[m], face_options(m, &candidates),
+    shade_cube_faces(executor, scene, distances.cubes[m], kept_face_options(distances, m, depth_range, candidates),
                      [&](const GBuffer& g, const Camera&, int face, const std::vector<std::uint8_t>*) {
                        layers[m].specular[face] = specular_texels(g, layers[m].specular_texel[face]);
                        return ImageRGBA{};
@@ -209,10 +201,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
           continue;
         }
         s.found = distance_map_search(executor, s.texels, distances, face_search, nullptr, &read[k - 1]);
-        st.searches += s.found.stats.searches;
-        st.lookups += s.found.stats.lookups;
-        st.bracketed += s.found.stats.bracketed;
-        st.missed += s.found.stats.missed;
+        st += s.found.stats;
       }
   }
   // Round 1, and the direct light of every tile any round reads (the same in every round).
@@ -223,7 +212,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
   maps.map_of_object = distances.map_of_object;
   for (std::size_t m = 0; m < count; ++m) {
     const std::array<ImageRGBA, kCubeFaces> colour = shade_cube_faces(
-        executor, scene, distances.cubes[m], face_options(m, &any_round[m]),
+        executor, scene, distances.cubes[m], kept_face_options(distances, m, depth_range, any_round[m]),
         [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* texels) {
           direct[m][face] = direct_light(executor, scene, g, cam, shadows, env, texels);
           // Other reflectors seen in round 1's maps show the environment (render_reflector_maps).
@@ -270,12 +259,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
   maps.levels = distances.levels;
   maps.refracts = distances.refracts;
   maps.tiles = std::move(read[rounds]);
-  if (stats) {
-    stats->searches += st.searches;
-    stats->lookups += st.lookups;
-    stats->bracketed += st.bracketed;
-    stats->missed += st.missed;
-  }
+  if (stats) *stats += st;
   return maps;
 }
 
@@ -286,8 +270,7 @@ ReflectorMaps MultiReflectionWhereReadPass::operator()(par::NodeContext& c, cons
   DistanceReflectStats st;
   ReflectorMaps maps = render_multi_reflection_maps_where_read(c.executor(), *scene, shadows, environment, distances,
                                                                camera, rounds, search, &st);
-  c.count("cube_maps", maps.cubes.size());
-  c.count("cube_texels", rendered_texels(maps));
+  count_maps(c, maps);
   c.count("searches", st.searches);
   c.count("distance_lookups", st.lookups);
   c.count("fallback_search_missed", st.missed);

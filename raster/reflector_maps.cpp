@@ -539,6 +539,16 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
   return out;
 }
 
+CubeMapOptions kept_face_options(const ReflectorMaps& distances, std::size_t m, const CubeDepthRange& depth_range,
+                                 const CubeTileMask& tiles) {
+  CubeMapOptions opt;
+  opt.size = distances.cubes[m].size;
+  opt.set_depth_range(depth_range);
+  opt.face_mask = distances.faces[m] & tiles.faces();
+  opt.tiles = &tiles;
+  return opt;
+}
+
 ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
                                    const EnvironmentMap& env, const ReflectorMaps& distances,
                                    std::vector<CubeTileMask> tiles, const FaceLight& add_light) {
@@ -552,11 +562,7 @@ ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, 
   CubeMapScratch scratch;
   for (std::size_t m = 0; m < distances.cubes.size(); ++m) {
     const CubeMap& from = distances.cubes[m];
-    CubeMapOptions opt;
-    opt.size = from.size;
-    opt.set_depth_range(depth_range);
-    opt.tiles = &tiles[m];
-    opt.face_mask = distances.faces[m] & tiles[m].faces();
+    const CubeMapOptions opt = kept_face_options(distances, m, depth_range, tiles[m]);
     CubeMap cube;
     cube.size = from.size;
     cube.centre = from.centre;
@@ -580,13 +586,17 @@ double rendered_texels(const ReflectorMaps& maps) {
   return texels;
 }
 
+void count_maps(par::NodeContext& c, const ReflectorMaps& maps) {
+  c.count("cube_maps", maps.cubes.size());
+  c.count("cube_texels", rendered_texels(maps));
+}
+
 ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
                                                 const EnvironmentMap& environment,
                                                 const GBuffer& gbuffer) const {
   ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, shadows, environment, size, &gbuffer,
                                              which, {}, nullptr, sizing);
-  c.count("cube_maps", maps.cubes.size());
-  c.count("cube_texels", rendered_texels(maps));
+  count_maps(c, maps);
   return maps;
 }
 

@@ -91,6 +91,18 @@ struct MapSizing {
   bool keep_visibility = false;
 };
 
+// Maps searched before their colour is shaded (shade_reflector_maps, where the searches
+// read): their distances alone, on every face (bounding the faces searches reach costs more
+// than rendering the few it leaves out), each face's visibility kept. `skip_unseen`: no map
+// for a reflector the camera does not see (when only the camera's samples search them).
+inline MapSizing searched_distance_maps(bool skip_unseen) {
+  MapSizing m;
+  m.skip_unseen = skip_unseen;
+  m.colour_read = false;
+  m.keep_visibility = true;
+  return m;
+}
+
 // Bit f set: face f of a map centred at `centre` is read by the camera samples `samples` of
 // one reflector (G-buffer indices) under `sizing.reads`, on a map of side `size` with
 // `level_count` levels; exposed for tests.
@@ -177,12 +189,21 @@ ReflectorMaps shade_reflector_maps(par::Executor& executor, const Scene& scene, 
                                    const EnvironmentMap& env, const ReflectorMaps& distances,
                                    std::vector<CubeTileMask> tiles, const FaceLight& add_light = {});
 
+// The options shade_cube_faces takes to shade map m of `distances` (rendered with
+// keep_visibility) on `tiles` (kept by the caller while they are used): its side, the depth
+// range it was rendered with, and the rendered faces that hold a read tile.
+CubeMapOptions kept_face_options(const ReflectorMaps& distances, std::size_t m, const CubeDepthRange& depth_range,
+                                 const CubeTileMask& tiles);
+
 // The covered specular samples of `g`, compacted to one row in sample order; `texel`
 // receives their indices in g.
 GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel);
 
 // Texels rendered: the texels of the tiles rendered on the faces each map has.
 double rendered_texels(const ReflectorMaps& maps);
+
+// A maps node's counters: cube_maps, and cube_texels (rendered_texels).
+void count_maps(par::NodeContext& c, const ReflectorMaps& maps);
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {
@@ -220,8 +241,7 @@ struct ReflectorColourPass {
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
                            const ReflectorMaps& distances, const Reads& reads) const {
     ReflectorMaps maps = shade_reflector_maps(c.executor(), *scene, shadows, environment, distances, reads.tiles);
-    c.count("cube_maps", maps.cubes.size());
-    c.count("cube_texels", rendered_texels(maps));
+    count_maps(c, maps);
     return maps;
   }
 };

@@ -10,7 +10,7 @@ using namespace speculum::raster;
 
 FrameOutputs add_envmap_passes(par::Graph& g, const Scene* scene, const FrameSettings& f) {
   const SurfaceResources s = add_surface_passes(g, scene, f);
-  MapSizing sizing = camera_read_maps(true);
+  MapSizing sizing = camera_read_maps();
   sizing.refractors_read_at_surface = true;  // envmap_reflect reads every map, refractors' too
   auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, sizing},
                     s.shadow_maps, s.environment, s.gbuffer)

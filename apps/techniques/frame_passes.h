@@ -35,29 +35,15 @@ SurfaceResources add_surface_passes(par::Graph& graph, const Scene* scene,
                                     const FrameSettings& settings,
                                     const SurfacePassNotes& notes = {});
 
-// The reflector maps of a technique whose maps only the camera's samples read: none for
-// reflectors the camera does not see, only the faces those samples reach, and with
-// `by_direction` (looked up along a direction, envmap_reflect; otherwise searched,
-// distance_map_reflect with `lobe_directions` sub-lobes) each sized from its reflector's
-// footprint in the G-buffer (raster/reflector_maps.h MapSizing).
-inline raster::MapSizing camera_read_maps(bool by_direction, int lobe_directions = 8) {
+// The reflector maps of a technique whose maps only the camera's samples read, each along a
+// direction (envmap_reflect): none for reflectors the camera does not see, only the tiles of
+// the faces those lookups reach, each map sized from its reflector's footprint in the
+// G-buffer (raster/reflector_maps.h MapSizing). Searched maps: raster::searched_distance_maps.
+inline raster::MapSizing camera_read_maps() {
   raster::MapSizing m;
-  m.from_footprint = by_direction;
+  m.from_footprint = true;
   m.skip_unseen = true;
-  m.reads = by_direction ? raster::MapSizing::Reads::direction : raster::MapSizing::Reads::search;
-  m.lobe_directions = lobe_directions;
-  return m;
-}
-
-// Maps searched before their colour is shaded (shade_reflector_maps, where the searches
-// read): their distances alone, on every face (bounding the faces searches reach costs more
-// than rendering the few it leaves out), each face's visibility kept. `skip_unseen`: no map
-// for a reflector the camera does not see (when only the camera's samples search them).
-inline raster::MapSizing searched_distance_maps(bool skip_unseen) {
-  raster::MapSizing m;
-  m.skip_unseen = skip_unseen;
-  m.colour_read = false;
-  m.keep_visibility = true;
+  m.reads = raster::MapSizing::Reads::direction;
   return m;
 }
 

@@ -33,7 +33,7 @@ FrameOutputs add_refraction_passes(par::Graph& g, const Scene* scene, const Fram
   notes.visibility = "Camera visibility buffer: the refractors' front faces (P1).";
   notes.gbuffer = "Camera G-buffer: front-face positions and normals N1 (SURVEY §4.4).";
   const SurfaceResources s = add_surface_passes(g, scene, f, notes);
-  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, camera_read_maps(true)},
+  auto maps = g.add("reflector_cube_maps", ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, camera_read_maps()},
                     s.shadow_maps, s.environment, s.gbuffer)
                   .describe("Colour + distance cube map around each specular object, itself left "
                             "out: the environment distance map the refracted rays search "

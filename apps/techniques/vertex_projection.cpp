@@ -15,7 +15,7 @@ FrameOutputs add_vertex_projection_passes(par::Graph& g, const Scene* scene, con
   auto param = g.add("reflector_param", ReflectorParamPass{scene, int(f.param("param_size"))});
   // Specular samples the projection does not handle (glossy reflectors, reflectors that are
   // not star-shaped) keep the environment-map layer; only they get cube maps.
-  MapSizing sizing = camera_read_maps(true);
+  MapSizing sizing = camera_read_maps();
   sizing.refractors_read_at_surface = true;  // only envmap_reflect reads them
   auto maps = g.add("reflector_cube_maps", FallbackCubeMapsPass{scene, f.cube_map_size, sizing}, param, s.shadow_maps,
                     s.environment, s.gbuffer);

@@ -674,11 +674,8 @@ TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
     return gather_caustics(ex, face, caustics, direct, 0.05f);
   };
   const ReflectorMaps whole = render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, gather);
-  MapSizing distances_only;
-  distances_only.colour_read = false;
-  distances_only.keep_visibility = true;
   const ReflectorMaps distances =
-      render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, {}, nullptr, distances_only);
+      render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false));
   const DistanceSearchOptions search;
   const DistanceSearches found = distance_map_search(ex, g, distances, search);
   const ReflectorMaps lit = shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, caustics, 0.05f);

@@ -145,11 +145,8 @@ TEST(MultiReflection, RoundsShadedWhereReadGiveTheBytesOfWholeRounds) {
     const EnvironmentMap env = build_environment(ex, s.environment);
     const GBuffer g = resolve_gbuffer(ex, s, render_visibility(ex, s, cam, 96, 72), cam.eye);
     const DistanceSearchOptions search;
-    MapSizing distances_only;
-    distances_only.colour_read = false;
-    distances_only.keep_visibility = true;
     const ReflectorMaps distances =
-        render_reflector_maps(ex, s, shadows, env, 32, &g, ReflectorSelection::all, {}, nullptr, distances_only);
+        render_reflector_maps(ex, s, shadows, env, 32, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false));
     const DistanceSearches camera = distance_map_search(ex, g, distances, search);
     for (int rounds = 1; rounds <= 3; ++rounds) {
       SCOPED_TRACE(std::string(name) + ", rounds " + std::to_string(rounds));

@@ -315,11 +315,8 @@ TEST(PlanarMirror, CurvedMapsShadedWhereTheViewsSearchChangeNoSample) {
     ASSERT_FALSE(whole.cubes.empty());
     PlanarMirrorStats whole_stats;
     const ImageRGBA expected = planar_mirror_reflect(ex, s, mirrors, g, c, shadows, env, &whole, settings, &whole_stats);
-    MapSizing distances_only;
-    distances_only.colour_read = false;
-    distances_only.keep_visibility = true;
     const ReflectorMaps distances = render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::not_planar_mirrors,
-                                                          {}, nullptr, distances_only);
+                                                          {}, nullptr, searched_distance_maps(false));
     const PlanarMirrorViews views = planar_mirror_views(ex, s, mirrors, g, c, shadows, env, &distances, settings);
     EXPECT_GT(views.stats.mirrored_views, 0u);
     EXPECT_EQ(views.stats.mirrored_views, whole_stats.mirrored_views);

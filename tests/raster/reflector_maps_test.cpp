@@ -184,12 +184,9 @@ TEST(ReflectorMaps, ColourShadedWhereSearchesReadChangesNoSample) {
       searched.lobe_directions = search.lobe_directions;
       const ReflectorMaps whole =
           render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g, ReflectorSelection::all, {}, nullptr, searched);
-      MapSizing distances_only;  // every face, as the distance-map technique renders them
-      distances_only.skip_unseen = true;
-      distances_only.colour_read = false;
-      distances_only.keep_visibility = true;
       const ReflectorMaps distances = render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g,
-                                                            ReflectorSelection::all, {}, nullptr, distances_only);
+                                                            ReflectorSelection::all, {}, nullptr,
+                                                            searched_distance_maps(true));
       DistanceReflectStats one_pass;
       const ImageRGBA expected = distance_map_reflect(ex, v.g, v.env, whole, search, &one_pass);
       const DistanceSearches found = distance_map_search(ex, v.g, distances, search);
