@@ -388,6 +388,91 @@ struct CullGroup {
   Bounds box;
 };
 
+// What one depth image's rendering reuses from the one before it.
+struct DepthImageScratch {
+  std::vector<std::uint32_t> kept, indices, objects;
+  std::vector<glm::vec3> positions;
+  std::vector<ScreenVertex> vertices;
+  TileBins bins;
+  VisibilityBuffer vis;
+  GBuffer gb;
+};
+
+struct DepthImageCounts {
+  std::uint64_t set_up = 0, culled = 0;
+};
+
+// Cluster camera `cam`'s depth image into out's pixels from `base` on.
+DepthImageCounts render_depth_image(par::Executor& executor, const Scene& scene, const std::vector<CullGroup>& groups,
+                                    std::uint32_t reflector, const SoffCamera& cam, const SurfaceShader& shade,
+                                    const EnvironmentMap& env, std::size_t base, DepthImageScratch& s,
+                                    SoffDepthImages& out) {
+  const TriangleMesh& m = scene.mesh;
+  DepthImageCounts counts;
+  // Cull per cluster frustum before setup: whole groups outside one plane are dropped,
+  // and the cluster's own reflector is left out (first-order: SOFF §4.4).
+  const FrustumPlanes planes = frustum_planes(cam);
+  s.kept.clear();
+  for (const CullGroup& grp : groups) {
+    if (grp.object == reflector) continue;
+    if (box_outside(planes, grp.box)) {
+      counts.culled += grp.count;
+      continue;
+    }
+    for (std::uint32_t t = grp.first; t < grp.first + grp.count; ++t) s.kept.push_back(t);
+  }
+  counts.set_up = s.kept.size();
+  // Three vertices per kept triangle (shared vertices snap identically: make_screen_vertex
+  // is a pure function, so the mesh stays watertight).
+  s.positions.resize(3 * s.kept.size());
+  s.vertices.resize(3 * s.kept.size());
+  s.objects.resize(s.kept.size());
+  // 0, 1, 2, ... one index per kept vertex (grown by iota, so the kept prefix stays).
+  const std::size_t had = s.indices.size();
+  s.indices.resize(3 * s.kept.size());
+  if (s.indices.size() > had) std::iota(s.indices.begin() + std::ptrdiff_t(had), s.indices.end(), std::uint32_t(had));
+  const Viewport vp{cam.width, cam.height};
+  const glm::mat4 vp_matrix = cam.view_projection();
+  executor.parallel_for("soff_depth_images.vertices", s.kept.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t t = s.kept[k];
+      for (int v = 0; v < 3; ++v) s.positions[3 * k + v] = m.positions[m.indices[3 * t + v]];
+      s.objects[k] = m.triangle_object[t];
+    }
+    make_screen_vertices(vp_matrix, &s.positions[3 * begin], 3 * (end - begin), vp, &s.vertices[3 * begin]);
+  });
+  rasterize_screen_vertices(executor, s.vertices, s.indices, s.objects, cam.width, cam.height, {}, s.bins, s.vis);
+  VisibilityBuffer& vis = s.vis;
+  executor.parallel_for("soff_depth_images.ids", vis.triangle.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (vis.triangle.pixels[i] != kNoId) vis.triangle.pixels[i] = s.kept[vis.triangle.pixels[i]];
+  });
+  resolve_gbuffer(executor, scene, vis, cam.eye, s.gb);
+  const GBuffer& gb = s.gb;
+  executor.parallel_for("soff_depth_images.shade", gb.object.size(), 2048, [&](std::size_t begin, std::size_t end) {
+    shade.shade_samples(
+        gb, begin, end, [](std::size_t) { return true; },
+        [&](std::size_t i, const glm::vec3& radiance) {
+          out.inv_z[base + i] = 1.0f / vis.depth.pixels[i];
+          out.colour[base + i] = radiance;
+          out.surface[base + i] = gb.surface[i];
+          out.normal[base + i] = gb.normal.pixels[i];
+        },
+        [&](std::size_t i) {
+          const float sx = float(i % std::size_t(cam.width)) + 0.5f, sy = float(i / std::size_t(cam.width)) + 0.5f;
+          out.colour[base + i] = env.radiance(cam.pixel_direction(sx, sy), 1e6f);
+        });
+  });
+  return counts;
+}
+
+// Images of at least this many pixels are rendered one after another, each kernel's chunks
+// across the threads; the smaller ones (most of a frame's: a few thousand pixels, one or two
+// chunks per kernel) several at once, each image's kernels on one thread.
+constexpr std::size_t kSharedImagePixels = 16384;
+// Small images per task of that launch.
+constexpr std::size_t kSmallImagesPerTask = 4;
+
 }  // namespace
 
 SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, const SoffClusters& clusters,
@@ -419,80 +504,38 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
   out.surface.assign(out.pixels, SurfaceParams{});
   out.normal.assign(out.pixels, glm::vec3(0.0f));
 
-  SoffDepthStats st;
-  std::vector<std::uint32_t> kept, indices, objects;
-  std::vector<glm::vec3> positions;
-  std::vector<ScreenVertex> vertices;
-  TileBins bins;
-  VisibilityBuffer vis;
-  GBuffer gb;
   const SurfaceShader shade(scene, shadows, env);  // shade_surface's bits, eight at a time
-  // Largest images first: the planes above are then sized once, by the first image, and
-  // shrink for the others (growing them would value-initialize the growth on this thread).
-  // Each image writes its own range of `out`, so the order changes no byte.
-  std::vector<std::size_t> order(cameras.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return std::size_t(cameras[a].width) * cameras[a].height > std::size_t(cameras[b].width) * cameras[b].height;
+  // The valid images, largest first: a scratch's planes are then sized once, by its first
+  // image, and shrink for the others (growing them would value-initialize the growth on this
+  // thread). Each image writes its own range of `out`, so neither the order nor which thread
+  // renders an image changes a byte.
+  std::vector<std::size_t> order;
+  for (std::size_t c = 0; c < cameras.size(); ++c)
+    if (cameras[c].valid) order.push_back(c);
+  const auto pixels = [&](std::size_t c) { return out.offsets[c + 1] - out.offsets[c]; };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pixels(a) > pixels(b); });
+  std::vector<DepthImageCounts> counts(cameras.size());
+  const auto render = [&](par::Executor& on, std::size_t c, DepthImageScratch& scratch) {
+    counts[c] = render_depth_image(on, scene, groups, clusters.reflector[c], cameras[c], shade, env, out.offsets[c],
+                                   scratch, out);
+  };
+  std::size_t large = 0;
+  DepthImageScratch scratch;
+  for (; large < order.size() && pixels(order[large]) >= kSharedImagePixels; ++large)
+    render(executor, order[large], scratch);
+  executor.parallel_for("soff_depth_images.small_images", order.size() - large, kSmallImagesPerTask,
+                        [&](std::size_t begin, std::size_t end) {
+    par::Executor one_thread(1, executor.lanes());
+    one_thread.set_recording(false);
+    // Each thread keeps its scratch across tasks and frames (fresh planes per task cost
+    // more than the small images' work). No task can interleave with another on one thread:
+    // a one-thread executor runs its kernels inline and never waits for other tasks.
+    thread_local DepthImageScratch own;
+    for (std::size_t k = begin; k < end; ++k) render(one_thread, order[large + k], own);
   });
-  for (const std::size_t c : order) {
-    const SoffCamera& cam = cameras[c];
-    if (!cam.valid) continue;
-    ++st.images;
-    // Cull per cluster frustum before setup: whole groups outside one plane are dropped,
-    // and the cluster's own reflector is left out (first-order: SOFF §4.4).
-    const FrustumPlanes planes = frustum_planes(cam);
-    kept.clear();
-    for (const CullGroup& grp : groups) {
-      if (grp.object == clusters.reflector[c]) continue;
-      if (box_outside(planes, grp.box)) {
-        st.triangles_culled += grp.count;
-        continue;
-      }
-      for (std::uint32_t t = grp.first; t < grp.first + grp.count; ++t) kept.push_back(t);
-    }
-    st.triangles_set_up += kept.size();
-    // Three vertices per kept triangle (shared vertices snap identically: make_screen_vertex
-    // is a pure function, so the mesh stays watertight).
-    positions.resize(3 * kept.size());
-    vertices.resize(3 * kept.size());
-    objects.resize(kept.size());
-    // 0, 1, 2, ... one index per kept vertex (grown by iota, so the kept prefix stays).
-    const std::size_t had = indices.size();
-    indices.resize(3 * kept.size());
-    if (indices.size() > had) std::iota(indices.begin() + std::ptrdiff_t(had), indices.end(), std::uint32_t(had));
-    const Viewport vp{cam.width, cam.height};
-    const glm::mat4 vp_matrix = cam.view_projection();
-    executor.parallel_for("soff_depth_images.vertices", kept.size(), 4096, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k) {
-        const std::uint32_t t = kept[k];
-        for (int v = 0; v < 3; ++v) positions[3 * k + v] = m.positions[m.indices[3 * t + v]];
-        objects[k] = m.triangle_object[t];
-      }
-      make_screen_vertices(vp_matrix, &positions[3 * begin], 3 * (end - begin), vp, &vertices[3 * begin]);
-    });
-    rasterize_screen_vertices(executor, vertices, indices, objects, cam.width, cam.height, {}, bins, vis);
-    executor.parallel_for("soff_depth_images.ids", vis.triangle.size(), 8192, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i)
-        if (vis.triangle.pixels[i] != kNoId) vis.triangle.pixels[i] = kept[vis.triangle.pixels[i]];
-    });
-    resolve_gbuffer(executor, scene, vis, cam.eye, gb);
-    const std::size_t base = out.offsets[c];
-    executor.parallel_for("soff_depth_images.shade", gb.object.size(), 2048, [&](std::size_t begin, std::size_t end) {
-      shade.shade_samples(
-          gb, begin, end, [](std::size_t) { return true; },
-          [&](std::size_t i, const glm::vec3& radiance) {
-            out.inv_z[base + i] = 1.0f / vis.depth.pixels[i];
-            out.colour[base + i] = radiance;
-            out.surface[base + i] = gb.surface[i];
-            out.normal[base + i] = gb.normal.pixels[i];
-          },
-          [&](std::size_t i) {
-            const float sx = float(i % std::size_t(cam.width)) + 0.5f, sy = float(i / std::size_t(cam.width)) + 0.5f;
-            out.colour[base + i] = env.radiance(cam.pixel_direction(sx, sy), 1e6f);
-          });
-    });
-  }
+  SoffDepthStats st;
+  st.images = order.size();
+  for (const DepthImageCounts& n : counts) st.triangles_set_up += n.set_up, st.triangles_culled += n.culled;
   if (stats) *stats = st;
   return out;
 }

@@ -1,7 +1,8 @@
 // Tests of second-order feed-forward reflections (SOFF): clustering bounds and partition
-// (§3.2), the corrected eq.1 of the cluster camera (§3.3), the depth-image walk on an
-// analytic ramp (§3.4), a planar cluster against the planar-mirror technique, and the
-// specular error against the exact specular reference.
+// (§3.2), the corrected eq.1 of the cluster camera (§3.3), the depth images whichever way
+// each is rendered (§3.1), the depth-image walk on an analytic ramp (§3.4), a planar cluster
+// against the planar-mirror technique, and the specular error against the exact specular
+// reference.
 #include "raster/soff.h"
 
 #include <cmath>
@@ -20,7 +21,9 @@
 #include "core/optics.h"
 #include "core/procedural_geometry.h"
 #include "core/scene_loader.h"
+#include "raster/environment.h"
 #include "raster/gbuffer.h"
+#include "raster/shadow_map.h"
 #include "raster/visibility.h"
 
 namespace speculum::raster {
@@ -124,6 +127,41 @@ TEST(SoffClusters, SameBytesForAnyThreadCount) {
     EXPECT_EQ(ca[k].width, cb[k].width);
     EXPECT_EQ(ca[k].l, cb[k].l);
   }
+}
+
+// The depth images are rendered by two paths (large ones one at a time across the threads,
+// small ones several at once on per-thread scratch kept across images and frames): every
+// image has the bytes of rendering it alone, whatever ran on its thread before.
+TEST(SoffDepthImages, EveryImageHasTheBytesOfRenderingItAlone) {
+  const Scene s = load_scene("living-room:size=20000");
+  par::Executor two(2), three(3);
+  const GBuffer g = gbuffer_of(two, s, s.cameras.front(), 640, 480);
+  const SoffClusters clusters = soff_cluster(two, g, {});
+  SoffCameraSettings cs;
+  cs.scene_diameter = glm::length(s.bounds().extent());
+  const SoffCameras cameras = soff_cameras(two, g, clusters, cs);
+  const EnvironmentMap env = build_environment(two, s.environment, 8);
+  const std::vector<ShadowMap> shadows = render_shadow_maps(two, s, 256);
+  const SoffDepthImages all = soff_depth_images(two, s, clusters, cameras, shadows, env);
+  std::size_t large = 0, small = 0;
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    if (!cameras[k].valid) continue;
+    const std::size_t pixels = all.offsets[k + 1] - all.offsets[k];
+    (pixels >= 16384 ? large : small) += 1;
+    SoffCameras one_camera = cameras;
+    for (std::size_t j = 0; j < one_camera.size(); ++j) one_camera[j].valid = j == k;
+    const SoffDepthImages alone = soff_depth_images(k % 2 ? two : three, s, clusters, one_camera, shadows, env);
+    ASSERT_EQ(alone.pixels, pixels);
+    const std::size_t at = all.offsets[k];
+    EXPECT_EQ(0, std::memcmp(&all.inv_z[at], alone.inv_z.data(), pixels * sizeof(float))) << "image " << k;
+    EXPECT_EQ(0, std::memcmp(&all.colour[at], alone.colour.data(), pixels * sizeof(glm::vec3))) << "image " << k;
+    EXPECT_EQ(0, std::memcmp(&all.normal[at], alone.normal.data(), pixels * sizeof(glm::vec3))) << "image " << k;
+    for (std::size_t i = 0; i < pixels; ++i)
+      ASSERT_EQ(0, std::memcmp(&all.surface[at + i], &alone.surface[i], sizeof(SurfaceParams)))
+          << "image " << k << " pixel " << i;
+  }
+  EXPECT_GE(large, 1u) << "no image took the shared path";
+  EXPECT_GE(small, 20u) << "too few images took the per-thread path";
 }
 
 // The bin scale is the calibrated gain × a_R[%] / n_v, clamped to 1.
