@@ -317,6 +317,9 @@ SoffCameras soff_cameras(par::Executor& executor, const GBuffer& g, const SoffCl
       positions.resize(count), normals.resize(count), reflected.resize(count);
       adjacent.clear();
       float cone = 0.0f;
+      // The first sample at or after the one below sample k: i + width grows with k, so it
+      // only moves forward (a merge, not a binary search per sample).
+      std::uint32_t below = 0;
       for (std::uint32_t k = 0; k < count; ++k) {
         const std::uint32_t i = clusters.samples[first + k];
         const glm::vec3 nrm = g.normal.pixels[i];
@@ -337,10 +340,8 @@ SoffCameras soff_cameras(par::Executor& executor, const GBuffer& g, const SoffCl
         if (x + 1 < std::uint32_t(g.width) && clusters.cluster[i + 1] == c)
           adjacent.push_back({k, k + 1, false});  // samples are in increasing order: i + 1 is next
         if (y + 1 < std::uint32_t(g.height) && clusters.cluster[i + g.width] == c) {
-          const auto below = std::lower_bound(clusters.samples.begin() + first,
-                                              clusters.samples.begin() + first + count,
-                                              i + std::uint32_t(g.width));
-          adjacent.push_back({k, std::uint32_t(below - (clusters.samples.begin() + first)), true});
+          while (clusters.samples[first + below] < i + std::uint32_t(g.width)) ++below;
+          adjacent.push_back({k, below, true});
         }
       }
       const float far = cone > 0.0f ? settings.scene_diameter * settings.glossy_far : settings.scene_diameter;
