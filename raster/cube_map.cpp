@@ -224,10 +224,7 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
     dist = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
     executor.parallel_for("cube_map.distance", dist.size(), 4096,
                           [&](std::size_t begin, std::size_t end) {
-                            for (std::size_t i = begin; i < end; ++i)
-                              if (vis.triangle.pixels[i] != kNoId)
-                                dist.pixels[i] = glm::length(
-                                    visible_position(scene.mesh, vis, i) - centre);
+                            visible_distances(scene.mesh, vis, centre, begin, end, dist.pixels.data() + begin);
                           });
     if (options.keep_visibility) {  // what resolving reads (not the depths)
       VisibilityBuffer& kept = cube.visibility[face];

@@ -3,6 +3,7 @@
 #include "raster/gbuffer.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -503,6 +504,57 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const GBufferT
   if (!triangles.matches(scene.mesh))
     throw InputError(scene.name, "G-buffer triangle records were built from another mesh");
   resolve(executor, scene, &triangles, vis, eye, g);
+}
+
+void visible_distances(const TriangleMesh& m, const VisibilityBuffer& vis, const glm::vec3& from, std::size_t begin,
+                       std::size_t end, float* out) {
+  const std::uint32_t* tri = vis.triangle.pixels.data();
+  const __m256i none = _mm256_set1_epi32(static_cast<int>(kNoId));
+  std::size_t i = begin;
+  for (; i + 8 <= end; i += 8) {
+    const __m256i t = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(tri + i));
+    const int covered = ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(t, none))) & 0xff;
+    if (!covered) continue;
+    // The corners, component-major: c[3k + a] holds component a of corner k in each lane.
+    // Runs of one triangle (most of a map's texels) load its corners once.
+    alignas(32) float c[9][8];
+    const __m256i same = _mm256_cmpeq_epi32(t, _mm256_set1_epi32(static_cast<int>(tri[i])));
+    if (covered == 0xff && _mm256_movemask_epi8(same) == -1) {
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3& p = m.positions[m.indices[3 * std::size_t(tri[i]) + k]];
+        for (int a = 0; a < 3; ++a) _mm256_store_ps(c[3 * k + a], _mm256_set1_ps(p[a]));
+      }
+    } else {
+      for (int j = 0; j < 8; ++j) {
+        const std::size_t ti = (covered >> j) & 1 ? tri[i + j] : tri[i + std::countr_zero(unsigned(covered))];
+        for (int k = 0; k < 3; ++k) {
+          const glm::vec3& p = m.positions[m.indices[3 * ti + k]];
+          for (int a = 0; a < 3; ++a) c[3 * k + a][j] = p[a];
+        }
+      }
+    }
+    // (b1, b2) of the 8 samples, de-interleaved; b0 = (1 − b1) − b2.
+    const float* bary = &vis.bary.pixels[i].x;
+    const __m256 lo = _mm256_loadu_ps(bary), hi = _mm256_loadu_ps(bary + 8);
+    const __m256 b1 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0x88)), 0xd8));
+    const __m256 b2 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0xdd)), 0xd8));
+    const __m256 b0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), b1), b2);
+    __m256 d[3];
+    for (int a = 0; a < 3; ++a) {
+      // (b0·p0 + b1·p1) + b2·p2, then minus `from`: visible_position's order.
+      const __m256 p = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(b0, _mm256_load_ps(c[a])),
+                                                   _mm256_mul_ps(b1, _mm256_load_ps(c[3 + a]))),
+                                     _mm256_mul_ps(b2, _mm256_load_ps(c[6 + a])));
+      d[a] = _mm256_sub_ps(p, _mm256_set1_ps(from[a]));
+    }
+    // glm::length: the root of (x·x + y·y) + z·z.
+    const __m256 len = _mm256_sqrt_ps(_mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])), _mm256_mul_ps(d[2], d[2])));
+    const __m256i keep = _mm256_xor_si256(_mm256_cmpeq_epi32(t, none), _mm256_set1_epi32(-1));
+    _mm256_maskstore_ps(out + (i - begin), keep, len);
+  }
+  for (; i < end; ++i)
+    if (tri[i] != kNoId) out[i - begin] = glm::length(visible_position(m, vis, i) - from);
 }
 
 ImageF specular_level_image(const GBuffer& g) {

@@ -65,6 +65,12 @@ inline glm::vec3 visible_position(const TriangleMesh& m, const VisibilityBuffer&
          b.x * m.positions[m.indices[3 * t + 1]] + b.y * m.positions[m.indices[3 * t + 2]];
 }
 
+// |visible_position(m, vis, i) − from| for the covered samples i in [begin, end), written to
+// out[i − begin] (uncovered samples' entries are left as they were): eight samples at a time
+// in lanes, with the scalar expression's operations per lane (the same bits).
+void visible_distances(const TriangleMesh& m, const VisibilityBuffer& vis, const glm::vec3& from, std::size_t begin,
+                       std::size_t end, float* out);
+
 // The scalar views of the G-buffer for inspection: specular level (max of F0 for
 // non-diffuse surfaces, 0 otherwise) and glossiness (Phong exponent).
 ImageF specular_level_image(const GBuffer& g);

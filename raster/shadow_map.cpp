@@ -80,10 +80,8 @@ std::vector<ShadowMap> render_shadow_maps(par::Executor& executor, const Scene& 
       m.distance = ImageF(size, size, std::numeric_limits<float>::infinity());
       executor.parallel_for("shadow_map.distance", m.distance.size(), 4096,
                             [&](std::size_t begin, std::size_t end) {
-                              for (std::size_t i = begin; i < end; ++i)
-                                if (vis.triangle.pixels[i] != kNoId)
-                                  m.distance.pixels[i] = glm::length(
-                                      visible_position(scene.mesh, vis, i) - m.camera.eye);
+                              visible_distances(scene.mesh, vis, m.camera.eye, begin, end,
+                                                m.distance.pixels.data() + begin);
                             });
     } else {
       CubeMapOptions opt;

@@ -231,6 +231,40 @@ TEST(GBuffer, EveryByteMatchesAPerSampleOracle) {
   }
 }
 
+// The distances distance-only maps store: every covered sample's entry has the bits of the
+// per-sample expression, every uncovered one keeps what it held, for ranges starting and
+// ending anywhere (runs of eight on one triangle, mixed runs, background, tails).
+TEST(GBuffer, VisibleDistancesHaveTheBitsOfTheScalarExpression) {
+  const Scene scene = mixed_material_scene();
+  Camera cam;
+  cam.eye = {0.4f, -0.6f, 3.2f};
+  cam.target = {0.0f, 0.0f, 0.3f};
+  par::Executor ex(2);
+  const auto vis = render_visibility(ex, scene, cam, 97, 61);
+  const glm::vec3 from(0.3f, -1.7f, 2.9f);
+  std::size_t one_triangle_runs = 0, mixed_runs = 0;
+  for (std::size_t i = 0; i + 8 <= vis.triangle.size(); i += 8) {
+    const auto* t = &vis.triangle.pixels[i];
+    const bool same = std::all_of(t, t + 8, [&](std::uint32_t x) { return x == t[0]; });
+    (same && t[0] != kNoId ? one_triangle_runs : mixed_runs) += 1;
+  }
+  EXPECT_GT(one_triangle_runs, 50u);
+  EXPECT_GT(mixed_runs, 50u);
+  for (const auto& [begin, end] : {std::pair<std::size_t, std::size_t>{0, vis.triangle.size()},
+                                   {3, vis.triangle.size() - 5}, {1000, 1013}, {77, 77}}) {
+    std::vector<float> out(end - begin, -7.0f);
+    visible_distances(scene.mesh, vis, from, begin, end, out.data());
+    std::size_t bad = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const float expected = vis.triangle.pixels[i] == kNoId
+                                 ? -7.0f
+                                 : glm::length(visible_position(scene.mesh, vis, i) - from);
+      bad += std::memcmp(&expected, &out[i - begin], sizeof(float)) != 0;
+    }
+    EXPECT_EQ(bad, 0u) << "range " << begin << ".." << end;
+  }
+}
+
 // The line-phase staging writer: for every 4-byte phase of the run's start, run lengths that
 // end inside and on line boundaries, and blocks of uneven sizes, with and without streaming,
 // the run's bytes arrive in order and not one byte outside the run changes.
