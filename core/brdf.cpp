@@ -138,27 +138,38 @@ float smith_g1(float cos_n, float alpha) {
 }
 
 glm::vec3 sample_ggx_visible_normal(const glm::vec3& v_local, float alpha, glm::vec2 u) {
-  alpha = std::max(alpha, kMinAlpha);
+  return GgxVisibleNormalSampler(v_local, alpha)(u);
+}
+
+GgxVisibleNormalSampler::GgxVisibleNormalSampler(const glm::vec3& v_local, float alpha)
+    : alpha_(std::max(alpha, kMinAlpha)) {
   // Stretch the view to the hemisphere configuration, sample the projected disc of visible
   // normals (denser on its side facing v), unstretch (Heitz 2018, "Sampling the GGX
   // Distribution of Visible Normals").
-  const glm::vec3 vh = glm::normalize(glm::vec3(alpha * v_local.x, alpha * v_local.y, v_local.z));
-  const float len2 = vh.x * vh.x + vh.y * vh.y;
-  const glm::vec3 t1 = len2 > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : glm::vec3(1.0f, 0.0f, 0.0f);
-  const glm::vec3 t2 = glm::cross(vh, t1);
+  vh_ = glm::normalize(glm::vec3(alpha_ * v_local.x, alpha_ * v_local.y, v_local.z));
+  const float len2 = vh_.x * vh_.x + vh_.y * vh_.y;
+  t1_ = len2 > 0.0f ? glm::vec3(-vh_.y, vh_.x, 0.0f) / std::sqrt(len2) : glm::vec3(1.0f, 0.0f, 0.0f);
+  t2_ = glm::cross(vh_, t1_);
+  s_ = 0.5f * (1.0f + vh_.z);
+}
+
+glm::vec3 GgxVisibleNormalSampler::operator()(glm::vec2 u) const {
   const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
   const float p1 = r * std::cos(phi);
-  const float s = 0.5f * (1.0f + vh.z);
-  const float p2 = (1.0f - s) * std::sqrt(std::max(1.0f - p1 * p1, 0.0f)) + s * r * std::sin(phi);
-  const glm::vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
-  return glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(nh.z, 0.0f)));
+  const float p2 = (1.0f - s_) * std::sqrt(std::max(1.0f - p1 * p1, 0.0f)) + s_ * r * std::sin(phi);
+  const glm::vec3 nh = p1 * t1_ + p2 * t2_ + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh_;
+  return glm::normalize(glm::vec3(alpha_ * nh.x, alpha_ * nh.y, std::max(nh.z, 0.0f)));
 }
 
 float ggx_sample_weight(float cos_nl, float cos_nv, float alpha) {
   if (cos_nl <= 0.0f || cos_nv <= 0.0f) return 0.0f;
+  return ggx_sample_weight(cos_nl, cos_nv, alpha, smith_g1(cos_nv, std::max(alpha, kMinAlpha)));
+}
+
+float ggx_sample_weight(float cos_nl, float cos_nv, float alpha, float g1) {
+  if (cos_nl <= 0.0f || cos_nv <= 0.0f) return 0.0f;
   alpha = std::max(alpha, kMinAlpha);
   const float g2 = 4.0f * cos_nl * cos_nv * smith_visibility_height_correlated(cos_nl, cos_nv, alpha);
-  const float g1 = smith_g1(cos_nv, alpha);
   return g1 > 0.0f ? g2 / g1 : 0.0f;
 }
 

@@ -124,7 +124,21 @@ std::string albedo_table_source(const AlbedoTable& table);
 // G1(v) max(v·h, 0) D(h) / (N·V), so l = reflect(−v, h) has pdf that over 4 v·h and the
 // estimator f_spec (N·L) / pdf is F_x(v·h) G2(l, v) / G1(v) (ggx_sample_weight).
 glm::vec3 sample_ggx_visible_normal(const glm::vec3& v_local, float alpha, glm::vec2 u);
+// The same for many u at one viewer and roughness: the stretched view and its basis are
+// computed once (the same bits as the one-call form, which uses it).
+class GgxVisibleNormalSampler {
+ public:
+  GgxVisibleNormalSampler(const glm::vec3& v_local, float alpha);
+  glm::vec3 operator()(glm::vec2 u) const;
+
+ private:
+  float alpha_;
+  glm::vec3 vh_, t1_, t2_;  // the stretched view and the basis of its projected disc
+  float s_;                 // the disc's warp towards v
+};
 // F_x(v·h) G2 / G1(v) without F: G2 = 4 (N·L)(N·V) V(l, v); 0 when l is below the surface.
 float ggx_sample_weight(float cos_nl, float cos_nv, float alpha);
+// The same given g1 = smith_g1(cos_nv, max(alpha, kMinAlpha)) (for many l at one viewer).
+float ggx_sample_weight(float cos_nl, float cos_nv, float alpha, float g1);
 
 }  // namespace speculum

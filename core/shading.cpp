@@ -127,16 +127,33 @@ glm::vec3 diffuse_albedo_over_pi(const SurfaceParams& s, float cos_nv) {
 }
 
 LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u) {
-  const float alpha = s.roughness * s.roughness;
-  const Onb frame(n);
-  const glm::vec3 v_local(glm::dot(v, frame.t), glm::dot(v, frame.b), glm::dot(v, n));
-  if (!(v_local.z > 0.0f)) return {};
-  const glm::vec3 h = frame.to_world(sample_ggx_visible_normal(v_local, alpha, u));
-  const float cos_vh = glm::dot(v, h);
-  const glm::vec3 wi = glm::normalize(2.0f * cos_vh * h - v);
-  const float w = ggx_sample_weight(glm::dot(wi, n), v_local.z, alpha);
+  return SpecularLobeSampler(s, n, v)(u);
+}
+
+namespace {
+glm::vec3 local_view(const Onb& frame, const glm::vec3& v) {
+  return {glm::dot(v, frame.t), glm::dot(v, frame.b), glm::dot(v, frame.n)};
+}
+}  // namespace
+
+SpecularLobeSampler::SpecularLobeSampler(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v)
+    : frame_(n),
+      v_(v),
+      alpha_(s.roughness * s.roughness),
+      cos_nv_(local_view(frame_, v).z),
+      g1_(smith_g1(cos_nv_, std::max(alpha_, kMinAlpha))),
+      above_(cos_nv_ > 0.0f),
+      normals_(local_view(frame_, v), alpha_),
+      f0_(specular_f0(s)) {}
+
+LobeSample SpecularLobeSampler::operator()(glm::vec2 u) const {
+  if (!above_) return {};
+  const glm::vec3 h = frame_.to_world(normals_(u));
+  const float cos_vh = glm::dot(v_, h);
+  const glm::vec3 wi = glm::normalize(2.0f * cos_vh * h - v_);
+  const float w = ggx_sample_weight(glm::dot(wi, frame_.n), cos_nv_, alpha_, g1_);
   if (!(w > 0.0f)) return {};
-  return {wi, fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w};
+  return {wi, fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), f0_) * w};
 }
 
 BrdfParams brdf_params_for_punctual_light(const SurfaceParams& s) {

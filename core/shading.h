@@ -57,6 +57,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/brdf.h"
+#include "core/sampling.h"
 #include "core/scene.h"
 
 namespace speculum {
@@ -175,6 +176,21 @@ struct LobeSample {
   glm::vec3 weight{0.0f};
 };
 LobeSample sample_specular_lobe(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u);
+// The same for many u at one surface point and viewer: the frame, the visible-normal
+// sampler, G1(v) and F0 are computed once (the same bits as the one-call form, which uses it).
+class SpecularLobeSampler {
+ public:
+  SpecularLobeSampler(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v);
+  LobeSample operator()(glm::vec2 u) const;
+
+ private:
+  Onb frame_;
+  glm::vec3 v_;
+  float alpha_, cos_nv_, g1_;
+  bool above_;  // v above the surface (else every sample weighs 0)
+  GgxVisibleNormalSampler normals_;
+  glm::vec3 f0_;
+};
 
 // The diffuse part alone, for irradiance from many directions (environment, ambient): the
 // weight of incident irradiance, (1 - metallic)(1 - transmission)(1 - E_dielectric(N·V))

@@ -879,9 +879,10 @@ ImageRGBA soff_intersect(par::Executor& executor, const Scene& scene, const GBuf
         // F G2/G1, from a per-pixel rotated Hammersley set; rays below the surface count 0.
         const int k_rays = settings.glossy_rays;
         const glm::vec2 offset = random_float2(std::uint32_t(i), 0, 0, settings.seed);
+        const SpecularLobeSampler lobes(s, n, v);
         for (int k = 0; k < k_rays; ++k) {
           const glm::vec2 u = rotate_unit_square(hamersley(std::uint32_t(k), std::uint32_t(k_rays)), offset);
-          const LobeSample lobe = sample_specular_lobe(s, n, v, u);
+          const LobeSample lobe = lobes(u);
           if (lobe.weight == glm::vec3(0.0f)) continue;
           radiance += lobe.weight * trace(lobe.direction);
         }

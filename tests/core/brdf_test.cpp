@@ -10,6 +10,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <vector>
@@ -159,6 +160,63 @@ TEST(SpecularAlbedo, VisibleNormalSamplesAreValid) {
       }
     }
   }
+}
+
+// The lobe sampler that keeps what one surface point and viewer share gives, for every u,
+// the bits of the whole computation written out per sample (the oracle below: the frame,
+// the stretched view, the disc sample, reflection and F G2/G1 all evaluated afresh).
+LobeSample lobe_sample_written_out(const SurfaceParams& s, const glm::vec3& n, const glm::vec3& v, glm::vec2 u) {
+  const float alpha = std::max(s.roughness * s.roughness, kMinAlpha);
+  const Onb frame(n);
+  const glm::vec3 vl(glm::dot(v, frame.t), glm::dot(v, frame.b), glm::dot(v, n));
+  if (!(vl.z > 0.0f)) return {};
+  const glm::vec3 vh = glm::normalize(glm::vec3(alpha * vl.x, alpha * vl.y, vl.z));
+  const float len2 = vh.x * vh.x + vh.y * vh.y;
+  const glm::vec3 t1 = len2 > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : glm::vec3(1.0f, 0.0f, 0.0f);
+  const glm::vec3 t2 = glm::cross(vh, t1);
+  const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+  const float p1 = r * std::cos(phi);
+  const float sw = 0.5f * (1.0f + vh.z);
+  const float p2 = (1.0f - sw) * std::sqrt(std::max(1.0f - p1 * p1, 0.0f)) + sw * r * std::sin(phi);
+  const glm::vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+  const glm::vec3 h = frame.to_world(glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(nh.z, 0.0f))));
+  const float cos_vh = glm::dot(v, h);
+  const glm::vec3 wi = glm::normalize(2.0f * cos_vh * h - v);
+  const float cos_nl = glm::dot(wi, n);
+  if (cos_nl <= 0.0f) return {};
+  const float g2 = 4.0f * cos_nl * vl.z * smith_visibility_height_correlated(cos_nl, vl.z, alpha);
+  const float g1 = smith_g1(vl.z, alpha);
+  const float w = g1 > 0.0f ? g2 / g1 : 0.0f;
+  if (!(w > 0.0f)) return {};
+  return {wi, fresnel_schlick(std::clamp(cos_vh, 0.0f, 1.0f), specular_f0(s)) * w};
+}
+
+TEST(SpecularLobe, SamplerGivesTheBitsOfTheWrittenOutSample) {
+  std::uint32_t state = 12345u;
+  const auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / float(1u << 24);
+  };
+  std::size_t below = 0, compared = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    SurfaceParams s;
+    s.roughness = trial % 7 == 0 ? 0.0f : next();
+    s.metallic = next();
+    s.base_color = {next(), next(), next()};
+    const glm::vec3 n = glm::normalize(glm::vec3(next() - 0.5f, next() - 0.5f, next() - 0.5f));
+    const glm::vec3 v = glm::normalize(glm::vec3(next() - 0.5f, next() - 0.5f, next() - 0.5f));
+    const SpecularLobeSampler sampler(s, n, v);
+    for (int k = 0; k < 16; ++k) {
+      const glm::vec2 u(next(), next());
+      const LobeSample a = sampler(u), b = lobe_sample_written_out(s, n, v, u), c = sample_specular_lobe(s, n, v, u);
+      below += b.weight == glm::vec3(0.0f);
+      ++compared;
+      ASSERT_EQ(0, std::memcmp(&a, &b, sizeof(LobeSample))) << "trial " << trial << " sample " << k;
+      ASSERT_EQ(0, std::memcmp(&c, &b, sizeof(LobeSample))) << "trial " << trial << " sample " << k;
+    }
+  }
+  EXPECT_GT(below, compared / 4);  // viewers below the surface and samples below it occur
+  EXPECT_LT(below, compared * 3 / 4);
 }
 
 // The spec's limit α → 0: the specular lobe gathers in a small cone about the mirror
