@@ -2,6 +2,7 @@
 #include "raster/distance_map_reflect.h"
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -27,14 +28,15 @@ constexpr float kGlossySearchExponent = 1e4f;
 // `search(direction, exponent)`: the radiance one search along `direction` finds, read
 // through a lobe of that exponent. Every user walks the same searches in the same order.
 template <class Search>
-glm::vec3 searched_lookup(const glm::vec3& n, const glm::vec3& d, float exponent, int directions, Search&& search) {
+glm::vec3 searched_lookup(const glm::vec3& n, const glm::vec3& d, float exponent, SubLobeAxes& axes, Search&& search) {
+  const int directions = axes.count();
   if (directions <= 1 || !(exponent < kGlossySearchExponent)) return search(d, exponent);
   const Onb frame(d);
+  const glm::vec3* local = axes(exponent);
   glm::vec3 sum(0.0f);
   int used = 0;
   for (int k = 0; k < directions; ++k) {
-    const glm::vec3 dk = frame.to_world(sample_phong_lobe(
-        hamersley(static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(directions)), exponent * (4.0f / 3.0f)));
+    const glm::vec3 dk = frame.to_world(local[k]);
     if (glm::dot(dk, n) <= 0.0f) continue;  // below the surface: no light arrives from there
     sum += search(dk, 4.0f * exponent);
     ++used;
@@ -80,6 +82,16 @@ constexpr std::size_t kChunk = 2048;
 
 }  // namespace
 
+const glm::vec3* SubLobeAxes::operator()(float exponent) {
+  if (!(exponent == exponent_)) {
+    exponent_ = exponent;
+    const auto count = static_cast<std::uint32_t>(local_.size());
+    for (std::uint32_t k = 0; k < count; ++k)
+      local_[k] = sample_phong_lobe(hamersley(k, count), exponent * (4.0f / 3.0f));
+  }
+  return local_.data();
+}
+
 ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
                                const EnvironmentMap& env, const ReflectorMaps& maps,
                                const DistanceSearchOptions& options, DistanceReflectStats* stats,
@@ -89,6 +101,7 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
   executor.parallel_for("distance_map_reflect.search", out.size(), kChunk,
                         [&](std::size_t begin, std::size_t end) {
     DistanceReflectStats& st = per_chunk[begin / kChunk];
+    SubLobeAxes axes(options.lobe_directions);
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface[i];
@@ -99,7 +112,7 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
       // (at infinity) for objects without one.
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         if (m < 0) return env.radiance(d, exponent);
-        return searched_lookup(n, d, exponent, options.lobe_directions, [&](const glm::vec3& dk, float e) {
+        return searched_lookup(n, d, exponent, axes, [&](const glm::vec3& dk, float e) {
           return maps.maps[m].radiance(search_counted(maps, m, x, dk, options, st), e);
         });
       };
@@ -128,6 +141,7 @@ DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, 
     std::vector<glm::vec3>& found = out.found[begin / kChunk];
     std::vector<LookupTileMarker> markers;
     for (std::size_t m = 0; m < maps.cubes.size(); ++m) markers.emplace_back(tiles[m], maps.levels[m]);
+    SubLobeAxes axes(options.lobe_directions);
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface[i];
@@ -135,7 +149,7 @@ DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, 
       if (m < 0) continue;
       const glm::vec3 x = g.position.pixels[i], n = g.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
-        return searched_lookup(n, d, exponent, options.lobe_directions, [&](const glm::vec3& dk, float e) {
+        return searched_lookup(n, d, exponent, axes, [&](const glm::vec3& dk, float e) {
           found.push_back(search_counted(maps, m, x, dk, options, st));
           markers[m].mark(found.back(), e);
           return glm::vec3(0.0f);
@@ -159,6 +173,7 @@ ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const E
   executor.parallel_for("distance_map_reflect.lookup", out.size(), kChunk, [&](std::size_t begin, std::size_t end) {
     const std::vector<glm::vec3>& found = searches.found[begin / kChunk];
     std::size_t next = 0;
+    SubLobeAxes axes(options.lobe_directions);
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface[i];
@@ -167,7 +182,7 @@ ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const E
       const glm::vec3 n = g.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         if (m < 0) return env.radiance(d, exponent);
-        return searched_lookup(n, d, exponent, options.lobe_directions,
+        return searched_lookup(n, d, exponent, axes,
                                [&](const glm::vec3&, float e) { return maps.maps[m].radiance(found[next++], e); });
       };
       out.pixels[i] = glm::vec4(specular_radiance(s, n, g.view_direction(i), lookup), 1.0f);

@@ -5,8 +5,12 @@
 // Fresnel exactly like envmap_reflect. Samples of objects without a map use the environment.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "core/fallback_mask.h"
 #include "parallel/executor.h"
@@ -27,6 +31,22 @@ struct DistanceReflectStats {
     searches += o.searches, lookups += o.lookups, bracketed += o.bracketed, missed += o.missed;
     return *this;
   }
+};
+
+// A glossy lobe is searched along `directions` sub-lobe axes (a fixed Hamersley set of a
+// Phong lobe of exponent 4n/3, each read at 4n; see distance_map_reflect.cpp). Their
+// directions in the lobe's own frame depend on n alone: kept for the last n asked, as a
+// chunk's glossy samples mostly share one material.
+class SubLobeAxes {
+ public:
+  explicit SubLobeAxes(int directions) : local_(static_cast<std::size_t>(std::max(directions, 0))) {}
+  int count() const { return static_cast<int>(local_.size()); }
+  // count() directions, valid until the next call.
+  const glm::vec3* operator()(float exponent);
+
+ private:
+  float exponent_ = std::numeric_limits<float>::quiet_NaN();
+  std::vector<glm::vec3> local_;
 };
 
 // The specular layer (zero on diffuse samples). Works on any G-buffer, including a cube

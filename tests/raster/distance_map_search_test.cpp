@@ -13,7 +13,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "core/sampling.h"
 #include "core/scene_loader.h"
+#include "raster/distance_map_reflect.h"
 #include "raster_test_scenes.h"
 
 namespace speculum::raster {
@@ -201,6 +203,25 @@ TEST(DistanceMapSearch, MarchInLanesGivesTheBitsOfTheScalarMarch) {
     }
   }
   EXPECT_GT(bracketed, compared / 3);
+}
+
+// The sub-lobe axes a glossy search keeps for the last exponent: whatever exponents came
+// before, the axes of each are those computed afresh.
+TEST(DistanceMapSearch, SubLobeAxesAreThoseOfTheExponentAsked) {
+  for (const int directions : {1, 5, 8}) {
+    SubLobeAxes axes(directions);
+    EXPECT_EQ(axes.count(), directions);
+    for (const float exponent : {131.0f, 131.0f, 20.0f, 131.0f, 4000.0f, 4000.0f, 20.0f}) {
+      const glm::vec3* got = axes(exponent);
+      for (int k = 0; k < directions; ++k) {
+        const glm::vec3 expected = sample_phong_lobe(
+            hamersley(std::uint32_t(k), std::uint32_t(directions)), exponent * (4.0f / 3.0f));
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(got[k].x), std::bit_cast<std::uint32_t>(expected.x));
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(got[k].y), std::bit_cast<std::uint32_t>(expected.y));
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(got[k].z), std::bit_cast<std::uint32_t>(expected.z));
+      }
+    }
+  }
 }
 
 TEST(DistanceMapSearch, ErrorGrowsWithDistanceFromTheReferencePoint) {
