@@ -24,24 +24,43 @@ namespace {
 // kGlossySearchExponent's (under 0.7° at half maximum) are searched along R only.
 constexpr float kGlossySearchExponent = 1e4f;
 
+// Sub-lobe searches handed to a search callback at once.
+constexpr int kLobeBatch = 8;
+
 // The radiance arriving along d through a lobe of `exponent` at a sample with normal n, from
-// `search(direction, exponent)`: the radiance one search along `direction` finds, read
-// through a lobe of that exponent. Every user walks the same searches in the same order.
+// `search(directions, count, exponent, radiance)`: into radiance[j] the radiance one search
+// along directions[j] (j < count ≤ kLobeBatch) finds, read through a lobe of that exponent.
+// Every user walks the same searches in the same order.
 template <class Search>
 glm::vec3 searched_lookup(const glm::vec3& n, const glm::vec3& d, float exponent, SubLobeAxes& axes, Search&& search) {
+  glm::vec3 along_d;
   const int directions = axes.count();
-  if (directions <= 1 || !(exponent < kGlossySearchExponent)) return search(d, exponent);
+  if (directions <= 1 || !(exponent < kGlossySearchExponent)) {
+    search(&d, 1, exponent, &along_d);
+    return along_d;
+  }
   const Onb frame(d);
   const glm::vec3* local = axes(exponent);
+  glm::vec3 batch[kLobeBatch], found[kLobeBatch];
+  int batched = 0;
   glm::vec3 sum(0.0f);
   int used = 0;
+  const auto flush = [&] {
+    search(batch, batched, 4.0f * exponent, found);
+    for (int j = 0; j < batched; ++j) sum += found[j];
+    used += batched;
+    batched = 0;
+  };
   for (int k = 0; k < directions; ++k) {
     const glm::vec3 dk = frame.to_world(local[k]);
     if (glm::dot(dk, n) <= 0.0f) continue;  // below the surface: no light arrives from there
-    sum += search(dk, 4.0f * exponent);
-    ++used;
+    batch[batched++] = dk;
+    if (batched == kLobeBatch) flush();
   }
-  return used > 0 ? sum / float(used) : search(d, exponent);
+  if (batched > 0) flush();
+  if (used > 0) return sum / float(used);
+  search(&d, 1, exponent, &along_d);
+  return along_d;
 }
 
 // The map of sample i's object (-1: none, the environment instead).
@@ -50,15 +69,19 @@ int map_of_sample(const GBuffer& g, const ReflectorMaps& maps, std::size_t i) {
   return object < maps.map_of_object.size() ? maps.map_of_object[object] : -1;
 }
 
-// One search from x along d in map m, counted in `st`: the direction its colour is read along.
-glm::vec3 search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, const glm::vec3& d,
-                         const DistanceSearchOptions& options, DistanceReflectStats& st) {
-  const DistanceSearchResult hit = search_distance_map(maps.cubes[m], x, d, options);
-  ++st.searches;
-  st.lookups += hit.lookups;
-  st.bracketed += hit.bracketed;
-  st.missed += !std::isfinite(hit.d);
-  return glm::normalize(hit.direction);
+// The searches from x along directions[0..count) in map m, counted in `st`: into found[j]
+// the direction search j reads its colour along.
+void search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, const glm::vec3* directions, int count,
+                    const DistanceSearchOptions& options, DistanceReflectStats& st, glm::vec3* found) {
+  DistanceSearchResult hits[kLobeBatch];
+  search_distance_map8(maps.cubes[m], x, directions, count, options, hits);
+  for (int j = 0; j < count; ++j) {
+    ++st.searches;
+    st.lookups += hits[j].lookups;
+    st.bracketed += hits[j].bracketed;
+    st.missed += !std::isfinite(hits[j].d);
+    found[j] = glm::normalize(hits[j].direction);
+  }
 }
 
 // Chunks' counts summed in chunk order.
@@ -112,8 +135,11 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
       // (at infinity) for objects without one.
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         if (m < 0) return env.radiance(d, exponent);
-        return searched_lookup(n, d, exponent, axes, [&](const glm::vec3& dk, float e) {
-          return maps.maps[m].radiance(search_counted(maps, m, x, dk, options, st), e);
+        return searched_lookup(n, d, exponent, axes,
+                               [&](const glm::vec3* dk, int count, float e, glm::vec3* radiance) {
+          glm::vec3 found[kLobeBatch];
+          search_counted(maps, m, x, dk, count, options, st, found);
+          for (int j = 0; j < count; ++j) radiance[j] = maps.maps[m].radiance(found[j], e);
         });
       };
       const std::uint64_t missed_before = st.missed;
@@ -149,10 +175,15 @@ DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, 
       if (m < 0) continue;
       const glm::vec3 x = g.position.pixels[i], n = g.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
-        return searched_lookup(n, d, exponent, axes, [&](const glm::vec3& dk, float e) {
-          found.push_back(search_counted(maps, m, x, dk, options, st));
-          markers[m].mark(found.back(), e);
-          return glm::vec3(0.0f);
+        return searched_lookup(n, d, exponent, axes,
+                               [&](const glm::vec3* dk, int count, float e, glm::vec3* radiance) {
+          glm::vec3 along[kLobeBatch];
+          search_counted(maps, m, x, dk, count, options, st, along);
+          for (int j = 0; j < count; ++j) {
+            found.push_back(along[j]);
+            markers[m].mark(along[j], e);
+            radiance[j] = glm::vec3(0.0f);
+          }
         });
       };
       const std::uint64_t missed_before = st.missed;
@@ -182,8 +213,9 @@ ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const E
       const glm::vec3 n = g.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         if (m < 0) return env.radiance(d, exponent);
-        return searched_lookup(n, d, exponent, axes,
-                               [&](const glm::vec3&, float e) { return maps.maps[m].radiance(found[next++], e); });
+        return searched_lookup(n, d, exponent, axes, [&](const glm::vec3*, int count, float e, glm::vec3* radiance) {
+          for (int j = 0; j < count; ++j) radiance[j] = maps.maps[m].radiance(found[next++], e);
+        });
       };
       out.pixels[i] = glm::vec4(specular_radiance(s, n, g.view_direction(i), lookup), 1.0f);
     }

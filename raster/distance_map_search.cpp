@@ -1,6 +1,7 @@
 // The distance-map search on a cube map: see distance_map_search.h.
 #include "raster/distance_map_search.h"
 
+#include <bit>
 #include <cstdint>
 #include <limits>
 
@@ -11,39 +12,99 @@ namespace speculum::raster {
 
 namespace {
 
+using L = par::Lanes<8>;
+using f32 = L::f32;
+using i32 = L::i32;
+
+// ratio() for eight points l = x + r d at once (x and r per lane), each lane with its
+// operations in their order (l, |l|, cube_coord, the nearest texel's distance, |l| / stored
+// or 0 where the map is empty), so the same bits; lanes outside `wanted` read nothing. The
+// lanes that read the map (what ratio() counts) in `reads`.
+[[gnu::always_inline]] inline f32 ratio8(const CubeMap& map, const f32 (&x)[3], const f32 (&r)[3], const f32& d,
+                                         const L::mask& wanted, L::mask& reads) {
+  const f32 l[3] = {x[0] + r[0] * d, x[1] + r[1] * d, x[2] + r[2] * d};
+  const f32 len = L::sqrt((l[0] * l[0] + l[1] * l[1]) + l[2] * l[2]);
+  reads = !(len <= 0.0f) && wanted;
+  const CubeCoordLanes c = cube_coord8(l, map.size);
+  // distance_at's texel; lanes that read nothing (l = 0: their coordinates are NaN, which
+  // no float-to-int conversion may see) read texel 0 of face 0 instead.
+  const i32 last(map.size - 1), zero(0);
+  const f32 at_x = L::select(reads, c.x, f32(0.0f)), at_y = L::select(reads, c.y, f32(0.0f));
+  const i32 tx = L::clamp(L::to_int(at_x), zero, last), ty = L::clamp(L::to_int(at_y), zero, last);
+  const i32 face = L::select(reads, c.face, zero);
+  alignas(32) std::int32_t fx[8], px[8], py[8];
+  L::store_aligned(face, fx), L::store_aligned(tx, px), L::store_aligned(ty, py);
+  alignas(32) float stored_at[8];
+  for (int j = 0; j < 8; ++j) stored_at[j] = map.distance[fx[j]].at(px[j], py[j]);
+  const f32 stored = L::load_aligned(stored_at);
+  const f32 g = L::select(L::abs(stored) == std::numeric_limits<float>::infinity(), f32(0.0f), len / stored);
+  return L::select(reads, g, f32(0.0f));
+}
+
 // The linear march on a cube map, eight samples in lanes: per lane the operations of the
-// march's parameter and of ratio() (l = x + r d, |l|, cube_coord, the nearest texel's
-// distance, |l| / stored or 0 where the map is empty) in their order, so the same bits.
+// march's parameter and of ratio() in their order, so the same bits.
 struct CubeMarch {
   const CubeMap& map;
   void operator()(const glm::vec3& x, const glm::vec3& r, float x_len, int n, int first, MarchBatch& b) const {
-    using L = par::Lanes<8>;
-    using f32 = L::f32;
-    using i32 = L::i32;
     const i32 k = L::iota(first);
     const f32 t = L::to_float(k) / float(n);
     const f32 d = L::select(k == 0, f32(0.0f), x_len * t / (1.0f - t));
-    const f32 l[3] = {x.x + r.x * d, x.y + r.y * d, x.z + r.z * d};
-    const f32 len = L::sqrt((l[0] * l[0] + l[1] * l[1]) + l[2] * l[2]);
-    const L::mask reads = !(len <= 0.0f) && L::mask(k < n);
-    const CubeCoordLanes c = cube_coord8(l, map.size);
-    // distance_at's texel; lanes that read nothing (l = 0: their coordinates are NaN, which
-    // no float-to-int conversion may see) read texel 0 of face 0 instead.
-    const i32 last(map.size - 1), zero(0);
-    const f32 at_x = L::select(reads, c.x, f32(0.0f)), at_y = L::select(reads, c.y, f32(0.0f));
-    const i32 tx = L::clamp(L::to_int(at_x), zero, last), ty = L::clamp(L::to_int(at_y), zero, last);
-    const i32 face = L::select(reads, c.face, zero);
-    alignas(32) std::int32_t fx[8], px[8], py[8];
-    L::store_aligned(face, fx), L::store_aligned(tx, px), L::store_aligned(ty, py);
-    alignas(32) float stored_at[8];
-    for (int j = 0; j < 8; ++j) stored_at[j] = map.distance[fx[j]].at(px[j], py[j]);
-    const f32 stored = L::load_aligned(stored_at);
-    const f32 g = L::select(L::abs(stored) == std::numeric_limits<float>::infinity(), f32(0.0f), len / stored);
-    L::store(L::select(reads, g, f32(0.0f)), b.g);
+    const f32 xs[3] = {f32(x.x), f32(x.y), f32(x.z)}, rs[3] = {f32(r.x), f32(r.y), f32(r.z)};
+    L::mask reads;
+    const f32 g = ratio8(map, xs, rs, d, L::mask(k < n), reads);
+    L::store(g, b.g);
     L::store(d, b.d);
-    L::store(L::select(reads, i32(1), zero), b.counted);
+    L::store(L::select(reads, i32(1), i32(0)), b.counted);
   }
 };
+
+// refine_bracket for the searches j with bit j of `pending`, side by side: per lane the
+// scalar steps (secant_from_ratios, ratio, the bracket's update, the stop at a ratio of 1).
+void refine_brackets8(const CubeMap& map, const glm::vec3& x, const glm::vec3* r, const distance_search_detail::Bracket* b,
+                      unsigned pending, const DistanceSearchOptions& o, DistanceSearchResult* out) {
+  // Lanes of other searches repeat the first pending one: valid inputs, results dropped.
+  const int first = std::countr_zero(pending);
+  alignas(32) float in[7][8];
+  for (int j = 0; j < 8; ++j) {
+    const int k = (pending >> j) & 1u ? j : first;
+    in[0][j] = b[k].d_l, in[1][j] = b[k].g_l, in[2][j] = b[k].d_p, in[3][j] = b[k].g_p;
+    in[4][j] = r[k].x, in[5][j] = r[k].y, in[6][j] = r[k].z;
+  }
+  f32 d_l = L::load_aligned(in[0]), g_l = L::load_aligned(in[1]), d_p = L::load_aligned(in[2]),
+      g_p = L::load_aligned(in[3]);
+  const f32 rs[3] = {L::load_aligned(in[4]), L::load_aligned(in[5]), L::load_aligned(in[6])};
+  const f32 xs[3] = {f32(x.x), f32(x.y), f32(x.z)};
+  alignas(32) std::int32_t bits[8];
+  for (int j = 0; j < 8; ++j) bits[j] = (pending >> j) & 1u ? -1 : 0;
+  L::mask active = L::load_aligned(bits) != i32(0);
+  f32 best = d_p;
+  i32 lookups(0);
+  const f32 inf(std::numeric_limits<float>::infinity());
+  for (int s = 0; o.secant && s < o.secant_steps && L::any(active); ++s) {
+    // secant_from_ratios
+    const f32 denom = g_p - g_l;
+    const L::mask degenerate = denom == 0.0f || !(L::abs(denom) < inf);
+    const f32 d_new = L::select(degenerate, d_l, d_l + (d_p - d_l) * (1.0f - g_l) / denom);
+    best = L::select(active, d_new, best);
+    L::mask reads;
+    const f32 g_new = ratio8(map, xs, rs, d_new, active, reads);
+    lookups = lookups + L::select(reads, i32(1), i32(0));
+    const L::mask under = active && g_new < 1.0f, over = active && !(g_new < 1.0f);
+    d_l = L::select(under, d_new, d_l), g_l = L::select(under, g_new, g_l);
+    d_p = L::select(over, d_new, d_p), g_p = L::select(over, g_new, g_p);
+    active = active && !(g_new == 1.0f);
+  }
+  alignas(32) float best_at[8];
+  alignas(32) std::int32_t lookups_at[8];
+  L::store_aligned(best, best_at), L::store_aligned(lookups, lookups_at);
+  for (int j = 0; j < 8; ++j) {
+    if (!((pending >> j) & 1u)) continue;
+    out[j].bracketed = true;
+    out[j].lookups += lookups_at[j];
+    out[j].d = best_at[j];
+    out[j].direction = distance_search_detail::hit_direction(x, r[j], best_at[j]);
+  }
+}
 
 }  // namespace
 
@@ -51,6 +112,27 @@ DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_
                                          const glm::vec3& r, const DistanceSearchOptions& options) {
   return search_distance([&](const glm::vec3& d) { return map.distance_towards(d); }, CubeMarch{map},
                          x_world - map.centre, r, options);
+}
+
+void search_distance_map8(const CubeMap& map, const glm::vec3& x_world, const glm::vec3* r, int count,
+                          const DistanceSearchOptions& options, DistanceSearchResult* out) {
+  using namespace distance_search_detail;
+  const glm::vec3 x = x_world - map.centre;
+  const float x_len = glm::length(x);
+  if (count < 2 || x_len == 0.0f || !(options.linear && options.linear_steps >= 2)) {
+    for (int j = 0; j < count; ++j) out[j] = search_distance_map(map, x_world, r[j], options);
+    return;
+  }
+  const auto towards = [&](const glm::vec3& d) { return map.distance_towards(d); };
+  Bracket b[8];
+  unsigned pending = 0;
+  for (int j = 0; j < count; ++j) {
+    out[j] = {};
+    b[j] = march_to_bracket(CubeMarch{map}, x, r[j], x_len, options.linear_steps, out[j].lookups);
+    if (b[j].found) pending |= 1u << j;
+    else search_unbracketed(towards, x, r[j], options, out[j]);
+  }
+  if (pending) refine_brackets8(map, x, r, b, pending, options, out);
 }
 
 std::string describe_search(const DistanceSearchOptions& o) {

@@ -109,59 +109,64 @@ struct ScalarMarch {
   }
 };
 
-// The combined search. Order: x = o → the direct lookup along r. Linear search (when on)
-// for the first undershoot → overshoot pair, then `secant_steps` regula-falsi steps inside
-// it (without secant: the overshooting sample). Without a bracket: `parallax_steps` eq.4
-// iterations (when on), refined by plain secant steps between the last two guesses (the
-// ray start d = 0 counts as the first); with nothing on: the environment-map guess r.
-// `march` gives the linear march's ratios a batch at a time (any batch is computed before it
-// is scanned; the result and the counted lookups are those of the samples up to the bracket).
-template <class DistanceFn, class March>
-DistanceSearchResult search_distance(const DistanceFn& distance_towards, const March& march, const glm::vec3& x,
-                                     const glm::vec3& r, const DistanceSearchOptions& o) {
-  using namespace distance_search_detail;
-  DistanceSearchResult out;
-  const float x_len = glm::length(x);
-  if (x_len == 0.0f) {  // from the reference point every ray is a direct lookup
-    out.lookups = 1;
-    out.d = distance_towards(r);
-    out.direction = r;
-    return out;
-  }
-  if (o.linear && o.linear_steps >= 2) {
-    const int n = o.linear_steps;
-    float d_prev = 0.0f, g_prev = 0.0f;
-    MarchBatch b;
-    for (int first = 0; first < n; first += kMarchBatch) {
-      march(x, r, x_len, n, first, b);
-      for (int k = first; k < std::min(first + kMarchBatch, n); ++k) {
-        const int j = k - first;
-        out.lookups += b.counted[j];
-        const float d = b.d[j], g = b.g[j];
-        if (k > 0 && g_prev < 1.0f && g >= 1.0f) {
-          out.bracketed = true;
-          float d_l = d_prev, g_l = g_prev, d_p = d, g_p = g;  // undershoot, overshoot
-          float best = d_p;
-          for (int s = 0; o.secant && s < o.secant_steps; ++s) {
-            const float d_new = secant_from_ratios(d_l, g_l, d_p, g_p);
-            best = d_new;
-            const float g_new = ratio(distance_towards, x, r, d_new, out.lookups);
-            if (g_new < 1.0f) d_l = d_new, g_l = g_new;
-            else d_p = d_new, g_p = g_new;
-            if (g_new == 1.0f) break;
-          }
-          out.d = best;
-          out.direction = hit_direction(x, r, best);
-          return out;
-        }
-        d_prev = d;
-        g_prev = g;
-      }
+namespace distance_search_detail {
+
+// Where the linear march stopped: the first undershoot → overshoot pair, or none.
+struct Bracket {
+  bool found = false;
+  float d_l = 0.0f, g_l = 0.0f;  // undershoot
+  float d_p = 0.0f, g_p = 0.0f;  // overshoot
+};
+
+// The linear march of n steps (§4.1.2) from x (|x| = x_len > 0) along r, `march` giving its
+// ratios a batch at a time (any batch is computed before it is scanned); adds to `lookups`
+// those of the samples up to the bracket.
+template <class March>
+Bracket march_to_bracket(const March& march, const glm::vec3& x, const glm::vec3& r, float x_len, int n,
+                         int& lookups) {
+  float d_prev = 0.0f, g_prev = 0.0f;
+  MarchBatch b;
+  for (int first = 0; first < n; first += kMarchBatch) {
+    march(x, r, x_len, n, first, b);
+    for (int k = first; k < std::min(first + kMarchBatch, n); ++k) {
+      const int j = k - first;
+      lookups += b.counted[j];
+      const float d = b.d[j], g = b.g[j];
+      if (k > 0 && g_prev < 1.0f && g >= 1.0f) return {true, d_prev, g_prev, d, g};
+      d_prev = d;
+      g_prev = g;
     }
   }
+  return {};
+}
+
+// `secant_steps` regula-falsi steps inside the bracket (none: the overshooting sample).
+template <class DistanceFn>
+void refine_bracket(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r, Bracket b,
+                    const DistanceSearchOptions& o, DistanceSearchResult& out) {
+  out.bracketed = true;
+  float best = b.d_p;
+  for (int s = 0; o.secant && s < o.secant_steps; ++s) {
+    const float d_new = secant_from_ratios(b.d_l, b.g_l, b.d_p, b.g_p);
+    best = d_new;
+    const float g_new = ratio(distance_towards, x, r, d_new, out.lookups);
+    if (g_new < 1.0f) b.d_l = d_new, b.g_l = g_new;
+    else b.d_p = d_new, b.g_p = g_new;
+    if (g_new == 1.0f) break;
+  }
+  out.d = best;
+  out.direction = hit_direction(x, r, best);
+}
+
+// Without a bracket: `parallax_steps` eq.4 iterations (when on), refined by plain secant
+// steps between the last two guesses (the ray start d = 0 counts as the first); with
+// nothing on, the environment-map guess r.
+template <class DistanceFn>
+void search_unbracketed(const DistanceFn& distance_towards, const glm::vec3& x, const glm::vec3& r,
+                        const DistanceSearchOptions& o, DistanceSearchResult& out) {
   if (!o.parallax || o.parallax_steps < 1) {
     out.direction = r;  // environment mapping
-    return out;
+    return;
   }
   float d_before = 0.0f, d = std::numeric_limits<float>::infinity();
   for (int s = 0; s < o.parallax_steps; ++s) {
@@ -182,6 +187,37 @@ DistanceSearchResult search_distance(const DistanceFn& distance_towards, const M
   }
   out.d = d;
   out.direction = hit_direction(x, r, d);
+}
+
+}  // namespace distance_search_detail
+
+// The combined search. Order: x = o → the direct lookup along r. Linear search (when on)
+// for the first undershoot → overshoot pair, then `secant_steps` regula-falsi steps inside
+// it (without secant: the overshooting sample). Without a bracket: `parallax_steps` eq.4
+// iterations (when on), refined by plain secant steps between the last two guesses (the
+// ray start d = 0 counts as the first); with nothing on: the environment-map guess r.
+// `march` gives the linear march's ratios a batch at a time (any batch is computed before it
+// is scanned; the result and the counted lookups are those of the samples up to the bracket).
+template <class DistanceFn, class March>
+DistanceSearchResult search_distance(const DistanceFn& distance_towards, const March& march, const glm::vec3& x,
+                                     const glm::vec3& r, const DistanceSearchOptions& o) {
+  using namespace distance_search_detail;
+  DistanceSearchResult out;
+  const float x_len = glm::length(x);
+  if (x_len == 0.0f) {  // from the reference point every ray is a direct lookup
+    out.lookups = 1;
+    out.d = distance_towards(r);
+    out.direction = r;
+    return out;
+  }
+  if (o.linear && o.linear_steps >= 2) {
+    const Bracket b = march_to_bracket(march, x, r, x_len, o.linear_steps, out.lookups);
+    if (b.found) {
+      refine_bracket(distance_towards, x, r, b, o, out);
+      return out;
+    }
+  }
+  search_unbracketed(distance_towards, x, r, o, out);
   return out;
 }
 
@@ -196,5 +232,11 @@ DistanceSearchResult search_distance(const DistanceFn& distance_towards, const g
 // linear march reads eight samples at a time in lanes (each with ratio()'s bits).
 DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_world,
                                          const glm::vec3& r, const DistanceSearchOptions& options);
+// search_distance_map from one point along count (1..8) directions r[j], into out[j]: each
+// search's march as there, then the bracketed ones' secant steps side by side in lanes (a
+// step waits on the one before it; eight independent searches keep the core busy), each
+// lane with the scalar steps' operations in their order. The same results, bit for bit.
+void search_distance_map8(const CubeMap& map, const glm::vec3& x_world, const glm::vec3* r, int count,
+                          const DistanceSearchOptions& options, DistanceSearchResult* out);
 
 }  // namespace speculum::raster

@@ -205,6 +205,47 @@ TEST(DistanceMapSearch, MarchInLanesGivesTheBitsOfTheScalarMarch) {
   EXPECT_GT(bracketed, compared / 3);
 }
 
+// Eight searches from one point with their secant steps side by side in lanes: each result
+// (d, direction, bracket, lookups) has the bits of the search alone, for every count of
+// directions, with secant steps on and off, with and without the linear march and the
+// parallax steps, from the map's centre and elsewhere, on a map with empty texels.
+TEST(DistanceMapSearch, EightSearchesInLanesGiveTheBitsOfEachAlone) {
+  RoomFixture f;
+  for (int k = 0; k < 40; ++k) f.map.distance[k % kCubeFaces].pixels[(k * 997) % f.map.distance[0].pixels.size()] = kInf;
+  const std::vector<glm::vec3> dirs = sphere_directions(240);
+  std::vector<DistanceSearchOptions> options(6);
+  options[1].secant_steps = 1;
+  options[2].secant = false;
+  options[3].linear = false;
+  options[4].parallax = false, options[4].linear_steps = 5;
+  options[5].secant_steps = 9, options[5].linear_steps = 23;
+  int bracketed = 0, refined = 0, compared = 0;
+  for (std::size_t oi = 0; oi < options.size(); ++oi) {
+    const DistanceSearchOptions& o = options[oi];
+    for (std::size_t i = 0; i + 8 <= dirs.size(); i += 8) {
+      const float reach = 0.1f + 3.0f * float(i % 7) / 6.0f;
+      const glm::vec3 x = f.map.centre + reach * dirs[(i * 31 + 7) % dirs.size()];
+      const int count = 1 + int(i / 8) % 8;
+      for (const glm::vec3 origin : {x, f.map.centre}) {
+        DistanceSearchResult lanes[8];
+        search_distance_map8(f.map, origin, &dirs[i], count, o, lanes);
+        for (int j = 0; j < count; ++j) {
+          const DistanceSearchResult alone = search_distance_map(f.map, origin, dirs[i + j], o);
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(lanes[j].d), std::bit_cast<std::uint32_t>(alone.d)) << oi << " " << i << " " << j;
+          ASSERT_EQ(lanes[j].direction, alone.direction) << oi << " " << i << " " << j;
+          ASSERT_EQ(lanes[j].bracketed, alone.bracketed) << oi << " " << i << " " << j;
+          ASSERT_EQ(lanes[j].lookups, alone.lookups) << oi << " " << i << " " << j;
+          bracketed += alone.bracketed;
+          refined += alone.bracketed && o.secant && alone.lookups > 2;
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_GT(bracketed, compared / 5);  // from the centre and without the march: no bracket
+  EXPECT_GT(refined, compared / 6);
+}
+
 // The sub-lobe axes a glossy search keeps for the last exponent: whatever exponents came
 // before, the axes of each are those computed afresh.
 TEST(DistanceMapSearch, SubLobeAxesAreThoseOfTheExponentAsked) {
