@@ -63,6 +63,28 @@ constexpr float kTexelsPerSampleStep = 4.0f;
 // Half-power angle of a Phong lobe of exponent n (cos^n θ = 1/2, small-angle form).
 float lobe_half_power_angle(float n) { return std::sqrt(2.0f * 0.69314718f / std::max(n, 1e-6f)); }
 
+// The texel angle a glossy lobe of exponent n needs: a quarter of the half-power angle of
+// distance-map's sharpest read of it, the sub-lobe of exponent 4n (distance_map_reflect.cpp),
+// keeps every read at level 2 or above (prefiltered, as with the full-size map).
+float glossy_need(float n) { return 0.25f * lobe_half_power_angle(4.0f * n); }
+
+// MapSizing::from_lobes: a glossy map's texel angle is at most this share of the half-power
+// angle of its sharpest read (the sub-lobe of exponent 4n). A quarter, as glossy_need, halved
+// living-room's floor map (n ≈ 131) and its frame error grew (matrix at 160×120, distance-map
+// 19.23 → 19.32 mae8); at this share the floor keeps 256² and only the wider lobes shrink
+// (the vase, n ≈ 47, to 128²), with no error grown.
+constexpr float kLobeTexelShare = 0.15f;
+
+constexpr float kTexelAngleTimesSize = 0.5f * kPi;  // texel angle of a side-s face: (π/2)/s
+
+// The smallest power-of-two side (at least kMinFootprintSize, at most `size`) whose texel
+// angle is at most `need`.
+int side_for_need(float need, int size) {
+  int side = kMinFootprintSize;
+  while (side < size && !(kTexelAngleTimesSize / static_cast<float>(side) <= need)) side *= 2;
+  return std::min(side, size);
+}
+
 // The coarsest texel angle camera sample i can use without losing what the frame shows,
 // or NaN when i reads no map or has no neighbour on its object. Samples sit one pixel
 // apart; their reflected directions R differ by δ (the chord, at most the angle), and a
@@ -93,7 +115,7 @@ float sample_need(const GBuffer& g, std::size_t i) {
   if (!std::isfinite(delta)) return nan;
   float need = delta / kTexelsPerSampleStep;
   if (!s.is_mirror_lobe() && s.phong_exponent > 0.0f && s.phong_exponent < 1e6f)
-    need = std::max(need, 0.25f * lobe_half_power_angle(4.0f * s.phong_exponent));
+    need = std::max(need, glossy_need(s.phong_exponent));
   return need;
 }
 
@@ -408,7 +430,6 @@ std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, co
     if (s.is_refractor()) per_object[o].push_back(0.0f);
     else if (!std::isnan(need[i])) per_object[o].push_back(need[i]);
   }
-  constexpr float kTexelAngleTimesSize = 0.5f * kPi;  // texel angle of a side-s face: (π/2)/s
   for (std::size_t o = 0; o < per_object.size(); ++o) {
     if (!seen[o]) continue;
     std::vector<float>& v = per_object[o];
@@ -418,10 +439,7 @@ std::vector<int> footprint_sizes(par::Executor& executor, const Scene& scene, co
     }
     const std::size_t k = static_cast<std::size_t>(kFootprintQuantile * double(v.size() - 1));
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-    const float q = v[k];
-    int side = kMinFootprintSize;
-    while (side < size && !(kTexelAngleTimesSize / static_cast<float>(side) <= q)) side *= 2;
-    sizes[o] = std::min(side, size);
+    sizes[o] = side_for_need(v[k], size);
   }
   return sizes;
 }
@@ -463,11 +481,18 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
   struct MaterialReads {
     bool specular = false, refracts = false;
     float lobe = 1e6f;  // the Phong exponent a map is read with
+    int lobe_side = 0;  // MapSizing::from_lobes: the side its sharpest read needs
   };
   std::vector<MaterialReads> reads(scene.materials.size());
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const SurfaceParams s = surface_params(scene.materials[i]);
-    if (is_specular(s)) reads[i] = {true, s.is_refractor(), map_lookup_exponent(scene.materials[i], s)};
+    if (!is_specular(s)) continue;
+    // A mirror lobe, a refractor or a roughness texture (any lobe, down to a mirror's) need
+    // the full side.
+    const bool glossy = !s.is_refractor() && !s.is_mirror_lobe() && s.phong_exponent > 0.0f &&
+                        s.phong_exponent < 1e6f && !scene.materials[i].metallic_roughness_texture.valid();
+    reads[i] = {true, s.is_refractor(), map_lookup_exponent(scene.materials[i], s),
+                glossy ? side_for_need(kLobeTexelShare * lobe_half_power_angle(4.0f * s.phong_exponent), size) : size};
   }
   CubeMapScratch scratch;  // shared by the maps (each face rewrites it)
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
@@ -475,6 +500,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     if (skip && o < skip->size() && (*skip)[o]) continue;
     bool specular = false, refracts = false;
     float widest_lobe = 1e6f;  // smallest Phong exponent the map is read with
+    int lobe_side = 0;         // the side the sharpest read needs (MapSizing::from_lobes)
     Bounds b;
     for (std::uint32_t t = object.first_triangle; t < object.first_triangle + object.triangle_count;
          ++t) {
@@ -483,6 +509,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
         specular = true;
         refracts = refracts || r.refracts;
         widest_lobe = std::min(widest_lobe, r.lobe);
+        lobe_side = std::max(lobe_side, r.lobe_side);
       }
       for (int k = 0; k < 3; ++k) b.grow(m.positions[m.indices[3 * t + k]]);
     }
@@ -493,6 +520,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     int side = size;
     if (!seen_by_camera.empty() && !seen_by_camera[o]) continue;
     if (!sizes.empty() && sizes[o] > 0) side = sizes[o];
+    if (sizing.from_lobes) side = std::min(side, lobe_side);
     glm::vec3 centre = b.center();
     const glm::vec3 e = b.extent();
     const float smallest = std::min({e.x, e.y, e.z}), largest = std::max({e.x, e.y, e.z});

@@ -68,6 +68,13 @@ struct MapSizing {
   // bound (at 160×120 the mirror ball of sphere-in-room: exact specular mae8 4.76 → 7.11). Refractors
   // keep `size` (a lens magnifies what lies behind it beyond the rate of its first refraction).
   bool from_footprint = false;
+  // A reflector whose specular materials are all glossy lobes gets the side its sharpest
+  // lobe needs: texels under 0.15 of the half-power angle of its sharpest read (kLobeTexelShare
+  // in reflector_maps.cpp), from the materials alone, so it holds for every reader of the map
+  // (each a sample of the reflector itself reading through its lobe) and for searches too,
+  // whose hits the lobe blurs as much as their colour. Mirrors, refractors and roughness
+  // textures keep `size`.
+  bool from_lobes = false;
   // Reflectors with no camera sample get no map: nothing would read it.
   bool skip_unseen = false;
   // How the camera's samples read a reflector's map; unless `anywhere`, faces that no read
@@ -95,9 +102,12 @@ struct MapSizing {
 // read): their distances alone, on every face (bounding the faces searches reach costs more
 // than rendering the few it leaves out), each face's visibility kept. `skip_unseen`: no map
 // for a reflector the camera does not see (when only the camera's samples search them).
-inline MapSizing searched_distance_maps(bool skip_unseen) {
+// `from_lobes`: glossy reflectors' maps sized by their lobes (when only samples of the
+// reflector itself search its map, through its lobe; not a photon's search).
+inline MapSizing searched_distance_maps(bool skip_unseen, bool from_lobes) {
   MapSizing m;
   m.skip_unseen = skip_unseen;
+  m.from_lobes = from_lobes;
   m.colour_read = false;
   m.keep_visibility = true;
   return m;
@@ -218,6 +228,7 @@ struct ReflectorCubeMapsPass {
     p.set("size", size);
     p.set("reflectors", to_string(which));
     p.set("footprint_size", sizing.from_footprint ? 1 : 0);
+    p.set("lobe_size", sizing.from_lobes ? 1 : 0);
     p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
     if (!sizing.colour_read) p.set("colour", "none (distances only)");
     p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all"

@@ -675,7 +675,7 @@ TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
   };
   const ReflectorMaps whole = render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, gather);
   const ReflectorMaps distances =
-      render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false));
+      render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false, false));
   const DistanceSearchOptions search;
   const DistanceSearches found = distance_map_search(ex, g, distances, search);
   const ReflectorMaps lit = shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, caustics, 0.05f);

@@ -146,7 +146,7 @@ TEST(MultiReflection, RoundsShadedWhereReadGiveTheBytesOfWholeRounds) {
     const GBuffer g = resolve_gbuffer(ex, s, render_visibility(ex, s, cam, 96, 72), cam.eye);
     const DistanceSearchOptions search;
     const ReflectorMaps distances =
-        render_reflector_maps(ex, s, shadows, env, 32, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false));
+        render_reflector_maps(ex, s, shadows, env, 32, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false, false));
     const DistanceSearches camera = distance_map_search(ex, g, distances, search);
     for (int rounds = 1; rounds <= 3; ++rounds) {
       SCOPED_TRACE(std::string(name) + ", rounds " + std::to_string(rounds));

@@ -316,7 +316,7 @@ TEST(PlanarMirror, CurvedMapsShadedWhereTheViewsSearchChangeNoSample) {
     PlanarMirrorStats whole_stats;
     const ImageRGBA expected = planar_mirror_reflect(ex, s, mirrors, g, c, shadows, env, &whole, settings, &whole_stats);
     const ReflectorMaps distances = render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::not_planar_mirrors,
-                                                          {}, nullptr, searched_distance_maps(false));
+                                                          {}, nullptr, searched_distance_maps(false, false));
     const PlanarMirrorViews views = planar_mirror_views(ex, s, mirrors, g, c, shadows, env, &distances, settings);
     EXPECT_GT(views.stats.mirrored_views, 0u);
     EXPECT_EQ(views.stats.mirrored_views, whole_stats.mirrored_views);

@@ -186,7 +186,7 @@ TEST(ReflectorMaps, ColourShadedWhereSearchesReadChangesNoSample) {
           render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g, ReflectorSelection::all, {}, nullptr, searched);
       const ReflectorMaps distances = render_reflector_maps(ex, v.scene, v.shadows, v.env, size, &v.g,
                                                             ReflectorSelection::all, {}, nullptr,
-                                                            searched_distance_maps(true));
+                                                            searched_distance_maps(true, false));
       DistanceReflectStats one_pass;
       const ImageRGBA expected = distance_map_reflect(ex, v.g, v.env, whole, search, &one_pass);
       const DistanceSearches found = distance_map_search(ex, v.g, distances, search);
@@ -250,6 +250,48 @@ TEST(ReflectorMaps, FootprintSizesArePowersOfTwoThatGrowWithTheView) {
     EXPECT_LE(a[o], b[o]) << o;
   }
   EXPECT_GT(sized, 0);
+}
+
+// Lobe sizes (MapSizing::from_lobes): a map whose reflector reflects through glossy lobes
+// alone is the smallest power of two (at least kMinFootprintSize) whose texel angle (π/2)/side
+// is at most 0.15 of the half-power angle of its sharpest read, the sub-lobe of exponent 4n:
+// living-room's vase halves, its mirrors, refractor and the floor keep the cap; the sizes do
+// not depend on the view.
+TEST(ReflectorMaps, LobeSizesFollowTheSharpestGlossyLobe) {
+  par::Executor ex(2);
+  const View v = view_of("living-room", 96, 72, ex);
+  const View other = view_of("living-room", 64, 48, ex);
+  const ReflectorMaps capped = render_reflector_maps(ex, v.scene, v.shadows, v.env, 256, &v.g, ReflectorSelection::all,
+                                                     {}, nullptr, searched_distance_maps(false, false));
+  const ReflectorMaps sized = render_reflector_maps(ex, v.scene, v.shadows, v.env, 256, &v.g, ReflectorSelection::all,
+                                                    {}, nullptr, searched_distance_maps(false, true));
+  const ReflectorMaps sized_other = render_reflector_maps(ex, other.scene, other.shadows, other.env, 256, &other.g,
+                                                          ReflectorSelection::all, {}, nullptr,
+                                                          searched_distance_maps(false, true));
+  ASSERT_EQ(sized.cubes.size(), capped.cubes.size());
+  int smaller = 0;
+  for (std::size_t o = 0; o < v.scene.objects.size(); ++o) {
+    const int m = sized.map_of_object[o];
+    if (m < 0) continue;
+    SCOPED_TRACE(v.scene.objects[o].name);
+    const int side = sized.cubes[m].size;
+    EXPECT_EQ(side, sized_other.cubes[sized_other.map_of_object[o]].size);
+    EXPECT_EQ(capped.cubes[capped.map_of_object[o]].size, 256);
+    const Object& obj = v.scene.objects[o];
+    const SurfaceParams s = surface_params(v.scene.materials[v.scene.mesh.triangle_material[obj.first_triangle]]);
+    const bool glossy = !s.is_refractor() && !s.is_mirror_lobe() && s.phong_exponent < 1e6f;
+    if (!glossy) {
+      EXPECT_EQ(side, 256);
+      continue;
+    }
+    const float need = 0.15f * std::sqrt(2.0f * 0.69314718f / (4.0f * s.phong_exponent));
+    const auto angle = [](int n) { return 0.5f * kPi / float(n); };
+    EXPECT_TRUE(std::has_single_bit(unsigned(side)));
+    if (side < 256) EXPECT_LE(angle(side), need);
+    if (side > kMinFootprintSize) EXPECT_GT(angle(side / 2), need);
+    smaller += side < 256;
+  }
+  EXPECT_EQ(smaller, 1);  // the vase
 }
 
 }  // namespace
