@@ -1,6 +1,7 @@
 // The `distance_map_reflect` node: see distance_map_reflect.h.
 #include "raster/distance_map_reflect.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -84,6 +85,14 @@ void search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, const 
   }
 }
 
+// The colour the searches found along directions[0..count), read through lobes of exponent
+// e: eight lookups at once (radiance8, the bits of one at a time).
+void read_colour(const EnvironmentMap& map, const glm::vec3* directions, int count, float e, glm::vec3* radiance) {
+  float exponents[kLobeBatch];
+  std::fill(exponents, exponents + count, e);
+  map.radiance8(directions, exponents, count, radiance);
+}
+
 // Chunks' counts summed in chunk order.
 void add_stats(DistanceReflectStats& to, const std::vector<DistanceReflectStats>& per_chunk) {
   for (const DistanceReflectStats& c : per_chunk) to += c;
@@ -139,7 +148,7 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
                                [&](const glm::vec3* dk, int count, float e, glm::vec3* radiance) {
           glm::vec3 found[kLobeBatch];
           search_counted(maps, m, x, dk, count, options, st, found);
-          for (int j = 0; j < count; ++j) radiance[j] = maps.maps[m].radiance(found[j], e);
+          read_colour(maps.maps[m], found, count, e, radiance);
         });
       };
       const std::uint64_t missed_before = st.missed;
@@ -214,7 +223,8 @@ ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const E
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         if (m < 0) return env.radiance(d, exponent);
         return searched_lookup(n, d, exponent, axes, [&](const glm::vec3*, int count, float e, glm::vec3* radiance) {
-          for (int j = 0; j < count; ++j) radiance[j] = maps.maps[m].radiance(found[next++], e);
+          read_colour(maps.maps[m], &found[next], count, e, radiance);
+          next += static_cast<std::size_t>(count);
         });
       };
       out.pixels[i] = glm::vec4(specular_radiance(s, n, g.view_direction(i), lookup), 1.0f);

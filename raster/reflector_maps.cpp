@@ -2,6 +2,7 @@
 #include "raster/reflector_maps.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -617,6 +618,27 @@ double rendered_texels(const ReflectorMaps& maps) {
 void count_maps(par::NodeContext& c, const ReflectorMaps& maps) {
   c.count("cube_maps", maps.cubes.size());
   c.count("cube_texels", rendered_texels(maps));
+}
+
+void map_parameters(par::Params& p, int size, ReflectorSelection which, const MapSizing& sizing) {
+  p.set("size", size);
+  p.set("reflectors", to_string(which));
+  p.set("footprint_size", sizing.from_footprint ? 1 : 0);
+  p.set("lobe_size", sizing.from_lobes ? 1 : 0);
+  p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
+  if (!sizing.colour_read) p.set("colour", "none (distances only)");
+  p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all"
+                 : sizing.reads == MapSizing::Reads::direction ? "read along R" : "read by searches");
+}
+
+ReflectorMaps ReflectorDistanceMapsPass::operator()(par::NodeContext& c, const GBuffer& gbuffer) const {
+  if (sizing.colour_read) throw std::logic_error("reflector_distance_maps: a sizing that shades colour needs the lights");
+  const ShadowMaps unlit;
+  const EnvironmentMap no_environment;
+  ReflectorMaps maps = render_reflector_maps(c.executor(), *scene, unlit, no_environment, size, &gbuffer, which, {},
+                                             nullptr, sizing);
+  count_maps(c, maps);
+  return maps;
 }
 
 ReflectorMaps ReflectorCubeMapsPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,

@@ -216,6 +216,9 @@ double rendered_texels(const ReflectorMaps& maps);
 void count_maps(par::NodeContext& c, const ReflectorMaps& maps);
 
 // Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
+// The parameters a maps pass shows (`inspect`, profiles).
+void map_parameters(par::Params& p, int size, ReflectorSelection which, const MapSizing& sizing);
+
 struct ReflectorCubeMapsPass {
   static constexpr const char* description =
       "Per specular object a colour + distance cube map at its reference point, the object "
@@ -224,18 +227,26 @@ struct ReflectorCubeMapsPass {
   int size = 256;
   ReflectorSelection which = ReflectorSelection::all;
   MapSizing sizing;
-  void parameters(par::Params& p) const {
-    p.set("size", size);
-    p.set("reflectors", to_string(which));
-    p.set("footprint_size", sizing.from_footprint ? 1 : 0);
-    p.set("lobe_size", sizing.from_lobes ? 1 : 0);
-    p.set("skip_unseen", sizing.skip_unseen ? 1 : 0);
-    if (!sizing.colour_read) p.set("colour", "none (distances only)");
-    p.set("faces", sizing.reads == MapSizing::Reads::anywhere ? "all"
-                   : sizing.reads == MapSizing::Reads::direction ? "read along R" : "read by searches");
-  }
+  void parameters(par::Params& p) const { map_parameters(p, size, which, sizing); }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows,
                            const EnvironmentMap& environment, const GBuffer& gbuffer) const;
+};
+
+// Pass "reflector_distance_maps": the maps of ReflectorCubeMapsPass with their distances
+// alone (searched_distance_maps: no colour, each face's visibility kept for the colour pass
+// after the searches). Nothing in them is lit, so the pass reads neither the shadow maps nor
+// the environment and runs beside the shadow pass. Throws std::logic_error for a sizing that
+// shades colour.
+struct ReflectorDistanceMapsPass {
+  static constexpr const char* description =
+      "Per specular object the distances of its cube map at its reference point, the object itself "
+      "left out, each face's visibility kept for shading its colour later (SURVEY §4.1, §4.2).";
+  const Scene* scene = nullptr;
+  int size = 256;
+  ReflectorSelection which = ReflectorSelection::all;
+  MapSizing sizing;
+  void parameters(par::Params& p) const { map_parameters(p, size, which, sizing); }
+  ReflectorMaps operator()(par::NodeContext& c, const GBuffer& gbuffer) const;
 };
 
 // Pass "reflector_cube_maps" after the searches: the colour of maps rendered with

@@ -24,8 +24,8 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   // The photons search these maps' distances only, and so do the camera's searches; what
   // reflections read is the lit maps' colour below, shaded where those searches read it.
   auto maps = g.add("reflector_cube_maps",
-                    ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(false, false)},
-                    s.shadow_maps, s.environment, s.gbuffer)
+                    ReflectorDistanceMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(false, false)},
+                    s.gbuffer)
                   .describe("Distance cube map around each specular object, itself left out: what the "
                             "photons leaving a generator search (SURVEY §4.1, §6.1).");
   auto impostors = g.add("refractor_impostors",

@@ -25,8 +25,8 @@ FrameOutputs add_distance_map_passes(par::Graph& g, const Scene* scene, const Fr
   const DistanceSearchOptions search = distance_search_options(f);
   // The maps' distances first; their colour only where the searches turn out to read it.
   auto distances = g.add("reflector_distance_maps",
-                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(true, true)},
-                         s.shadow_maps, s.environment, s.gbuffer);
+                         ReflectorDistanceMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(true, true)},
+                         s.gbuffer);
   auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, distances);
   auto maps = g.add("reflector_cube_maps", ReflectorColourPass<DistanceSearches>{scene}, s.shadow_maps, s.environment, distances, searches);
   auto specular = g.add("distance_map_reflect", DistanceMapLookupPass{search}, s.gbuffer, s.environment, maps, searches);

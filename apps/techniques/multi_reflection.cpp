@@ -27,8 +27,8 @@ FrameOutputs add_multi_reflection_passes(par::Graph& g, const Scene* scene, cons
   // where the next round's searches (or the camera's) read it; the camera's reads.
   // Reflectors the camera does not see are seen in other maps: every one gets a map.
   auto distances = g.add("reflector_distance_maps",
-                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(false, false)},
-                         s.shadow_maps, s.environment, s.gbuffer);
+                         ReflectorDistanceMapsPass{scene, f.cube_map_size, ReflectorSelection::all, searched_distance_maps(false, false)},
+                         s.gbuffer);
   auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, distances);
   auto maps = g.add("multi_reflection_maps", MultiReflectionWhereReadPass{scene, rounds, search}, s.shadow_maps,
                     s.environment, distances, searches);

@@ -20,9 +20,9 @@ FrameOutputs add_planar_mirror_passes(par::Graph& g, const Scene* scene, const F
   // their distances first, their colour only where the searches of all views read it.
   // (Reflectors the camera does not see may be seen in a mirror: every one gets a map.)
   auto distances = g.add("reflector_distance_maps",
-                         ReflectorCubeMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors,
-                                               searched_distance_maps(false, true)},
-                         s.shadow_maps, s.environment, s.gbuffer);
+                         ReflectorDistanceMapsPass{scene, f.cube_map_size, ReflectorSelection::not_planar_mirrors,
+                                                   searched_distance_maps(false, true)},
+                         s.gbuffer);
   auto views = g.add("planar_mirror_views", PlanarMirrorViewsPass{scene, f.camera, static_cast<int>(f.param("depth"))},
                      mirrors, s.gbuffer, s.shadow_maps, s.environment, distances);
   auto curved = g.add("reflector_cube_maps", ReflectorColourPass<PlanarMirrorViews>{scene}, s.shadow_maps,
