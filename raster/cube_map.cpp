@@ -258,18 +258,22 @@ std::array<ImageRGBA, kCubeFaces> shade_cube_faces(par::Executor& executor, cons
     VisibilityBuffer& vis = s.vis;
     vis.width = kept.width, vis.height = kept.height;
     vis.depth = ImageF{};  // not kept: resolving does not read it
-    vis.bary = kept.bary;
     vis.coverage = kept.coverage;
     if (vis.triangle.width != kept.width || vis.triangle.height != kept.height) {
       vis.triangle = IdBuffer(kept.width, kept.height);
       vis.object = IdBuffer(kept.width, kept.height);
     }
+    if (vis.bary.width != kept.width || vis.bary.height != kept.height)
+      vis.bary = Buffer2D<glm::vec2>(kept.width, kept.height);
+    // The planes copied by the kernel's chunks, not serially before it.
     executor.parallel_for("cube_map.read_visibility", kept.triangle.size(), 4096, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const bool r = read.empty() || read[i];
         vis.triangle.pixels[i] = r ? kept.triangle.pixels[i] : kNoId;
         vis.object.pixels[i] = r ? kept.object.pixels[i] : kNoId;
       }
+      std::copy(kept.bary.pixels.begin() + std::ptrdiff_t(begin), kept.bary.pixels.begin() + std::ptrdiff_t(end),
+                vis.bary.pixels.begin() + std::ptrdiff_t(begin));
     });
     colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s.g);
   }
