@@ -205,6 +205,12 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
   CubeMapScratch own;
   CubeMapScratch& s = scratch ? *scratch : own;
   VisibilityBuffer& vis = s.vis;
+  if (s.groups_of != &scene.mesh) {
+    s.groups = triangle_groups(executor, scene.mesh);
+    s.groups_of = &scene.mesh;
+  }
+  RasterOptions raster = options.raster;
+  raster.groups = &s.groups;
   for (int face = 0; face < kCubeFaces; ++face) {
     if (!((options.face_mask >> face) & 1u)) {
       cube.distance[face] = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
@@ -212,7 +218,7 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
       continue;
     }
     const Camera cam = cube_face_camera(face, centre, options.znear, options.zfar);
-    render_visibility(executor, scene, cam, options.size, options.size, options.raster, s.workspace, vis);
+    render_visibility(executor, scene, cam, options.size, options.size, raster, s.workspace, vis);
     // Texels no reader reaches become background: not resolved, not shaded.
     const std::vector<std::uint8_t> read = read_texels(options, face);
     if (!read.empty())

@@ -176,6 +176,10 @@ struct CubeMapScratch {
   RasterWorkspace workspace;
   VisibilityBuffer vis;
   GBuffer g;
+  // The scene's triangle groups, built by the first map rendered with this scratch: a face
+  // sets up only the groups that reach it (a cube face sees about a sixth of the scene).
+  TriangleGroups groups;
+  const TriangleMesh* groups_of = nullptr;
 };
 
 // Renders the six faces: visibility → G-buffer → `shade` (skipped when empty: a

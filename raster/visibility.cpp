@@ -2,6 +2,7 @@
 // tile (see visibility.h). Chunk sizes are constants, never derived from the thread count.
 #include "raster/visibility.h"
 
+#include <algorithm>
 #include <string>
 
 #include "core/camera_rays.h"
@@ -18,6 +19,7 @@ constexpr std::size_t kTriangleChunk = 4096;
 constexpr std::size_t kTileChunk = 64;  // tiles per bin_offsets task
 // Clipping makes at most 7 records of a triangle: a chunk's records must fit a reference.
 static_assert(7 * kTriangleChunk <= std::size_t(1) << kRefIndexBits);
+static_assert(kTriangleChunk % TriangleGroups::kSize == 0, "a setup chunk holds whole triangle groups");
 }  // namespace
 
 namespace {
@@ -35,11 +37,14 @@ int cull_sign(CullMode mode) {
 
 }  // namespace
 
-void rasterize_screen_vertices(par::Executor& executor, const std::vector<ScreenVertex>& vertices,
-                               const std::vector<std::uint32_t>& indices,
-                               const std::vector<std::uint32_t>& triangle_object, int width,
-                               int height, const RasterOptions& options,
-                               TileBins& bins, VisibilityBuffer& out) {
+namespace {
+
+// rasterize_screen_vertices, leaving out the triangle groups flagged in `outside` (null:
+// none; see triangle_groups.h): setup would drop each of their triangles anyway.
+void rasterize(par::Executor& executor, const std::vector<ScreenVertex>& vertices,
+               const std::vector<std::uint32_t>& indices, const std::vector<std::uint32_t>& triangle_object,
+               int width, int height, const RasterOptions& options, const std::vector<std::uint8_t>* outside,
+               TileBins& bins, VisibilityBuffer& out) {
   check_target_size(width, height);
   const int lanes = options.lanes == 0 ? executor.lanes() : options.lanes;
   const Viewport vp{width, height};
@@ -63,9 +68,26 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
         const std::size_t c = begin / kTriangleChunk;
         BinnedChunk& chunk = bins.chunks[c];
         chunk.clip_maps.clear();
-        chunk.count = setup_triangles(vertices.data(), indices.data(), begin, end,
-                                      triangle_object.data(), excluded, vp, cull, 0,
-                                      chunk.triangles, chunk.clip_maps);
+        if (!outside) {
+          chunk.count = setup_triangles(vertices.data(), indices.data(), begin, end, triangle_object.data(),
+                                        excluded, vp, cull, 0, chunk.triangles, chunk.clip_maps);
+        } else {
+          // The runs of groups inside the view, in triangle order: the same records.
+          constexpr std::size_t kGroup = TriangleGroups::kSize;
+          std::size_t n = 0;
+          for (std::size_t run = begin; run < end;) {
+            if ((*outside)[run / kGroup]) {
+              run += kGroup;
+              continue;
+            }
+            std::size_t run_end = run;
+            while (run_end < end && !(*outside)[run_end / kGroup]) run_end = std::min(run_end + kGroup, end);
+            n = setup_triangles(vertices.data(), indices.data(), run, run_end, triangle_object.data(), excluded, vp,
+                                cull, n, chunk.triangles, chunk.clip_maps);
+            run = run_end;
+          }
+          chunk.count = n;
+        }
         count_chunk(bins, c, grid);
       });
   executor.parallel_for("raster.bin_offsets", tiles, kTileChunk,
@@ -90,6 +112,16 @@ void rasterize_screen_vertices(par::Executor& executor, const std::vector<Screen
                           for (std::size_t tile = begin; tile < end; ++tile)
                             rasterize_tile(static_cast<int>(tile), lanes, grid, vp, bins, out);
                         });
+}
+
+}  // namespace
+
+void rasterize_screen_vertices(par::Executor& executor, const std::vector<ScreenVertex>& vertices,
+                               const std::vector<std::uint32_t>& indices,
+                               const std::vector<std::uint32_t>& triangle_object, int width,
+                               int height, const RasterOptions& options,
+                               TileBins& bins, VisibilityBuffer& out) {
+  rasterize(executor, vertices, indices, triangle_object, width, height, options, nullptr, bins, out);
 }
 
 VisibilityBuffer rasterize_screen_vertices(par::Executor& executor,
@@ -121,8 +153,15 @@ void render_visibility(par::Executor& executor, const Scene& scene, const Camera
                           make_screen_vertices(view_projection, &mesh.positions[begin],
                                                end - begin, vp, &vertices[begin]);
                         });
-  rasterize_screen_vertices(executor, vertices, mesh.indices, mesh.triangle_object, width, height,
-                            options, workspace.bins, out);
+  const std::vector<std::uint8_t>* outside = nullptr;
+  if (options.groups) {
+    if (options.groups->triangles != mesh.triangle_count())
+      throw InputError(scene.name, "triangle groups were built from another mesh");
+    groups_outside(*options.groups, view_projection, workspace.outside_groups);
+    outside = &workspace.outside_groups;
+  }
+  rasterize(executor, vertices, mesh.indices, mesh.triangle_object, width, height, options, outside,
+            workspace.bins, out);
 }
 
 VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,

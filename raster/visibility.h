@@ -14,6 +14,7 @@
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
 #include "raster/tile_binning.h"
+#include "raster/triangle_groups.h"
 #include "raster/triangle_setup.h"
 
 namespace speculum::raster {
@@ -30,6 +31,10 @@ struct RasterOptions {
   // Objects to leave out (e.g. the reflector a cube map is rendered around); indexed by
   // object id, empty: none excluded.
   std::vector<std::uint8_t> excluded_objects;
+  // The scene's triangle groups (triangle_groups.h), built by a caller that renders many
+  // views of one scene: render_visibility then sets up no group wholly outside the view. The
+  // same output; null: every triangle is set up.
+  const TriangleGroups* groups = nullptr;
 };
 
 // One entry per sample; samples are the pixels of the (possibly supersampled) target and
@@ -59,6 +64,7 @@ VisibilityBuffer render_visibility(par::Executor& executor, const Scene& scene,
 struct RasterWorkspace {
   std::vector<ScreenVertex> vertices;
   TileBins bins;
+  std::vector<std::uint8_t> outside_groups;  // RasterOptions::groups wholly outside the view
 };
 
 // As above, reusing `workspace` and `out` (resized only when the size changes).

@@ -15,6 +15,8 @@
 
 #include "core/camera_rays.h"
 #include "core/error.h"
+#include "core/scene_loader.h"
+#include "raster/cube_map.h"
 #include "raster_test_scenes.h"
 
 namespace speculum::raster {
@@ -499,6 +501,46 @@ TEST(RasterHierarchicalDepth, RejectionNeverChangesTheResult) {
     opt.lanes = lanes;
     EXPECT_TRUE(same_bits(full, render_visibility(ex, scene, cam, 333, 250, opt))) << lanes;
   }
+}
+
+// Triangle groups wholly outside a view are not set up: the visibility buffer of every cube
+// face around points inside and outside three scenes, and of cameras looking along and
+// across the room, is the same bytes as with every triangle set up, while groups were
+// indeed left out; groups of another mesh are refused.
+TEST(RasterTriangleGroups, LeavingOutGroupsOutsideTheViewChangesNoByte) {
+  par::Executor ex(2);
+  std::size_t views = 0, left_out = 0, groups_total = 0;
+  for (const char* name : {"living-room", "sphere-in-room", "bathroom"}) {
+    SCOPED_TRACE(name);
+    const Scene scene = load_scene(name);
+    const TriangleGroups groups = triangle_groups(ex, scene.mesh);
+    const Bounds b = scene.bounds();
+    std::vector<Camera> cams;
+    for (const glm::vec3 at : {b.center(), b.lo + 0.2f * b.extent(), b.hi + 0.3f * b.extent()})
+      for (int face = 0; face < kCubeFaces; ++face) cams.push_back(cube_face_camera(face, at, 0.01f, 100.0f));
+    cams.push_back(scene.cameras.front());
+    for (const Camera& cam : cams) {
+      RasterOptions all, grouped;
+      grouped.groups = &groups;
+      RasterWorkspace w;
+      VisibilityBuffer a, g;
+      render_visibility(ex, scene, cam, 96, 96, all, w, a);
+      render_visibility(ex, scene, cam, 96, 96, grouped, w, g);
+      for (const std::uint8_t o : w.outside_groups) left_out += o;
+      groups_total += w.outside_groups.size();
+      ++views;
+      ASSERT_EQ(a.triangle.pixels, g.triangle.pixels) << views;
+      ASSERT_EQ(a.object.pixels, g.object.pixels) << views;
+      ASSERT_EQ(0, std::memcmp(a.depth.pixels.data(), g.depth.pixels.data(), a.depth.size() * sizeof(float)));
+      ASSERT_EQ(0, std::memcmp(a.bary.pixels.data(), g.bary.pixels.data(), a.bary.size() * sizeof(glm::vec2)));
+    }
+  }
+  EXPECT_GT(left_out, groups_total / 2) << "a cube face sees a small part of the scene";
+  const Scene other = load_scene("glossy-plane");
+  const TriangleGroups groups = triangle_groups(ex, load_scene("living-room").mesh);
+  RasterOptions wrong;
+  wrong.groups = &groups;
+  EXPECT_THROW(render_visibility(ex, other, other.cameras.front(), 32, 32, wrong), InputError);
 }
 
 TEST(RasterInput, AbsurdSizesAndCamerasThrowInputError) {
