@@ -9,42 +9,64 @@
 namespace speculum::raster {
 namespace {
 
-template <class MapOf, class Takes>
-ImageRGBA reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& map_of, const Takes& takes) {
-  ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
-  executor.parallel_for("envmap_reflect.lookup", out.size(), 4096,
+// Every sample i of `g`: shaded(i, radiance) with the radiance along R (and T) from
+// map_of(object) where takes(surface), else unshaded(i).
+template <class MapOf, class Takes, class Shaded, class Unshaded>
+void reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& map_of, const Takes& takes,
+                  const Shaded& shaded, const Unshaded& unshaded) {
+  executor.parallel_for("envmap_reflect.lookup", g.object.size(), 4096,
                         [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      if (!g.covered(i)) continue;
+      if (!g.covered(i) || !takes(g.surface[i])) {
+        unshaded(i);
+        continue;
+      }
       const SurfaceParams& s = g.surface[i];
-      if (!takes(s)) continue;
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return map_of(g.object.pixels[i]).radiance(d, exponent);
       };
-      const glm::vec3 radiance =
-          specular_radiance(s, g.normal.pixels[i], g.view_direction(i), lookup);
-      out.pixels[i] = glm::vec4(radiance, 1.0f);
+      shaded(i, specular_radiance(s, g.normal.pixels[i], g.view_direction(i), lookup));
     }
   });
+}
+
+template <class MapOf, class Takes>
+ImageRGBA reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& map_of, const Takes& takes) {
+  ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  reflect_with(
+      executor, g, map_of, takes, [&](std::size_t i, const glm::vec3& radiance) { out.pixels[i] = glm::vec4(radiance, 1.0f); },
+      [](std::size_t) {});
   return out;
+}
+
+// Each sample's map, or the environment.
+auto own_map_or(const EnvironmentMap& env, const ReflectorMaps* reflectors) {
+  return [&env, reflectors](std::uint32_t object) -> const EnvironmentMap& {
+    const EnvironmentMap* own = reflectors ? reflectors->for_object(object) : nullptr;
+    return own ? *own : env;
+  };
 }
 
 }  // namespace
 
 ImageRGBA envmap_reflect(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
                          const ReflectorMaps* reflectors) {
-  return reflect_with(executor, g, [&](std::uint32_t object) -> const EnvironmentMap& {
-    const EnvironmentMap* own = reflectors ? reflectors->for_object(object) : nullptr;
-    return own ? *own : env;
-  }, [](const SurfaceParams& s) { return is_specular(s); });
+  return reflect_with(executor, g, own_map_or(env, reflectors), [](const SurfaceParams& s) { return is_specular(s); });
+}
+
+void envmap_reflect_onto(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env, ImageRGBA& direct) {
+  // composite's sum, direct + specular with the specular layer 0 where nothing is reflected.
+  reflect_with(
+      executor, g, own_map_or(env, nullptr), [](const SurfaceParams& s) { return is_specular(s); },
+      [&](std::size_t i, const glm::vec3& radiance) {
+        direct.pixels[i] = glm::vec4(glm::vec3(direct.pixels[i]) + radiance, 1.0f);
+      },
+      [&](std::size_t i) { direct.pixels[i] = glm::vec4(glm::vec3(direct.pixels[i]) + glm::vec3(0.0f), 1.0f); });
 }
 
 ImageRGBA refractor_environment(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
                                 const ReflectorMaps* refractors) {
-  return reflect_with(executor, g, [&](std::uint32_t object) -> const EnvironmentMap& {
-    const EnvironmentMap* own = refractors ? refractors->for_object(object) : nullptr;
-    return own ? *own : env;
-  }, [](const SurfaceParams& s) { return s.is_refractor(); });
+  return reflect_with(executor, g, own_map_or(env, refractors), [](const SurfaceParams& s) { return s.is_refractor(); });
 }
 
 ImageRGBA RefractorEnvironmentPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,

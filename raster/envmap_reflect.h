@@ -18,6 +18,9 @@ namespace speculum::raster {
 // that map, any other the environment.
 ImageRGBA envmap_reflect(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
                          const ReflectorMaps* reflectors = nullptr);
+// composite(direct, envmap_reflect(g, env)) written over `direct` (the same bytes, without
+// the specular layer's image): the cube faces' shading.
+void envmap_reflect_onto(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env, ImageRGBA& direct);
 
 // Pass "envmap_reflect": the specular layer from the reflectors' cube maps or the environment.
 struct EnvmapReflectPass {

@@ -248,7 +248,8 @@ CubeFaceShader reflector_face_shader(par::Executor& executor, const Scene& scene
       kept->specular[face] = specular_texels(g, kept->specular_texel[face]);
       kept->direct[face] = direct;
     }
-    return composite(executor, direct, envmap_reflect(executor, g, env));
+    envmap_reflect_onto(executor, g, env, direct);
+    return direct;
   };
 }
 

@@ -15,6 +15,7 @@
 #include "apps/techniques/technique_table.h"
 #include "core/optics.h"
 #include "core/scene_loader.h"
+#include "raster/composite.h"
 #include "raster_test_scenes.h"
 
 namespace speculum::raster {
@@ -102,6 +103,33 @@ ImageRGBA render_envmap(const Scene& scene, int threads, int lanes) {
   graph.request(out.radiance);
   graph.run(ex);
   return graph.get(out.radiance);
+}
+
+// The cube faces' shading adds the specular layer onto the direct light in place: the bytes
+// of composite(direct, envmap_reflect(...)), on views with mirrors, glossy and refracting
+// samples, background, and a direct layer holding negative zeros.
+TEST(EnvmapReflect, OntoDirectGivesTheBytesOfTheComposite) {
+  par::Executor ex(2);
+  for (const char* name : {"living-room", "glass-sphere", "sphere-in-room"}) {
+    SCOPED_TRACE(name);
+    const Scene scene = load_scene(name);
+    const Camera cam = scene.cameras.front();
+    const GBuffer g = resolve_gbuffer(ex, scene, render_visibility(ex, scene, cam, 120, 90), cam.eye);
+    const EnvironmentMap env = build_environment(ex, scene.environment);
+    ImageRGBA direct(g.width, g.height);
+    std::size_t specular = 0;
+    for (std::size_t i = 0; i < direct.pixels.size(); ++i) {
+      const float v = float(i % 7) * 0.1f;
+      direct.pixels[i] = glm::vec4(i % 5 == 0 ? -0.0f : v, 0.5f * v, 0.25f, i % 3 == 0 ? 0.5f : 1.0f);
+      specular += g.covered(i) && is_specular(g.surface[i]);
+    }
+    EXPECT_GT(specular, 100u);
+    const ImageRGBA expected = composite(ex, direct, envmap_reflect(ex, g, env));
+    ImageRGBA onto = direct;
+    envmap_reflect_onto(ex, g, env, onto);
+    ASSERT_EQ(expected.pixels.size(), onto.pixels.size());
+    EXPECT_EQ(0, std::memcmp(expected.pixels.data(), onto.pixels.data(), expected.pixels.size() * sizeof(glm::vec4)));
+  }
 }
 
 TEST(EnvmapPipeline, BitIdenticalForThreadsAndLanes) {
