@@ -2,18 +2,17 @@
 #include "raster/reflector_maps.h"
 
 #include <algorithm>
-#include <stdexcept>
 #include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <glm/geometric.hpp>
 
 #include "core/optics.h"
 #include "core/sampling.h"
 
-#include "raster/composite.h"
 #include "raster/direct_light.h"
 #include "raster/envmap_reflect.h"
 #include "raster/planar_mirror.h"

@@ -215,10 +215,10 @@ double rendered_texels(const ReflectorMaps& maps);
 // A maps node's counters: cube_maps, and cube_texels (rendered_texels).
 void count_maps(par::NodeContext& c, const ReflectorMaps& maps);
 
-// Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 // The parameters a maps pass shows (`inspect`, profiles).
 void map_parameters(par::Params& p, int size, ReflectorSelection which, const MapSizing& sizing);
 
+// Pass "reflector_cube_maps": render_reflector_maps with the camera's G-buffer.
 struct ReflectorCubeMapsPass {
   static constexpr const char* description =
       "Per specular object a colour + distance cube map at its reference point, the object "
