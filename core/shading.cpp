@@ -27,8 +27,15 @@ SurfaceParams surface_params(const Material& m) {
 }
 
 int repeat_index(long long i, int n) {
-  // Most lookups land inside the image: no 64-bit division for those (the same index).
+  // Most lookups land inside the image or on a power-of-two side (a repeating texture's
+  // usual size, where two's complement makes the mask the positive remainder): no division
+  // for those, and a 32-bit one while i fits (the same index every way).
   if (i >= 0 && i < n) return static_cast<int>(i);
+  if ((n & (n - 1)) == 0) return static_cast<int>(i & static_cast<long long>(n - 1));
+  if (i >= std::numeric_limits<int>::min() && i <= std::numeric_limits<int>::max()) {
+    const int r = static_cast<int>(i) % n;
+    return r < 0 ? r + n : r;
+  }
   const long long r = i % n;
   return static_cast<int>(r < 0 ? r + n : r);
 }
@@ -41,8 +48,9 @@ glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   const float ax = fx - x0f, ay = fy - y0f;
   const long long x0 = static_cast<long long>(x0f), y0 = static_cast<long long>(y0f);
-  const int xa = repeat_index(x0, image.width), xb = repeat_index(x0 + 1, image.width);
-  const int ya = repeat_index(y0, image.height), yb = repeat_index(y0 + 1, image.height);
+  // The next texel wraps from the first: repeat_index(x0 + 1) without a second remainder.
+  const int xa = repeat_index(x0, image.width), xb = xa + 1 < image.width ? xa + 1 : 0;
+  const int ya = repeat_index(y0, image.height), yb = ya + 1 < image.height ? ya + 1 : 0;
   const glm::vec4 top = image.at(xa, ya) * (1.0f - ax) + image.at(xb, ya) * ax;
   const glm::vec4 bottom = image.at(xa, yb) * (1.0f - ax) + image.at(xb, yb) * ax;
   return top * (1.0f - ay) + bottom * ay;
