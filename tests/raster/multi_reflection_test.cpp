@@ -157,7 +157,9 @@ TEST(MultiReflection, RoundsShadedWhereReadGiveTheBytesOfWholeRounds) {
       EXPECT_TRUE(same_bytes(distance_map_reflect(ex, g, env, whole, search),
                              distance_map_lookup(ex, g, env, where_read, camera, search)));
       EXPECT_LT(rendered_texels(where_read), 6.0 * 32 * 32 * double(where_read.cubes.size()));
-      if (rounds > 1) EXPECT_LE(read_stats.searches, whole_stats.searches);
+      if (rounds > 1) {
+        EXPECT_LE(read_stats.searches, whole_stats.searches);
+      }
     }
   }
 }

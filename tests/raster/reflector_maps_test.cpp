@@ -197,7 +197,9 @@ TEST(ReflectorMaps, ColourShadedWhereSearchesReadChangesNoSample) {
       EXPECT_LE(rendered_texels(shaded), rendered_texels(whole));
       // The mirror ball's map, read at single texels (though nearly all around: the rest of
       // the room is in it), keeps under 70 % of its texels.
-      if (std::string(name) == "sphere-in-room") EXPECT_LT(rendered_texels(shaded), 0.7 * rendered_texels(whole));
+      if (std::string(name) == "sphere-in-room") {
+        EXPECT_LT(rendered_texels(shaded), 0.7 * rendered_texels(whole));
+      }
     }
   }
 }
@@ -287,8 +289,12 @@ TEST(ReflectorMaps, LobeSizesFollowTheSharpestGlossyLobe) {
     const float need = 0.15f * std::sqrt(2.0f * 0.69314718f / (4.0f * s.phong_exponent));
     const auto angle = [](int n) { return 0.5f * kPi / float(n); };
     EXPECT_TRUE(std::has_single_bit(unsigned(side)));
-    if (side < 256) EXPECT_LE(angle(side), need);
-    if (side > kMinFootprintSize) EXPECT_GT(angle(side / 2), need);
+    if (side < 256) {
+      EXPECT_LE(angle(side), need);
+    }
+    if (side > kMinFootprintSize) {
+      EXPECT_GT(angle(side / 2), need);
+    }
     smaller += side < 256;
   }
   EXPECT_EQ(smaller, 1);  // the vase
