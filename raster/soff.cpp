@@ -3,7 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -387,13 +387,14 @@ bool box_outside(const FrustumPlanes& f, const Bounds& b) {
 struct CullGroup {
   std::uint32_t first = 0, count = 0, object = 0;
   Bounds box;
+  std::uint32_t vertex_first = 0, vertex_last = 0;  // the range of vertex ids its triangles use
 };
 
 // What one depth image's rendering reuses from the one before it.
 struct DepthImageScratch {
   std::vector<std::uint32_t> kept, indices, objects;
-  std::vector<glm::vec3> positions;
-  std::vector<ScreenVertex> vertices;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> vertex_ranges;  // [first, last] of the kept groups
+  std::vector<ScreenVertex> vertices;  // by mesh vertex id; only the kept groups' ranges are written
   TileBins bins;
   VisibilityBuffer vis;
   GBuffer gb;
@@ -414,6 +415,7 @@ DepthImageCounts render_depth_image(par::Executor& executor, const Scene& scene,
   // and the cluster's own reflector is left out (first-order: SOFF §4.4).
   const FrustumPlanes planes = frustum_planes(cam);
   s.kept.clear();
+  s.vertex_ranges.clear();
   for (const CullGroup& grp : groups) {
     if (grp.object == reflector) continue;
     if (box_outside(planes, grp.box)) {
@@ -421,26 +423,38 @@ DepthImageCounts render_depth_image(par::Executor& executor, const Scene& scene,
       continue;
     }
     for (std::uint32_t t = grp.first; t < grp.first + grp.count; ++t) s.kept.push_back(t);
+    s.vertex_ranges.emplace_back(grp.vertex_first, grp.vertex_last);
   }
   counts.set_up = s.kept.size();
-  // Three vertices per kept triangle (shared vertices snap identically: make_screen_vertex
-  // is a pure function, so the mesh stays watertight).
-  s.positions.resize(3 * s.kept.size());
-  s.vertices.resize(3 * s.kept.size());
-  s.objects.resize(s.kept.size());
-  // 0, 1, 2, ... one index per kept vertex (grown by iota, so the kept prefix stays).
-  const std::size_t had = s.indices.size();
+  // The kept groups' vertices, each transformed once (about a sixth of three per kept
+  // triangle), in disjoint ranges: the ranges sorted and merged where they touch.
+  std::sort(s.vertex_ranges.begin(), s.vertex_ranges.end());
+  std::size_t merged = 0;
+  for (const auto& r : s.vertex_ranges) {
+    if (merged > 0 && r.first <= s.vertex_ranges[merged - 1].second + 1)
+      s.vertex_ranges[merged - 1].second = std::max(s.vertex_ranges[merged - 1].second, r.second);
+    else
+      s.vertex_ranges[merged++] = r;
+  }
+  s.vertex_ranges.resize(merged);
+  // Vertices the kept triangles do not use keep whatever an earlier image left: none is read.
+  if (s.vertices.size() < m.positions.size()) s.vertices.resize(m.positions.size());
   s.indices.resize(3 * s.kept.size());
-  if (s.indices.size() > had) std::iota(s.indices.begin() + std::ptrdiff_t(had), s.indices.end(), std::uint32_t(had));
+  s.objects.resize(s.kept.size());
   const Viewport vp{cam.width, cam.height};
   const glm::mat4 vp_matrix = cam.view_projection();
-  executor.parallel_for("soff_depth_images.vertices", s.kept.size(), 4096, [&](std::size_t begin, std::size_t end) {
+  executor.parallel_for("soff_depth_images.vertices", s.vertex_ranges.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto [first, last] = s.vertex_ranges[k];
+      make_screen_vertices(vp_matrix, &m.positions[first], std::size_t(last - first) + 1, vp, &s.vertices[first]);
+    }
+  });
+  executor.parallel_for("soff_depth_images.triangles", s.kept.size(), 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t t = s.kept[k];
-      for (int v = 0; v < 3; ++v) s.positions[3 * k + v] = m.positions[m.indices[3 * t + v]];
+      for (int v = 0; v < 3; ++v) s.indices[3 * k + v] = m.indices[3 * std::size_t(t) + v];
       s.objects[k] = m.triangle_object[t];
     }
-    make_screen_vertices(vp_matrix, &s.positions[3 * begin], 3 * (end - begin), vp, &s.vertices[3 * begin]);
   });
   rasterize_screen_vertices(executor, s.vertices, s.indices, s.objects, cam.width, cam.height, {}, s.bins, s.vis);
   VisibilityBuffer& vis = s.vis;
@@ -491,9 +505,17 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
   }
   executor.parallel_for("soff_depth_images.group_bounds", groups.size(), 64,
                         [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k)
-      for (std::uint32_t t = groups[k].first; t < groups[k].first + groups[k].count; ++t)
-        for (int v = 0; v < 3; ++v) groups[k].box.grow(m.positions[m.indices[3 * t + v]]);
+    for (std::size_t k = begin; k < end; ++k) {
+      CullGroup& grp = groups[k];
+      grp.vertex_first = m.indices[3 * std::size_t(grp.first)];
+      grp.vertex_last = grp.vertex_first;
+      for (std::uint32_t t = grp.first; t < grp.first + grp.count; ++t)
+        for (int v = 0; v < 3; ++v) {
+          const std::uint32_t i = m.indices[3 * std::size_t(t) + v];
+          grp.box.grow(m.positions[i]);
+          grp.vertex_first = std::min(grp.vertex_first, i), grp.vertex_last = std::max(grp.vertex_last, i);
+        }
+    }
   });
   out.offsets.assign(cameras.size() + 1, 0);
   for (std::size_t c = 0; c < cameras.size(); ++c)
