@@ -63,16 +63,16 @@ constexpr float kTexelsPerSampleStep = 4.0f;
 // Half-power angle of a Phong lobe of exponent n (cos^n θ = 1/2, small-angle form).
 float lobe_half_power_angle(float n) { return std::sqrt(2.0f * 0.69314718f / std::max(n, 1e-6f)); }
 
-// The texel angle a glossy lobe of exponent n needs: a quarter of the half-power angle of
-// distance-map's sharpest read of it, the sub-lobe of exponent 4n (distance_map_reflect.cpp),
-// keeps every read at level 2 or above (prefiltered, as with the full-size map).
-float glossy_need(float n) { return 0.25f * lobe_half_power_angle(4.0f * n); }
+// The texel angle a glossy lobe of exponent n needs: `share` of the half-power angle of
+// distance-map's sharpest read of it, the sub-lobe of exponent 4n (distance_map_reflect.cpp).
+float glossy_need(float n, float share) { return share * lobe_half_power_angle(4.0f * n); }
 
-// MapSizing::from_lobes: a glossy map's texel angle is at most this share of the half-power
-// angle of its sharpest read (the sub-lobe of exponent 4n). A quarter, as glossy_need, halved
-// living-room's floor map (n ≈ 131) and its frame error grew (matrix at 160×120, distance-map
-// 19.23 → 19.32 mae8); at this share the floor keeps 256² and only the wider lobes shrink
-// (the vase, n ≈ 47, to 128²), with no error grown.
+// Maps read along R (from_footprint): a quarter keeps every read at level 2 or above
+// (prefiltered, as with the full-size map).
+constexpr float kFootprintTexelShare = 0.25f;
+// Searched maps (from_lobes): a quarter halved living-room's floor map (n ≈ 131) and its frame
+// error grew (matrix at 160×120, distance-map 19.23 → 19.32 mae8); at this share the floor
+// keeps 256² and only the wider lobes shrink (the vase, n ≈ 47, to 128²), with no error grown.
 constexpr float kLobeTexelShare = 0.15f;
 
 constexpr float kTexelAngleTimesSize = 0.5f * kPi;  // texel angle of a side-s face: (π/2)/s
@@ -115,7 +115,7 @@ float sample_need(const GBuffer& g, std::size_t i) {
   if (!std::isfinite(delta)) return nan;
   float need = delta / kTexelsPerSampleStep;
   if (!s.is_mirror_lobe() && s.phong_exponent > 0.0f && s.phong_exponent < 1e6f)
-    need = std::max(need, glossy_need(s.phong_exponent));
+    need = std::max(need, glossy_need(s.phong_exponent, kFootprintTexelShare));
   return need;
 }
 
@@ -493,7 +493,7 @@ ReflectorMaps render_reflector_maps(par::Executor& executor, const Scene& scene,
     const bool glossy = !s.is_refractor() && !s.is_mirror_lobe() && s.phong_exponent > 0.0f &&
                         s.phong_exponent < 1e6f && !scene.materials[i].metallic_roughness_texture.valid();
     reads[i] = {true, s.is_refractor(), map_lookup_exponent(scene.materials[i], s),
-                glossy ? side_for_need(kLobeTexelShare * lobe_half_power_angle(4.0f * s.phong_exponent), size) : size};
+                glossy ? side_for_need(glossy_need(s.phong_exponent, kLobeTexelShare), size) : size};
   }
   CubeMapScratch scratch;  // shared by the maps (each face rewrites it)
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {

@@ -68,26 +68,23 @@ void rasterize(par::Executor& executor, const std::vector<ScreenVertex>& vertice
         const std::size_t c = begin / kTriangleChunk;
         BinnedChunk& chunk = bins.chunks[c];
         chunk.clip_maps.clear();
-        if (!outside) {
-          chunk.count = setup_triangles(vertices.data(), indices.data(), begin, end, triangle_object.data(),
-                                        excluded, vp, cull, 0, chunk.triangles, chunk.clip_maps);
-        } else {
-          // The runs of groups inside the view, in triangle order: the same records.
-          constexpr std::size_t kGroup = TriangleGroups::kSize;
-          std::size_t n = 0;
-          for (std::size_t run = begin; run < end;) {
-            if ((*outside)[run / kGroup]) {
-              run += kGroup;
-              continue;
-            }
-            std::size_t run_end = run;
-            while (run_end < end && !(*outside)[run_end / kGroup]) run_end = std::min(run_end + kGroup, end);
-            n = setup_triangles(vertices.data(), indices.data(), run, run_end, triangle_object.data(), excluded, vp,
-                                cull, n, chunk.triangles, chunk.clip_maps);
-            run = run_end;
+        // The runs of groups inside the view (without groups: the whole chunk), in triangle
+        // order: the same records.
+        constexpr std::size_t kGroup = TriangleGroups::kSize;
+        const auto left_out = [&](std::size_t t) { return outside && (*outside)[t / kGroup]; };
+        std::size_t n = 0;
+        for (std::size_t run = begin; run < end;) {
+          if (left_out(run)) {
+            run += kGroup;
+            continue;
           }
-          chunk.count = n;
+          std::size_t run_end = run;
+          while (run_end < end && !left_out(run_end)) run_end = outside ? std::min(run_end + kGroup, end) : end;
+          n = setup_triangles(vertices.data(), indices.data(), run, run_end, triangle_object.data(), excluded, vp,
+                              cull, n, chunk.triangles, chunk.clip_maps);
+          run = run_end;
         }
+        chunk.count = n;
         count_chunk(bins, c, grid);
       });
   executor.parallel_for("raster.bin_offsets", tiles, kTileChunk,
