@@ -316,6 +316,7 @@ void LookupTileMarker::mark(const glm::vec3& d, float exponent) {
   // a face): faces found full stop costing their marks' arithmetic. Maps of one-texel tiles
   // (level 0 alone) are too large to scan this often.
   if (mask_.tile > 1 && ++marks_ % 256 == 0) note_full_faces(mask_.tiles, whole_);
+  if (whole_ == 0x3fu) return;  // every face marked whole: nothing left to mark
   const glm::vec3 r = glm::normalize(d);
   if (level0_) mark_taps(mask_.tiles, mask_.tile, n_tiles, size, r, whole_);
   else mark_near(mask_.tiles, mask_.tile, n_tiles, size, r, margin_, whole_);
