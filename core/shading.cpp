@@ -40,33 +40,63 @@ int repeat_index(long long i, int n) {
   return static_cast<int>(r < 0 ? r + n : r);
 }
 
-glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) {
-  if (image.empty()) return glm::vec4(1.0f);
+namespace {
+const glm::vec4 kOne(1.0f);  // what a missing image or texture reads
+}  // namespace
+
+BilinearTaps bilinear_repeat_taps(const ImageRGBA& image, glm::vec2 uv) {
+  BilinearTaps t;
+  if (image.empty()) {
+    t.texel[0] = &kOne, t.single = true;
+    return t;
+  }
   const float fx = uv.x * static_cast<float>(image.width) - 0.5f;
   const float fy = uv.y * static_cast<float>(image.height) - 0.5f;
-  if (!std::isfinite(fx) || !std::isfinite(fy)) return image.pixels[0];
+  if (!std::isfinite(fx) || !std::isfinite(fy)) {
+    t.texel[0] = &image.pixels[0], t.single = true;
+    return t;
+  }
   const float x0f = std::floor(fx), y0f = std::floor(fy);
-  const float ax = fx - x0f, ay = fy - y0f;
+  t.ax = fx - x0f, t.ay = fy - y0f;
   const long long x0 = static_cast<long long>(x0f), y0 = static_cast<long long>(y0f);
   // The next texel wraps from the first: repeat_index(x0 + 1) without a second remainder.
   const int xa = repeat_index(x0, image.width), xb = xa + 1 < image.width ? xa + 1 : 0;
   const int ya = repeat_index(y0, image.height), yb = ya + 1 < image.height ? ya + 1 : 0;
-  const glm::vec4 top = image.at(xa, ya) * (1.0f - ax) + image.at(xb, ya) * ax;
-  const glm::vec4 bottom = image.at(xa, yb) * (1.0f - ax) + image.at(xb, yb) * ax;
+  t.texel[0] = &image.at(xa, ya), t.texel[1] = &image.at(xb, ya);
+  t.texel[2] = &image.at(xa, yb), t.texel[3] = &image.at(xb, yb);
+  return t;
+}
+
+glm::vec4 BilinearTaps::value() const {
+  if (single) return *texel[0];
+  const glm::vec4 top = *texel[0] * (1.0f - ax) + *texel[1] * ax;
+  const glm::vec4 bottom = *texel[2] * (1.0f - ax) + *texel[3] * ax;
   return top * (1.0f - ay) + bottom * ay;
 }
 
-namespace {
-const ImageRGBA* texture_of(const Scene& scene, const TextureRef& ref) {
-  if (!ref.valid() || static_cast<std::size_t>(ref.texture) >= scene.textures.size()) return nullptr;
-  return &scene.textures[static_cast<std::size_t>(ref.texture)];
+void BilinearTaps::prefetch() const {
+  const auto line = [](const glm::vec4* p) { __builtin_prefetch(p, 0, 3); };
+  line(texel[0]);
+  if (single) return;
+  for (int k = 1; k < 4; ++k) line(texel[k]);
 }
-glm::vec4 lookup(const Scene& scene, const TextureRef& ref, glm::vec2 uv, glm::vec2 uv1) {
-  const ImageRGBA* tex = texture_of(scene, ref);
-  if (!tex) return glm::vec4(1.0f);
+
+glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) { return bilinear_repeat_taps(image, uv).value(); }
+
+BilinearTaps texture_taps(const Scene& scene, const TextureRef& ref, glm::vec2 uv, glm::vec2 uv1) {
+  if (!ref.valid() || static_cast<std::size_t>(ref.texture) >= scene.textures.size()) {
+    BilinearTaps t;
+    t.texel[0] = &kOne, t.single = true;
+    return t;
+  }
   const glm::vec2 base = ref.texcoord == 1 ? uv1 : uv;
   const glm::vec3 t = ref.uv_transform * glm::vec3(base, 1.0f);
-  return sample_bilinear_repeat(*tex, glm::vec2(t));
+  return bilinear_repeat_taps(scene.textures[static_cast<std::size_t>(ref.texture)], glm::vec2(t));
+}
+
+namespace {
+glm::vec4 lookup(const Scene& scene, const TextureRef& ref, glm::vec2 uv, glm::vec2 uv1) {
+  return texture_taps(scene, ref, uv, uv1).value();
 }
 }  // namespace
 

@@ -220,6 +220,22 @@ glm::vec3 environment_mean_radiance(const Environment& env);
 int repeat_index(long long i, int n);
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv);
 
+// sample_bilinear_repeat in two steps: where it reads (bilinear_repeat_taps) and the blend
+// (value), so that a caller can find many lookups' texels, and fetch them, before it waits on
+// any. value(bilinear_repeat_taps(image, uv)) is sample_bilinear_repeat(image, uv) bit for bit.
+struct BilinearTaps {
+  const glm::vec4* texel[4];  // (x0, y0), (x1, y0), (x0, y1), (x1, y1); only [0] when `single`
+  float ax = 0.0f, ay = 0.0f;  // the weights of x1 and y1
+  bool single = false;         // the lookup is texel[0] itself (no image, or a non-finite uv)
+  glm::vec4 value() const;
+  // Asks for the cache lines of the texels.
+  void prefetch() const;
+};
+BilinearTaps bilinear_repeat_taps(const ImageRGBA& image, glm::vec2 uv);
+// The taps of texture `ref` of `scene` at uv (TEXCOORD_0) / uv1 (TEXCOORD_1) after its
+// KHR_texture_transform: surface_params' lookups (an invalid reference reads 1).
+BilinearTaps texture_taps(const Scene& scene, const TextureRef& ref, glm::vec2 uv, glm::vec2 uv1);
+
 // Per scene object: 1 when any of its triangles has a refracting material.
 std::vector<std::uint8_t> refractor_objects(const Scene& scene);
 

@@ -43,6 +43,11 @@ struct MaterialInfo {
   bool textured = false;       // parameters vary with uv: evaluate per sample
   bool normal_mapped = false;
   bool simple = false;         // neither: constant parameters, normals take the 8-wide path
+  // A base colour texture and no other texture or normal map: the normal, its side and
+  // is_specular are those of the constant parameters, so the normal takes the 8-wide path,
+  // and only the base colour is looked up per sample (after the block's other work, see
+  // PendingColour).
+  bool colour_textured = false;
   std::uint32_t keep_side = 0; // all ones for refractors (see resolve_sample)
   bool specular = false;       // is_specular(constant)
 };
@@ -205,11 +210,40 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
   out.reflector[j] = is_specular(sp) ? object : kNoId;
 }
 
-// The interpolation half of resolve_sample for a simple material (constant parameters, no
-// normal map): the normal step runs later over the block's lanes.
-inline void interpolate_sample(const SampleContext& c, std::size_t i, const TriangleRecord& r,
+// A block's base-colour-textured samples (MaterialInfo::colour_textured): their texels are
+// looked up where the sample is interpolated, and fetched while the block's other samples
+// are, then read (finish) once the block is done, so that no sample waits alone on its
+// texture's cache misses. Each sample's parameters are those of resolve_sample bit for bit:
+// the constant ones with the base colour times the texture's value.
+class PendingColour {
+ public:
+  void add(std::size_t i, std::uint32_t mat, const BilinearTaps& taps) { entries_[count_++] = {i, mat, taps}; }
+  void finish(const SampleContext& c) {
+    for (std::size_t k = 0; k < count_; ++k) {
+      const Entry& e = entries_[k];
+      SurfaceParams s = c.materials[e.mat].constant;
+      s.base_color *= glm::vec3(e.taps.value());
+      c.own_surface[e.i] = s;
+    }
+    count_ = 0;
+  }
+
+ private:
+  struct Entry {
+    std::size_t i;
+    std::uint32_t mat;
+    BilinearTaps taps;
+  };
+  Entry entries_[kBlock];
+  std::size_t count_ = 0;
+};
+
+// The interpolation half of resolve_sample for a simple or colour-textured material (no
+// normal map, the side and is_specular of its constant parameters): the normal step runs
+// later over the block's lanes.
+inline void interpolate_sample(const SampleContext& c, std::size_t i, std::uint32_t t, const TriangleRecord& r,
                                std::uint32_t mat, const StagingBlock& out,
-                               detail::NormalLanes<kBlock>& lanes, std::size_t j) {
+                               detail::NormalLanes<kBlock>& lanes, std::size_t j, PendingColour& pending) {
   const MaterialInfo& info = c.materials[mat];
   const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
@@ -222,8 +256,22 @@ inline void interpolate_sample(const SampleContext& c, std::size_t i, const Tria
   lanes.keep_side[j] = info.keep_side;
   out.object[j] = object;
   out.position[j] = p;
-  out.uv[j] = lerp3(r.uv);
-  out.surface[j] = mat;  // the shared entry of an untextured material is its index
+  const glm::vec2 uv = lerp3(r.uv);
+  out.uv[j] = uv;
+  if (info.colour_textured) {  // its texels are asked for now and read after the block
+    const TriangleMesh& m = c.m;
+    glm::vec2 uv1(0.0f);
+    if (!m.uvs1.empty()) {
+      const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+      uv1 = b0 * m.uvs1[i0] + b.x * m.uvs1[i1] + b.y * m.uvs1[i2];
+    }
+    const BilinearTaps taps = texture_taps(c.scene, c.scene.materials[mat].base_color_texture, uv, uv1);
+    taps.prefetch();
+    pending.add(i, mat, taps);
+    out.surface[j] = SurfacePlane::kOwn;
+  } else {
+    out.surface[j] = mat;  // the shared entry of an untextured material is its index
+  }
   out.reflector[j] = info.specular ? object : kNoId;
 }
 
@@ -345,6 +393,7 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
                    std::size_t end, bool stream, GBuffer& g) {
   PlaneWriters writers(g, begin, stream);
   detail::NormalLanes<kBlock> lanes{};
+  PendingColour pending;
   bool simple[kBlock];
   const std::uint32_t* tri = c.vis.triangle.pixels.data();
   const std::size_t total = c.vis.triangle.size();
@@ -391,14 +440,15 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
       decltype(auto) r = corners(t);
       const std::uint32_t mat = corners.material(t);
       const MaterialInfo& info = c.materials[mat];
-      if (info.simple) {
-        interpolate_sample(c, i, r, mat, blk, lanes, j);
+      if (info.simple || info.colour_textured) {
+        interpolate_sample(c, i, t, r, mat, blk, lanes, j, pending);
         simple[j] = true;
         normals_pending = true;
       } else {
         resolve_sample(c, i, t, r, mat, blk, j);
       }
     }
+    pending.finish(c);
     if (!normals_pending) {
       writers.commit(n);
       continue;
@@ -455,6 +505,9 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
                     mat.emissive_texture.valid() || mat.transmission_texture.valid();
     info.normal_mapped = mat.normal_texture.valid();
     info.simple = !info.textured && !info.normal_mapped;
+    info.colour_textured = mat.base_color_texture.valid() && !mat.metallic_roughness_texture.valid() &&
+                           !mat.emissive_texture.valid() && !mat.transmission_texture.valid() &&
+                           !info.normal_mapped;
     info.keep_side = info.constant.is_refractor() ? ~0u : 0u;
     info.specular = is_specular(info.constant);
     any_textured |= info.textured;
