@@ -108,6 +108,13 @@ struct CubeTileMask {
   int size = 0;  // level-0 side; 0: no mask (every texel of the faces in face_mask)
   int tile = kTile;  // tile side in level-0 texels
   std::array<std::vector<std::uint8_t>, kCubeFaces> tiles;  // tiles_per_side()² per face, 1: read
+  // Reads too wide for a bound on one face's plane (LookupTileMarker), recorded first per
+  // coarse cell of directions, wide_cells()² a face: 0 or the bits of the widest reach read
+  // in the cell (a positive float, so the bits order as the values). settle_wide_reads
+  // (reflector_maps.h) turns them into tiles.
+  static constexpr int kWideCells = 16;
+  std::array<std::vector<std::uint32_t>, kCubeFaces> wide;
+  int wide_cells() const { return size < kWideCells ? size : kWideCells; }
 
   bool active() const { return size > 0; }
   // Bit f: face f has a read tile.

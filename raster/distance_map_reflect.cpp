@@ -202,6 +202,7 @@ DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, 
       if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
     }
   });
+  for (CubeTileMask& mask : tiles) settle_wide_reads(executor, mask);
   add_stats(out.stats, per_chunk);
   return out;
 }

@@ -234,6 +234,38 @@ void mark_taps(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int til
     mark(tiles[c.face], static_cast<std::size_t>(y) * n + x0 / tile, static_cast<std::size_t>(x1 / tile - x0 / tile + 1));
 }
 
+// Records in the coarse cell of direction d (any length, non-zero) a read of reach `reach`:
+// the cell keeps the widest (a max of positive floats' bits, the same whatever order the
+// threads record in).
+void record_wide_read(CubeTileMask& mask, const glm::vec3& d, float reach) {
+  const int cells = mask.wide_cells();
+  const CubeCoord c = cube_coord(d, cells);
+  const int x = std::min(static_cast<int>(c.pixel.x), cells - 1), y = std::min(static_cast<int>(c.pixel.y), cells - 1);
+  std::atomic_ref<std::uint32_t> cell(mask.wide[c.face][static_cast<std::size_t>(y) * cells + x]);
+  const std::uint32_t bits = std::bit_cast<std::uint32_t>(reach);
+  std::uint32_t now = cell.load(std::memory_order_relaxed);
+  while (now < bits && !cell.compare_exchange_weak(now, bits, std::memory_order_relaxed)) {
+  }
+}
+
+// The largest angle from the centre direction of a square of `span` texels (a tile or a
+// cell) of a face of side `size` to its corners, over every such square of a face: a point in
+// the square is no farther from its centre's direction (the square is a convex spherical
+// quadrilateral, farthest at a corner).
+float square_radius(int size, int span) {
+  float widest = 0.0f;
+  const int n = (size + span - 1) / span;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const float x0 = float(x * span), y0 = float(y * span);
+      const float x1 = float(std::min(size, (x + 1) * span)), y1 = float(std::min(size, (y + 1) * span));
+      const glm::vec3 centre = cube_direction(0, {0.5f * (x0 + x1), 0.5f * (y0 + y1)}, size);
+      for (const glm::vec2 corner : {glm::vec2(x0, y0), glm::vec2(x1, y0), glm::vec2(x0, y1), glm::vec2(x1, y1)})
+        widest = std::max(widest, std::acos(std::clamp(glm::dot(centre, cube_direction(0, corner, size)), -1.0f, 1.0f)));
+    }
+  return widest;
+}
+
 // A reflector map face's colour (MapFaceLayers: `kept`, may be null, receives its layers).
 CubeFaceShader reflector_face_shader(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
                                      const EnvironmentMap& env, const FaceLight& add_light, MapFaceLayers* kept) {
@@ -300,6 +332,9 @@ CubeTileMask tile_mask_for_reads(int size, int level_count) {
   if (level_count == 1) mask.tile = 1;
   const int n_tiles = mask.tiles_per_side();
   for (auto& t : mask.tiles) t.assign(static_cast<std::size_t>(n_tiles) * n_tiles, 0);
+  const int cells = mask.wide_cells();
+  if (mask.tile > 1)
+    for (auto& w : mask.wide) w.assign(static_cast<std::size_t>(cells) * cells, 0u);
   return mask;
 }
 
@@ -311,6 +346,11 @@ void LookupTileMarker::mark(const glm::vec3& d, float exponent) {
     last_exponent_ = exponent;
     margin_ = std::max(lookup_reach(size, level_count_, exponent), 1e-3f);
     level0_ = levels_for_lobes(size, exponent) == 1;
+    wide_ = !level0_ && margin_ >= kWholeFaceMargin && !mask_.wide[0].empty();
+  }
+  if (wide_) {
+    record_wide_read(mask_, d, margin_);
+    return;
   }
   // A wide lobe's marks soon fill whole faces (every sample of a glossy floor marks most of
   // a face): faces found full stop costing their marks' arithmetic. Maps of one-texel tiles
@@ -320,6 +360,48 @@ void LookupTileMarker::mark(const glm::vec3& d, float exponent) {
   const glm::vec3 r = glm::normalize(d);
   if (level0_) mark_taps(mask_.tiles, mask_.tile, n_tiles, size, r, whole_);
   else mark_near(mask_.tiles, mask_.tile, n_tiles, size, r, margin_, whole_);
+}
+
+void settle_wide_reads(par::Executor& executor, CubeTileMask& mask) {
+  if (!mask.active() || mask.wide[0].empty()) return;
+  const int cells = mask.wide_cells(), n = mask.tiles_per_side();
+  // The recorded cells: centre direction and the cosine of the widest angle a tile centre
+  // may lie from it (the reach, the two squares' radii and a margin for float rounding).
+  struct Cell {
+    glm::vec3 centre;
+    float cos_within;
+  };
+  std::vector<Cell> recorded;
+  float radii = -1.0f;
+  for (int f = 0; f < kCubeFaces; ++f)
+    for (int y = 0; y < cells; ++y)
+      for (int x = 0; x < cells; ++x) {
+        const std::uint32_t bits = mask.wide[f][static_cast<std::size_t>(y) * cells + x];
+        if (bits == 0u) continue;
+        if (radii < 0.0f) radii = square_radius(cells, 1) + square_radius(mask.size, mask.tile) + 1e-3f;
+        const float within = std::bit_cast<float>(bits) + radii;
+        recorded.push_back({cube_direction(f, {x + 0.5f, y + 0.5f}, cells),
+                            within >= kPi ? -2.0f : std::cos(within)});
+      }
+  if (recorded.empty()) return;
+  const std::size_t per_face = static_cast<std::size_t>(n) * n;
+  executor.parallel_for("tile_marks.settle_wide", kCubeFaces * per_face, 1024, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const int f = static_cast<int>(k / per_face);
+      const std::size_t i = k % per_face;
+      std::uint8_t& tile = mask.tiles[f][i];
+      if (tile) continue;
+      const int tx = static_cast<int>(i % n), ty = static_cast<int>(i / n);
+      const float x0 = float(tx * mask.tile), y0 = float(ty * mask.tile);
+      const float x1 = float(std::min(mask.size, (tx + 1) * mask.tile)), y1 = float(std::min(mask.size, (ty + 1) * mask.tile));
+      const glm::vec3 centre = cube_direction(f, {0.5f * (x0 + x1), 0.5f * (y0 + y1)}, mask.size);
+      for (const Cell& c : recorded)
+        if (glm::dot(c.centre, centre) >= c.cos_within) {
+          tile = 1;
+          break;
+        }
+    }
+  });
 }
 
 void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask>& from) {
@@ -355,6 +437,7 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& g, const std::ve
     }
   });
   if (refracts.load()) for (auto& t : mask.tiles) std::fill(t.begin(), t.end(), std::uint8_t(1));
+  else settle_wide_reads(executor, mask);
   return mask;
 }
 

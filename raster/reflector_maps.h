@@ -141,7 +141,8 @@ CubeTileMask tile_mask_for_reads(int size, int level_count);
 // the map read: the bilinear taps of a lookup that reads level 0 alone, else every texel
 // within lookup_reach of d. One marker per thread (it keeps per-call state); any number of
 // markers may mark one mask at once: a tile is only ever set, so the mask is the same
-// whatever marked what.
+// whatever marked what. A reach too wide for the face-plane bound is recorded in the mask's
+// coarse cells (CubeTileMask::wide): call settle_wide_reads once the markers are done.
 class LookupTileMarker {
  public:
   LookupTileMarker(CubeTileMask& mask, int level_count);
@@ -152,9 +153,16 @@ class LookupTileMarker {
   int level_count_;
   float last_exponent_ = std::numeric_limits<float>::quiet_NaN(), margin_ = 0.0f;
   bool level0_ = false;
+  bool wide_ = false;   // the reach is recorded per coarse cell (settle_wide_reads)
   unsigned whole_ = 0;  // faces found marked whole
   unsigned marks_ = 0;
 };
+
+// Marks the tiles within reach of the coarse cells LookupTileMarker recorded in `mask`: a
+// tile whose centre is within the cell's reach plus both one's and the other's angular
+// radius of a recorded cell's centre (a texel within reach of a direction in the cell can lie
+// no farther). Named launch "tile_marks.settle_wide".
+void settle_wide_reads(par::Executor& executor, CubeTileMask& mask);
 
 // Marks in `into` every tile marked in `from` (masks of the same maps, in map order).
 void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask>& from);

@@ -123,6 +123,57 @@ TEST(ReflectorMaps, MarkedTilesHoldEveryTexelWithinTheMargin) {
   }
 }
 
+// Reads whose reach is too wide for the face-plane bound (LookupTileMarker records them per
+// coarse cell; settle_wide_reads turns the cells into tiles): every texel centre within the
+// reach of a read direction, at every level, lies over a marked tile — brute force over maps
+// of side 64 and 128, one direction a mask and all of them in one mask from two markers —
+// while lone reads under a radian mark fewer tiles than the whole faces they come near.
+TEST(ReflectorMaps, WideReadsMarkEveryTexelWithinTheirReach) {
+  std::vector<glm::vec3> directions = {{1, 0, 0}, {0, -1, 0}, {1, 1, 0}, {1, 1, 1}, {-1, 0.999f, 0.2f}, {0.3f, -0.2f, -1}};
+  for (std::uint32_t k = 0; k < 24; ++k) {
+    const glm::vec2 u = hamersley(k, 24);
+    directions.push_back(spherical_local(1.0f - 2.0f * u.x, u.y));
+  }
+  for (glm::vec3& d : directions) d = glm::normalize(d);
+  par::Executor ex(2);
+  for (const int size : {64, 128}) {
+    const int levels = static_cast<int>(std::log2(float(size))) + 1;
+    for (const float exponent : {40.0f, 262.0f}) {
+      const float reach = lookup_reach(size, levels, exponent);
+      ASSERT_GE(reach, 0.5f) << "a wide read";
+      const auto check = [&](const CubeTileMask& mask, const std::vector<glm::vec3>& read) {
+        for (int level = 0; level < levels; ++level) {
+          const int s = size >> level;
+          for (int face = 0; face < kCubeFaces; ++face)
+            for (int y = 0; y < s; ++y)
+              for (int x = 0; x < s; ++x) {
+                const glm::vec3 t = cube_direction(face, {x + 0.5f, y + 0.5f}, s);
+                bool within = false;
+                for (const glm::vec3& d : read) within = within || std::acos(std::clamp(glm::dot(t, d), -1.0f, 1.0f)) <= reach;
+                if (within) ASSERT_TRUE(mask.covers(face, level, x, y)) << "size " << size << " level " << level << " face " << face;
+              }
+        }
+      };
+      long long marked = 0, whole = 0;
+      for (const glm::vec3& d : directions) {
+        CubeTileMask mask = tile_mask_for_reads(size, levels);
+        LookupTileMarker marker(mask, levels);
+        marker.mark(d * 3.0f, exponent);  // any length
+        settle_wide_reads(ex, mask);
+        check(mask, {d});
+        marked += static_cast<long long>(mask.texel_count(0x3fu));
+        whole += static_cast<long long>(std::popcount(cube_faces_near(d, reach))) * size * size;
+      }
+      if (reach < 1.0f) EXPECT_LT(marked * 10, whole * 9) << size << " " << exponent;
+      CubeTileMask all = tile_mask_for_reads(size, levels);
+      LookupTileMarker first(all, levels), second(all, levels);
+      for (std::size_t k = 0; k < directions.size(); ++k) (k % 2 ? first : second).mark(directions[k], exponent);
+      settle_wide_reads(ex, all);
+      check(all, directions);
+    }
+  }
+}
+
 // Lookups along R read only the tiles near their directions: maps rendered on those tiles
 // alone give the same specular layer, byte for byte, as complete maps, and fewer texels; with
 // refractors_read_at_surface, a refractor's map too.
