@@ -402,6 +402,9 @@ void settle_wide_reads(par::Executor& executor, CubeTileMask& mask) {
         }
     }
   });
+  // Settled: a later call (marks into the same masks, e.g. each face's searches of a
+  // multi-reflection round) tests only what is recorded after this one.
+  for (auto& w : mask.wide) std::fill(w.begin(), w.end(), 0u);
 }
 
 void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask>& from) {

@@ -161,7 +161,7 @@ class LookupTileMarker {
 // Marks the tiles within reach of the coarse cells LookupTileMarker recorded in `mask`: a
 // tile whose centre is within the cell's reach plus both one's and the other's angular
 // radius of a recorded cell's centre (a texel within reach of a direction in the cell can lie
-// no farther). Named launch "tile_marks.settle_wide".
+// no farther); then clears the cells. Named launch "tile_marks.settle_wide".
 void settle_wide_reads(par::Executor& executor, CubeTileMask& mask);
 
 // Marks in `into` every tile marked in `from` (masks of the same maps, in map order).
