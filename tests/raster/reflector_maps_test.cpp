@@ -79,40 +79,57 @@ TEST(ReflectorMaps, UnreadFacesChangeNoSearchedOrLookedUpSample) {
   EXPECT_GT(culled_looked_up, culled_searched);
 }
 
+// Unit directions at face centres, edges, corners and `random` more spread over the sphere.
+std::vector<glm::vec3> test_directions(std::uint32_t random) {
+  std::vector<glm::vec3> directions = {{1, 0, 0}, {0, -1, 0}, {1, 1, 0}, {1, 1, 1}, {-1, 0.999f, 0.2f}, {0.3f, -0.2f, -1}};
+  for (std::uint32_t k = 0; k < random; ++k) {
+    const glm::vec2 u = hamersley(k, random);
+    directions.push_back(spherical_local(1.0f - 2.0f * u.x, u.y));
+  }
+  for (glm::vec3& d : directions) d = glm::normalize(d);
+  return directions;
+}
+
+// The texels of a map of side `size` (every face, levels [0, levels)) whose centre is within
+// `angle` of one of `reads` but that `mask` does not cover; the first one described in `first`.
+long long uncovered_texels(const CubeTileMask& mask, int size, int levels, const std::vector<glm::vec3>& reads, float angle,
+                           std::string& first) {
+  long long uncovered = 0;
+  for (int level = 0; level < levels; ++level) {
+    const int s = size >> level;
+    for (int face = 0; face < kCubeFaces; ++face)
+      for (int y = 0; y < s; ++y)
+        for (int x = 0; x < s; ++x) {
+          const glm::vec3 t = cube_direction(face, {x + 0.5f, y + 0.5f}, s);
+          bool within = false;
+          for (const glm::vec3& d : reads) within = within || std::acos(std::clamp(glm::dot(t, d), -1.0f, 1.0f)) <= angle;
+          if (!within || mask.covers(face, level, x, y)) continue;
+          if (uncovered++ == 0)
+            first = "level " + std::to_string(level) + " face " + std::to_string(face) + " texel " + std::to_string(x) +
+                    "," + std::to_string(y);
+        }
+  }
+  return uncovered;
+}
+
 // The tile bound (mark_tiles_near): every texel centre within the margin of a direction, on
 // every face and at every mip level, lies over a marked tile — brute force over all texels of
 // maps of side 32 and 64, for directions at face centres, edges, corners and at random —
 // while small margins mark only a small part of the map.
 TEST(ReflectorMaps, MarkedTilesHoldEveryTexelWithinTheMargin) {
-  std::vector<glm::vec3> directions = {{1, 0, 0}, {0, -1, 0}, {1, 1, 0}, {1, 1, 1}, {-1, 0.999f, 0.2f}, {0.3f, -0.2f, -1}};
-  for (std::uint32_t k = 0; k < 40; ++k) {
-    const glm::vec2 u = hamersley(k, 40);
-    directions.push_back(spherical_local(1.0f - 2.0f * u.x, u.y));
-  }
+  const std::vector<glm::vec3> directions = test_directions(40);
   for (const auto& [size, tile] : {std::pair{32, 8}, std::pair{64, 8}, std::pair{32, 1}, std::pair{64, 2}}) {
     long long marked_small = 0, total_small = 0;
-    for (glm::vec3 d : directions) {
-      d = glm::normalize(d);
+    for (const glm::vec3& d : directions) {
       for (const float margin : {0.001f, 0.02f, 0.1f, 0.3f, 0.49f, 0.6f}) {
         CubeTileMask mask;
         mask.size = size;
         mask.tile = tile;
         mark_tiles_near(mask, d, margin);
-        const int levels = static_cast<int>(std::log2(float(size))) + 1;
-        for (int level = 0; level < levels; ++level) {
-          const int s = size >> level;
-          for (int face = 0; face < kCubeFaces; ++face)
-            for (int y = 0; y < s; ++y)
-              for (int x = 0; x < s; ++x) {
-                const glm::vec3 t = cube_direction(face, {x + 0.5f, y + 0.5f}, s);
-                const float angle = std::acos(std::clamp(glm::dot(t, d), -1.0f, 1.0f));
-                if (angle <= margin) {
-                  ASSERT_TRUE(mask.covers(face, level, x, y))
-                      << "size " << size << " tile " << tile << " level " << level << " face " << face << " texel " << x << "," << y
-                      << " margin " << margin << " d " << d.x << "," << d.y << "," << d.z;
-                }
-              }
-        }
+        std::string first;
+        EXPECT_EQ(uncovered_texels(mask, size, static_cast<int>(std::log2(float(size))) + 1, {d}, margin, first), 0)
+            << "size " << size << " tile " << tile << " margin " << margin << " d " << d.x << "," << d.y << "," << d.z
+            << ": " << first;
         if (margin <= 0.02f) {
           marked_small += static_cast<long long>(mask.texel_count(0x3fu));
           total_small += 6LL * size * size;
@@ -129,12 +146,7 @@ TEST(ReflectorMaps, MarkedTilesHoldEveryTexelWithinTheMargin) {
 // of side 64 and 128, one direction a mask and all of them in one mask from two markers —
 // while lone reads under a radian mark fewer tiles than the whole faces they come near.
 TEST(ReflectorMaps, WideReadsMarkEveryTexelWithinTheirReach) {
-  std::vector<glm::vec3> directions = {{1, 0, 0}, {0, -1, 0}, {1, 1, 0}, {1, 1, 1}, {-1, 0.999f, 0.2f}, {0.3f, -0.2f, -1}};
-  for (std::uint32_t k = 0; k < 24; ++k) {
-    const glm::vec2 u = hamersley(k, 24);
-    directions.push_back(spherical_local(1.0f - 2.0f * u.x, u.y));
-  }
-  for (glm::vec3& d : directions) d = glm::normalize(d);
+  const std::vector<glm::vec3> directions = test_directions(24);
   par::Executor ex(2);
   for (const int size : {64, 128}) {
     const int levels = static_cast<int>(std::log2(float(size))) + 1;
@@ -142,17 +154,9 @@ TEST(ReflectorMaps, WideReadsMarkEveryTexelWithinTheirReach) {
       const float reach = lookup_reach(size, levels, exponent);
       ASSERT_GE(reach, 0.5f) << "a wide read";
       const auto check = [&](const CubeTileMask& mask, const std::vector<glm::vec3>& read) {
-        for (int level = 0; level < levels; ++level) {
-          const int s = size >> level;
-          for (int face = 0; face < kCubeFaces; ++face)
-            for (int y = 0; y < s; ++y)
-              for (int x = 0; x < s; ++x) {
-                const glm::vec3 t = cube_direction(face, {x + 0.5f, y + 0.5f}, s);
-                bool within = false;
-                for (const glm::vec3& d : read) within = within || std::acos(std::clamp(glm::dot(t, d), -1.0f, 1.0f)) <= reach;
-                if (within) ASSERT_TRUE(mask.covers(face, level, x, y)) << "size " << size << " level " << level << " face " << face;
-              }
-        }
+        std::string first;
+        EXPECT_EQ(uncovered_texels(mask, size, levels, read, reach, first), 0)
+            << "size " << size << " exponent " << exponent << ": " << first;
       };
       long long marked = 0, whole = 0;
       for (const glm::vec3& d : directions) {
