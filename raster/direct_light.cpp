@@ -143,9 +143,16 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
     }
   if (rough == 0) return;
   env_->radiance8(along, exponent, rough, environment);
+  // specular_reflectance(s, N·V) of a rough lobe is the view's albedo split applied to F0: the
+  // punctual α is the lobe's own (roughness ≥ kGlossyRoughness > kMinPunctualRoughness), the
+  // table clamps N·V to [0, 1] either way, and view.f0 is specular_f0's sum.
+  alignas(32) float f0[3][8], scale[8], bias[8];
+  L::store_aligned(view.f0.x, f0[0]), L::store_aligned(view.f0.y, f0[1]), L::store_aligned(view.f0.z, f0[2]);
+  L::store_aligned(view.scale_at_view, scale), L::store_aligned(view.bias_at_view, bias);
   for (int t = 0; t < rough; ++t) {
     const int j = rough_lane[t];
-    out[j] += specular_reflectance(*s[j], glm::dot(n[j], v[j])) * environment[t];
+    const SpecularAlbedo albedo{scale[j], bias[j]};
+    out[j] += albedo(glm::vec3(f0[0][j], f0[1][j], f0[2][j])) * environment[t];
   }
 }
 
