@@ -7,6 +7,7 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -308,28 +309,36 @@ void EnvironmentMap::radiance8(const glm::vec3* d, const float* phong_exponent, 
                    ? level[k - 1]
                    : read_level(*this, phong_exponent[k]);
   }
-  const int l0 = static_cast<int>(level[0]);
-  bool shared = true;  // one level pair for every lane: one lookup per level in lanes
-  for (int j = 1; j < count; ++j) shared &= static_cast<int>(level[j]) == l0;
-  if (!shared) {
-    for (int j = 0; j < count; ++j) out[j] = radiance(d[j], phong_exponent[j]);
-    return;
+  // The lanes grouped by the first level they read (usually one group): each group's
+  // lookups in lanes, the other lanes repeating the group's first direction (dropped).
+  unsigned todo = (1u << count) - 1u;
+  while (todo) {
+    const int first = std::countr_zero(todo);
+    const int l0 = static_cast<int>(level[first]);
+    unsigned group = 0;
+    for (int j = first; j < count; ++j)
+      if (((todo >> j) & 1u) && static_cast<int>(level[j]) == l0) group |= 1u << j;
+    todo &= ~group;
+    alignas(32) float dir[3][8], from_l0[8];
+    for (int j = 0; j < 8; ++j) {
+      const int k = (group >> j) & 1u ? j : first;
+      for (int c = 0; c < 3; ++c) dir[c][j] = d[k][c];
+      from_l0[j] = level[k] - float(l0);
+    }
+    f32 dv[3];
+    for (int c = 0; c < 3; ++c) dv[c] = L::load_aligned(dir[c]);
+    f32 a[3];
+    lookup_level8(LevelFaces(levels[l0]), dv, a);
+    const f32 t = L::load_aligned(from_l0);
+    const L::mask blend = t > 0.0f;
+    if (L::any(blend)) {
+      f32 b[3];
+      lookup_level8(LevelFaces(levels[std::min(l0 + 1, last)]), dv, b);
+      for (int c = 0; c < 3; ++c) a[c] = L::select(blend, a[c] * (1.0f - t) + b[c] * t, a[c]);
+    }
+    for (int j = first; j < count; ++j)
+      if ((group >> j) & 1u) out[j] = glm::vec3(a[0][j], a[1][j], a[2][j]);
   }
-  alignas(32) float dir[3][8];
-  for (int j = 0; j < 8; ++j)
-    for (int c = 0; c < 3; ++c) dir[c][j] = d[j < count ? j : 0][c];
-  f32 dv[3];
-  for (int c = 0; c < 3; ++c) dv[c] = L::load_aligned(dir[c]);
-  f32 a[3];
-  lookup_level8(LevelFaces(levels[l0]), dv, a);
-  const f32 t = L::load_aligned(level) - float(l0);
-  const L::mask blend = t > 0.0f;
-  if (L::any(blend)) {
-    f32 b[3];
-    lookup_level8(LevelFaces(levels[std::min(l0 + 1, last)]), dv, b);
-    for (int c = 0; c < 3; ++c) a[c] = L::select(blend, a[c] * (1.0f - t) + b[c] * t, a[c]);
-  }
-  for (int j = 0; j < count; ++j) out[j] = glm::vec3(a[0][j], a[1][j], a[2][j]);
 }
 
 glm::vec3 EnvironmentMap::irradiance(const glm::vec3& n) const {
