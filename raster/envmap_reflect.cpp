@@ -16,17 +16,36 @@ void reflect_with(par::Executor& executor, const GBuffer& g, const MapOf& map_of
                   const Shaded& shaded, const Unshaded& unshaded) {
   executor.parallel_for("envmap_reflect.lookup", g.object.size(), 4096,
                         [&](std::size_t begin, std::size_t end) {
+    // Consecutive samples reading one map have up to eight lookups made together
+    // (radiance8, each with radiance's bits), then each sample's radiance from its own.
+    constexpr int kBatch = 8;
+    SpecularLookups plan[kBatch] = {};
+    std::size_t sample[kBatch];
+    glm::vec3 direction[kBatch], found[kBatch];
+    float exponent[kBatch];
+    int samples = 0, lookups = 0;
+    const EnvironmentMap* batch_map = nullptr;
+    const auto flush = [&] {
+      if (samples == 0) return;
+      batch_map->radiance8(direction, exponent, lookups, found);
+      for (int k = 0, next = 0; k < samples; next += plan[k].count, ++k) shaded(sample[k], plan[k].radiance(found + next));
+      samples = lookups = 0;
+    };
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i) || !takes(g.surface[i])) {
         unshaded(i);
         continue;
       }
-      const SurfaceParams& s = g.surface[i];
-      const auto lookup = [&](const glm::vec3& d, float exponent) {
-        return map_of(g.object.pixels[i]).radiance(d, exponent);
-      };
-      shaded(i, specular_radiance(s, g.normal.pixels[i], g.view_direction(i), lookup));
+      const SpecularLookups lookup(g.surface[i], g.normal.pixels[i], g.view_direction(i));
+      const EnvironmentMap& map = map_of(g.object.pixels[i]);
+      if (&map != batch_map || lookups + lookup.count > kBatch) flush();
+      batch_map = &map;
+      for (int k = 0; k < lookup.count; ++k)
+        direction[lookups] = lookup.direction[k], exponent[lookups] = lookup.exponent[k], ++lookups;
+      plan[samples] = lookup;
+      sample[samples++] = i;
     }
+    flush();
   });
 }
 

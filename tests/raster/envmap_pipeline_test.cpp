@@ -16,6 +16,9 @@
 #include "core/optics.h"
 #include "core/scene_loader.h"
 #include "raster/composite.h"
+#include "raster/reflector_maps.h"
+#include "raster/shadow_map.h"
+#include "raster/specular_radiance.h"
 #include "raster_test_scenes.h"
 
 namespace speculum::raster {
@@ -129,6 +132,38 @@ TEST(EnvmapReflect, OntoDirectGivesTheBytesOfTheComposite) {
     envmap_reflect_onto(ex, g, env, onto);
     ASSERT_EQ(expected.pixels.size(), onto.pixels.size());
     EXPECT_EQ(0, std::memcmp(expected.pixels.data(), onto.pixels.data(), expected.pixels.size() * sizeof(glm::vec4)));
+  }
+}
+
+// The lookups made eight at a time (consecutive samples of one map, mirrors, glossy lobes and
+// refractors mixed, each reflector in its own map) give per sample the bytes of
+// specular_radiance with one scalar lookup at a time.
+TEST(EnvmapReflect, BatchedLookupsGiveTheBytesOfOneAtATime) {
+  par::Executor ex(2);
+  for (const char* name : {"living-room", "glass-sphere", "bathroom"}) {
+    SCOPED_TRACE(name);
+    const Scene scene = load_scene(name);
+    const Camera cam = scene.cameras.front();
+    const GBuffer g = resolve_gbuffer(ex, scene, render_visibility(ex, scene, cam, 120, 90), cam.eye);
+    const EnvironmentMap env = build_environment(ex, scene.environment);
+    const ShadowMaps shadows = render_shadow_maps(ex, scene, 64);
+    const ReflectorMaps maps = render_reflector_maps(ex, scene, shadows, env, 32, &g);
+    for (const ReflectorMaps* reflectors : {static_cast<const ReflectorMaps*>(nullptr), &maps}) {
+      const ImageRGBA got = envmap_reflect(ex, g, env, reflectors);
+      std::size_t specular = 0, mismatched = 0;
+      for (std::size_t i = 0; i < got.pixels.size(); ++i) {
+        if (!g.covered(i) || !is_specular(g.surface[i])) continue;
+        ++specular;
+        const EnvironmentMap* own = reflectors ? reflectors->for_object(g.object.pixels[i]) : nullptr;
+        const EnvironmentMap& map = own ? *own : env;
+        const glm::vec3 want = specular_radiance(g.surface[i], g.normal.pixels[i], g.view_direction(i),
+                                                 [&](const glm::vec3& d, float e) { return map.radiance(d, e); });
+        const glm::vec4 expected(want, 1.0f);
+        mismatched += std::memcmp(&expected, &got.pixels[i], sizeof expected) != 0;
+      }
+      EXPECT_GT(specular, 100u);
+      EXPECT_EQ(mismatched, 0u);
+    }
   }
 }
 
