@@ -108,6 +108,18 @@ ImageRGBA render_envmap(const Scene& scene, int threads, int lanes) {
   return graph.get(out.radiance);
 }
 
+// A built-in scene's first camera view at 120×90: its G-buffer and environment map.
+struct SceneView {
+  Scene scene;
+  GBuffer g;
+  EnvironmentMap env;
+  SceneView(par::Executor& ex, const char* name) : scene(load_scene(name)) {
+    const Camera cam = scene.cameras.front();
+    g = resolve_gbuffer(ex, scene, render_visibility(ex, scene, cam, 120, 90), cam.eye);
+    env = build_environment(ex, scene.environment);
+  }
+};
+
 // The cube faces' shading adds the specular layer onto the direct light in place: the bytes
 // of composite(direct, envmap_reflect(...)), on views with mirrors, glossy and refracting
 // samples, background, and a direct layer holding negative zeros.
@@ -115,10 +127,9 @@ TEST(EnvmapReflect, OntoDirectGivesTheBytesOfTheComposite) {
   par::Executor ex(2);
   for (const char* name : {"living-room", "glass-sphere", "sphere-in-room"}) {
     SCOPED_TRACE(name);
-    const Scene scene = load_scene(name);
-    const Camera cam = scene.cameras.front();
-    const GBuffer g = resolve_gbuffer(ex, scene, render_visibility(ex, scene, cam, 120, 90), cam.eye);
-    const EnvironmentMap env = build_environment(ex, scene.environment);
+    const SceneView view(ex, name);
+    const GBuffer& g = view.g;
+    const EnvironmentMap& env = view.env;
     ImageRGBA direct(g.width, g.height);
     std::size_t specular = 0;
     for (std::size_t i = 0; i < direct.pixels.size(); ++i) {
@@ -142,12 +153,10 @@ TEST(EnvmapReflect, BatchedLookupsGiveTheBytesOfOneAtATime) {
   par::Executor ex(2);
   for (const char* name : {"living-room", "glass-sphere", "bathroom"}) {
     SCOPED_TRACE(name);
-    const Scene scene = load_scene(name);
-    const Camera cam = scene.cameras.front();
-    const GBuffer g = resolve_gbuffer(ex, scene, render_visibility(ex, scene, cam, 120, 90), cam.eye);
-    const EnvironmentMap env = build_environment(ex, scene.environment);
-    const ShadowMaps shadows = render_shadow_maps(ex, scene, 64);
-    const ReflectorMaps maps = render_reflector_maps(ex, scene, shadows, env, 32, &g);
+    const SceneView view(ex, name);
+    const GBuffer& g = view.g;
+    const EnvironmentMap& env = view.env;
+    const ReflectorMaps maps = render_reflector_maps(ex, view.scene, render_shadow_maps(ex, view.scene, 64), env, 32, &g);
     for (const ReflectorMaps* reflectors : {static_cast<const ReflectorMaps*>(nullptr), &maps}) {
       const ImageRGBA got = envmap_reflect(ex, g, env, reflectors);
       std::size_t specular = 0, mismatched = 0;
