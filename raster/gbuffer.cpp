@@ -157,6 +157,15 @@ struct RecordCorners {
   }
 };
 
+// TEXCOORD_1 of triangle t at barycentrics (1 − b.x − b.y, b.x, b.y), from the mesh (the
+// records carry TEXCOORD_0 only); 0 when the mesh has none.
+glm::vec2 second_uv(const TriangleMesh& m, std::uint32_t t, glm::vec2 b) {
+  if (m.uvs1.empty()) return glm::vec2(0.0f);
+  const float b0 = 1.0f - b.x - b.y;
+  const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+  return b0 * m.uvs1[i0] + b.x * m.uvs1[i1] + b.y * m.uvs1[i2];
+}
+
 // Resolves covered visibility sample i of triangle t (corners r) into slot j of the block.
 inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t t,
                            const TriangleRecord& r, std::uint32_t mat, const StagingBlock& out,
@@ -179,9 +188,7 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
   const glm::vec3 unmapped = n;  // decides the side (below); the map tilts within it
   if (info.textured || info.normal_mapped) {  // rare: the extra vertex streams come from the mesh
     const TriangleMesh& m = c.m;
-    const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
-    auto lerp_mesh = [&](const auto& a) { return b0 * a[i0] + b.x * a[i1] + b.y * a[i2]; };
-    const glm::vec2 uv1 = !m.uvs1.empty() ? lerp_mesh(m.uvs1) : glm::vec2(0.0f);
+    const glm::vec2 uv1 = second_uv(m, t, b);
     if (info.normal_mapped) {
       const Material& material = c.scene.materials[mat];
       n = normal_mapped(c.scene, material, n,
@@ -259,13 +266,8 @@ inline void interpolate_sample(const SampleContext& c, std::size_t i, std::uint3
   const glm::vec2 uv = lerp3(r.uv);
   out.uv[j] = uv;
   if (info.colour_textured) {  // its texels are asked for now and read after the block
-    const TriangleMesh& m = c.m;
-    glm::vec2 uv1(0.0f);
-    if (!m.uvs1.empty()) {
-      const std::uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
-      uv1 = b0 * m.uvs1[i0] + b.x * m.uvs1[i1] + b.y * m.uvs1[i2];
-    }
-    const BilinearTaps taps = texture_taps(c.scene, c.scene.materials[mat].base_color_texture, uv, uv1);
+    const BilinearTaps taps =
+        texture_taps(c.scene, c.scene.materials[mat].base_color_texture, uv, second_uv(c.m, t, b));
     taps.prefetch();
     pending.add(i, mat, taps);
     out.surface[j] = SurfacePlane::kOwn;
