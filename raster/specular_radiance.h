@@ -24,10 +24,11 @@ struct SpecularLookups {
   int count = 0;
   glm::vec3 direction[2];
   float exponent[2] = {0.0f, 0.0f};
-  // How the found radiance combines: reflectance × found[0] (a reflector); found[0] (a
-  // refractor under total internal reflection: F = 1); f found[0] + (1 − f) base found[1].
-  enum class Combine { reflect, total_internal, refract } combine = Combine::reflect;
-  glm::vec3 reflectance{0.0f}, base_color{0.0f};
+  // How the found radiance combines: reflectance × found[0] (a reflector, or a refractor
+  // under total internal reflection: F = 1, and 1 × x is x exactly), else the refractor's
+  // f found[0] + (1 − f) base found[1].
+  bool refracts = false;
+  glm::vec3 reflectance{1.0f}, base_color{0.0f};
   float f = 0.0f;
 
   SpecularLookups() = default;
@@ -46,12 +47,11 @@ struct SpecularLookups {
     const glm::vec3 r = reflect(incident, n);
     glm::vec3 t;
     if (!refract(incident, n, nu, t)) {
-      combine = Combine::total_internal;
       add(r, kSharpLookupExponent);
       return;
     }
     // Schlick with F0 of the interface.
-    combine = Combine::refract;
+    refracts = true;
     f = fresnel_schlick(glm::dot(n, v), fresnel_f0(nu));
     base_color = s.base_color;
     add(r, kSharpLookupExponent);
@@ -59,12 +59,7 @@ struct SpecularLookups {
   }
   // found[k]: the radiance arriving along direction[k], prefiltered for exponent[k].
   glm::vec3 radiance(const glm::vec3* found) const {
-    switch (combine) {
-      case Combine::reflect: return reflectance * found[0];
-      case Combine::total_internal: return found[0];
-      case Combine::refract: break;
-    }
-    return f * found[0] + (1.0f - f) * base_color * found[1];
+    return refracts ? f * found[0] + (1.0f - f) * base_color * found[1] : reflectance * found[0];
   }
 
  private:
