@@ -42,20 +42,20 @@ int repeat_index(long long i, int n) {
 
 namespace {
 const glm::vec4 kOne(1.0f);  // what a missing image or texture reads
+// The taps of a lookup that is one texel itself.
+BilinearTaps single_texel(const glm::vec4& texel) {
+  BilinearTaps t;
+  t.texel[0] = &texel, t.single = true;
+  return t;
+}
 }  // namespace
 
 BilinearTaps bilinear_repeat_taps(const ImageRGBA& image, glm::vec2 uv) {
-  BilinearTaps t;
-  if (image.empty()) {
-    t.texel[0] = &kOne, t.single = true;
-    return t;
-  }
+  if (image.empty()) return single_texel(kOne);
   const float fx = uv.x * static_cast<float>(image.width) - 0.5f;
   const float fy = uv.y * static_cast<float>(image.height) - 0.5f;
-  if (!std::isfinite(fx) || !std::isfinite(fy)) {
-    t.texel[0] = &image.pixels[0], t.single = true;
-    return t;
-  }
+  if (!std::isfinite(fx) || !std::isfinite(fy)) return single_texel(image.pixels[0]);
+  BilinearTaps t;
   const float x0f = std::floor(fx), y0f = std::floor(fy);
   t.ax = fx - x0f, t.ay = fy - y0f;
   const long long x0 = static_cast<long long>(x0f), y0 = static_cast<long long>(y0f);
@@ -84,11 +84,7 @@ void BilinearTaps::prefetch() const {
 glm::vec4 sample_bilinear_repeat(const ImageRGBA& image, glm::vec2 uv) { return bilinear_repeat_taps(image, uv).value(); }
 
 BilinearTaps texture_taps(const Scene& scene, const TextureRef& ref, glm::vec2 uv, glm::vec2 uv1) {
-  if (!ref.valid() || static_cast<std::size_t>(ref.texture) >= scene.textures.size()) {
-    BilinearTaps t;
-    t.texel[0] = &kOne, t.single = true;
-    return t;
-  }
+  if (!ref.valid() || static_cast<std::size_t>(ref.texture) >= scene.textures.size()) return single_texel(kOne);
   const glm::vec2 base = ref.texcoord == 1 ? uv1 : uv;
   const glm::vec3 t = ref.uv_transform * glm::vec3(base, 1.0f);
   return bilinear_repeat_taps(scene.textures[static_cast<std::size_t>(ref.texture)], glm::vec2(t));
