@@ -251,12 +251,17 @@ void record_wide_read(CubeTileMask& mask, const glm::vec3& d, float reach) {
 // The largest angle from the centre direction of a square of `span` texels (a tile or a
 // cell) of a face of side `size` to its corners, over every such square of a face: a point in
 // the square is no farther from its centre's direction (the square is a convex spherical
-// quadrilateral, farthest at a corner).
+// quadrilateral, farthest at a corner). When the squares tile the face evenly, the face's
+// mirror symmetries (x ↔ n−1−x, y ↔ n−1−y, x ↔ y, each an isometry of the sphere) map them
+// onto each other, so one eighth of them holds every radius (float rounding aside, which
+// settle_wide_reads' margin covers).
 float square_radius(int size, int span) {
   float widest = 0.0f;
   const int n = (size + span - 1) / span;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
+  const bool even = size % span == 0;
+  const int half = even ? (n + 1) / 2 : n;
+  for (int y = 0; y < half; ++y)
+    for (int x = even ? y : 0; x < half; ++x) {
       const float x0 = float(x * span), y0 = float(y * span);
       const float x1 = float(std::min(size, (x + 1) * span)), y1 = float(std::min(size, (y + 1) * span));
       const glm::vec3 centre = cube_direction(0, {0.5f * (x0 + x1), 0.5f * (y0 + y1)}, size);
