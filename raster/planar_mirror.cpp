@@ -63,6 +63,24 @@ std::vector<PlanarMirror> find_planar_mirrors(const Scene& scene, float toleranc
 
 namespace {
 
+// The samples of a mirrored view that `g`'s samples of mirror `object` show: the mirrored
+// camera sees the reflected rays left-right mirrored, so sample (x, y) of `g` shows sample
+// (w − 1 − x, y) of the view (the same size).
+std::vector<std::uint8_t> samples_shown_by(const GBuffer& g, std::uint32_t object) {
+  const std::size_t w = static_cast<std::size_t>(g.width);
+  std::vector<std::uint8_t> shown(g.object.pixels.size(), 0);
+  for (std::size_t row = 0; row < shown.size(); row += w)
+    for (std::size_t x = 0; x < w; ++x) shown[row + w - 1 - x] = g.object.pixels[row + x] == object;
+  return shown;
+}
+
+// Only the samples a view's parent shows are composited, so the others are made background:
+// no pass lights, searches or recurses from them (their values were never read).
+void keep_samples(GBuffer& g, const std::vector<std::uint8_t>& keep) {
+  for (std::size_t i = 0; i < keep.size(); ++i)
+    if (!keep[i]) g.object.pixels[i] = g.reflector.pixels[i] = kNoId;
+}
+
 // Phase one of the recursion: every view rendered, lit and searched, depth-first in mirror
 // order (which views fit max_views does not depend on threads).
 struct ViewRecursion {
@@ -112,7 +130,9 @@ struct ViewRecursion {
       PlanarMirrorView& view = out.views[child];
       const VisibilityBuffer vis = render_visibility(executor, view_scene, mirrored, settings.width, settings.height);
       view.g = resolve_gbuffer(executor, view_scene, vis, mirrored.eye);
-      view.direct = direct_light(executor, view_scene, view.g, mirrored, shadows, env);
+      const std::vector<std::uint8_t> shown = samples_shown_by(g, mirror.object);
+      keep_samples(view.g, shown);
+      view.direct = direct_light(executor, view_scene, view.g, mirrored, shadows, env, &shown);
       add(child, out.views[child].g, mirrored, level + 1);
     }
   }

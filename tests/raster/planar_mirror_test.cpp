@@ -287,11 +287,62 @@ TEST(PlanarMirror, MirrorsThatSeeEachOtherStopAtTheViewBudget) {
   EXPECT_EQ(budget_stats2.mirrored_views, budget_stats.mirrored_views);
   EXPECT_EQ(budget_stats2.views_over_budget, budget_stats.views_over_budget);
   EXPECT_EQ(0, std::memcmp(a.pixels.data(), b.pixels.data(), a.size() * sizeof(glm::vec4)));
-  // Depth 8 with the default budget: bounded by it.
-  PlanarMirrorStats deep;
-  run(two, 8, PlanarMirrorSettings{}.max_views, deep);
-  EXPECT_EQ(deep.mirrored_views, static_cast<std::uint64_t>(PlanarMirrorSettings{}.max_views));
+  // Depth 8: more views than depth 3 (fewer than 3^8: a view renders only what its parent's
+  // mirror shows, and the images of the corner shrink to nothing), and a budget bounds them.
+  PlanarMirrorStats deep_free, deep;
+  run(two, 8, 1 << 20, deep_free);
+  EXPECT_GT(deep_free.mirrored_views, free_stats.mirrored_views);
+  EXPECT_EQ(deep_free.views_over_budget, 0u);
+  const int deep_budget = static_cast<int>(deep_free.mirrored_views / 2);
+  run(two, 8, deep_budget, deep);
+  EXPECT_EQ(deep.mirrored_views, static_cast<std::uint64_t>(deep_budget));
   EXPECT_GT(deep.views_over_budget, 0u);
+}
+
+// A mirrored view keeps only the samples its parent's mirror shows (sample (x, y) of the
+// parent shows (w − 1 − x, y)): the others are background, so nothing lights or searches
+// them; the kept ones are the whole view's.
+TEST(PlanarMirror, MirroredViewsKeepOnlyTheSamplesTheirParentShows) {
+  par::Executor ex(2);
+  const Scene s = load_scene("mirror-corridor");
+  const int w = 96, h = 72;
+  const EnvironmentMap env = build_environment(ex, s.environment);
+  const ShadowMaps shadows = render_shadow_maps(ex, s, 64);
+  const auto mirrors = find_planar_mirrors(s);
+  PlanarMirrorSettings settings;
+  settings.depth = 2;
+  std::vector<Camera> cameras{s.cameras.front()};  // per view
+  const GBuffer g = resolve_gbuffer(ex, s, render_visibility(ex, s, cameras[0], w, h), cameras[0].eye);
+  const PlanarMirrorViews views = planar_mirror_views(ex, s, mirrors, g, cameras[0], shadows, env, nullptr, settings);
+  ASSERT_GT(views.views.size(), 2u);
+  cameras.resize(views.views.size());
+  for (std::size_t v = 0; v < views.views.size(); ++v) {
+    const GBuffer& parent = v == 0 ? g : views.views[v].g;
+    for (const auto& [k, child] : views.views[v].mirrored) {
+      ASSERT_GT(child, v);  // depth-first: a view's children come after it
+      const PlanarMirror& mirror = mirrors[k];
+      cameras[child] = mirrored_camera(cameras[v], mirror.plane);
+      const Scene& clipped = mirror.clipped_for(cameras[v].eye);
+      const GBuffer whole = resolve_gbuffer(ex, clipped, render_visibility(ex, clipped, cameras[child], w, h),
+                                            cameras[child].eye);
+      const PlanarMirrorView& view = views.views[child];
+      std::size_t kept = 0;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y * w + x), flipped = static_cast<std::size_t>(y * w + w - 1 - x);
+          const bool shown = parent.object.pixels[flipped] == mirror.object;
+          kept += view.g.covered(i);
+          if (shown) {
+            ASSERT_EQ(view.g.object.pixels[i], whole.object.pixels[i]) << "view " << child << " sample " << x << "," << y;
+            if (whole.covered(i)) EXPECT_EQ(view.g.position.pixels[i], whole.position.pixels[i]);
+          } else {
+            EXPECT_FALSE(view.g.covered(i)) << "view " << child << " sample " << x << "," << y;
+            EXPECT_EQ(view.direct.pixels[i], glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+          }
+        }
+      EXPECT_GT(kept, 0u) << "view " << child;
+    }
+  }
 }
 
 // The curved reflectors' maps shaded only where the searches of every view (the camera's and
