@@ -53,8 +53,8 @@ struct MaterialInfo {
 };
 
 // Per material, for the 8-lane path: one word gathered by material index whose bits say
-// simple, keep_side (refractor) and specular.
-constexpr std::uint32_t kLaneSimple = 1, kLaneKeepSide = 2, kLaneSpecular = 4;
+// simple, keep_side (refractor), specular and colour_textured.
+constexpr std::uint32_t kLaneSimple = 1, kLaneKeepSide = 2, kLaneSpecular = 4, kLaneColourTextured = 8;
 
 struct SampleContext {
   const Scene& scene;
@@ -295,17 +295,18 @@ inline void store_vec3x8(glm::vec3* dst, __m256 x, __m256 y, __m256 z) {
   }
 }
 
-// interpolate_sample for 8 covered samples i .. i+7 of simple materials at once, the
-// triangles' corners gathered from their records in lanes: the same IEEE operations per
-// component in the same order (b0 = (1 − b1) − b2, then (b0·a0 + b1·a1) + b2·a2), so the
-// same bytes. Returns kGroupSkipped, writing nothing, if a sample is background or not
-// simple; kGroupNormalsPending when a normal is degenerate (the normals are then left in
-// `lanes` for the block's normal step).
+// interpolate_sample for 8 covered samples i .. i+7 of simple or colour-textured materials
+// at once, the triangles' corners gathered from their records in lanes: the same IEEE
+// operations per component in the same order (b0 = (1 − b1) − b2, then
+// (b0·a0 + b1·a1) + b2·a2), so the same bytes; the colour-textured samples' texels are asked
+// for from the interpolated uv, as there. Returns kGroupSkipped, writing nothing, if a sample
+// is background or neither kind; kGroupNormalsPending when a normal is degenerate (the
+// normals are then left in `lanes` for the block's normal step).
 enum GroupResult { kGroupSkipped, kGroupDone, kGroupNormalsPending };
 inline GroupResult interpolate_group8(const SampleContext& c, const TriangleRecord* records,
                                const std::uint32_t* materials, std::size_t i,
                                const StagingBlock& out, detail::NormalLanes<kBlock>& lanes,
-                               std::size_t j) {
+                               std::size_t j, PendingColour& pending) {
   static_assert(sizeof(TriangleRecord) == 24 * sizeof(float) &&
                 offsetof(TriangleRecord, normal) == 36 && offsetof(TriangleRecord, uv) == 72,
                 "the gathers below index the record as 24 dwords");
@@ -322,7 +323,9 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
     const __m256i b = _mm256_set1_epi32(static_cast<int>(bit));
     return _mm256_cmpeq_epi32(_mm256_and_si256(flags, b), b);
   };
-  if (_mm256_movemask_ps(_mm256_castsi256_ps(has(kLaneSimple))) != 0xff) return kGroupSkipped;
+  const __m256i colour_textured = has(kLaneColourTextured);
+  if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(has(kLaneSimple), colour_textured))) != 0xff)
+    return kGroupSkipped;
   const __m256i keep = has(kLaneKeepSide), specular = has(kLaneSpecular);
   // Barycentrics (b1, b2) of 8 samples, de-interleaved.
   const float* bary = &c.vis.bary.pixels[i].x;
@@ -374,6 +377,19 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   _mm256_storeu_ps(uv, _mm256_permute2f128_ps(uv_lo, uv_hi, 0x20));
   _mm256_storeu_ps(uv + 8, _mm256_permute2f128_ps(uv_lo, uv_hi, 0x31));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.surface + j), mat);  // simple: the shared entry
+  // The colour-textured samples: their own entry, its base colour after the block (as in
+  // interpolate_sample).
+  for (int textured = _mm256_movemask_ps(_mm256_castsi256_ps(colour_textured)); textured != 0;
+       textured &= textured - 1) {
+    const int k = std::countr_zero(static_cast<unsigned>(textured));
+    const std::size_t at = i + static_cast<std::size_t>(k);
+    const std::uint32_t m = out.surface[j + k];
+    const BilinearTaps taps = texture_taps(c.scene, c.scene.materials[m].base_color_texture, out.uv[j + k],
+                                           second_uv(c.m, c.vis.triangle.pixels[at], c.vis.bary.pixels[at]));
+    taps.prefetch();
+    pending.add(at, m, taps);
+    out.surface[j + k] = SurfacePlane::kOwn;
+  }
   return all_valid ? kGroupDone : kGroupNormalsPending;
 }
 
@@ -418,7 +434,7 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
       const std::size_t i = b + j;
       if constexpr (std::is_same_v<Corners, RecordCorners>) {
         const GroupResult group =
-            j + 8 <= n ? interpolate_group8(c, corners.records, corners.materials, i, blk, lanes, j)
+            j + 8 <= n ? interpolate_group8(c, corners.records, corners.materials, i, blk, lanes, j, pending)
                        : kGroupSkipped;
         if (group != kGroupSkipped) {
           for (std::size_t k = i; k < i + 8; ++k) prefetch_at(k + kPrefetchAhead);
@@ -515,7 +531,7 @@ void resolve(par::Executor& executor, const Scene& scene, const GBufferTriangles
     any_textured |= info.textured;
     g.surface.shared.push_back(info.constant);
     materials.push_back(info);
-    material_flags.push_back((info.simple ? kLaneSimple : 0u) |
+    material_flags.push_back((info.simple ? kLaneSimple : 0u) | (info.colour_textured ? kLaneColourTextured : 0u) |
                                    (info.keep_side ? kLaneKeepSide : 0u) |
                                    (info.specular ? kLaneSpecular : 0u));
   }

@@ -184,8 +184,11 @@ float texel_reach(int size) { return 2.0f * 1.4142136f / static_cast<float>(size
 // face's plane. One texel more absorbs rounding.
 // `whole` (bit f: face f marked whole already) spares a caller marking many directions the
 // repeated whole-face marks.
+// `last` (may be null): per face the rectangle of tiles the caller's previous mark set there
+// (x0, y0, x1, y1), updated here; a rectangle within it is not marked again.
 void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int tile, int n, int size,
-               const glm::vec3& d, float margin, unsigned& whole) {
+               const glm::vec3& d, float margin, unsigned& whole,
+               std::array<std::array<int, 4>, kCubeFaces>* last = nullptr) {
   const unsigned faces = cube_faces_near(d, margin) & ~whole;
   constexpr float kFaceHalfAngle = 0.95531662f;  // acos(1/√3)
   for (int f = 0; f < kCubeFaces; ++f) {
@@ -205,6 +208,11 @@ void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int til
     if (!(hi_x >= 0.0f && hi_y >= 0.0f && lo_x < float(n) && lo_y < float(n))) continue;
     const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(n - 1, static_cast<int>(hi_x));
     const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(n - 1, static_cast<int>(hi_y));
+    if (last) {
+      std::array<int, 4>& r = (*last)[f];
+      if (x0 >= r[0] && y0 >= r[1] && x1 <= r[2] && y1 <= r[3]) continue;
+      r = {x0, y0, x1, y1};
+    }
     for (int y = y0; y <= y1; ++y) mark(t, static_cast<std::size_t>(y) * n + x0, static_cast<std::size_t>(x1 - x0 + 1));
   }
 }
@@ -343,7 +351,9 @@ CubeTileMask tile_mask_for_reads(int size, int level_count) {
   return mask;
 }
 
-LookupTileMarker::LookupTileMarker(CubeTileMask& mask, int level_count) : mask_(mask), level_count_(level_count) {}
+LookupTileMarker::LookupTileMarker(CubeTileMask& mask, int level_count) : mask_(mask), level_count_(level_count) {
+  for (std::array<int, 4>& r : last_marked_) r = {0, 0, -1, -1};
+}
 
 void LookupTileMarker::mark(const glm::vec3& d, float exponent) {
   const int size = mask_.size, n_tiles = mask_.tiles_per_side();
@@ -364,7 +374,7 @@ void LookupTileMarker::mark(const glm::vec3& d, float exponent) {
   if (whole_ == 0x3fu) return;  // every face marked whole: nothing left to mark
   const glm::vec3 r = glm::normalize(d);
   if (level0_) mark_taps(mask_.tiles, mask_.tile, n_tiles, size, r, whole_);
-  else mark_near(mask_.tiles, mask_.tile, n_tiles, size, r, margin_, whole_);
+  else mark_near(mask_.tiles, mask_.tile, n_tiles, size, r, margin_, whole_, &last_marked_);
 }
 
 void settle_wide_reads(par::Executor& executor, CubeTileMask& mask) {

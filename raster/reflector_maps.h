@@ -156,6 +156,10 @@ class LookupTileMarker {
   bool wide_ = false;   // the reach is recorded per coarse cell (settle_wide_reads)
   unsigned whole_ = 0;  // faces found marked whole
   unsigned marks_ = 0;
+  // Per face the last rectangle of tiles this marker marked (x0, y0, x1, y1; empty at first):
+  // a neighbouring sample's read usually reaches the same tiles, which are then not walked
+  // again.
+  std::array<std::array<int, 4>, kCubeFaces> last_marked_{};
 };
 
 // Marks the tiles within reach of the coarse cells LookupTileMarker recorded in `mask`: a
