@@ -494,17 +494,124 @@ glm::dvec3 caustic_map_flux(const CubeMap& map) {
   return sum;
 }
 
-CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const CausticPhotons& photons,
+// Stores the photons of image `img` into its map (target), in the order of its texels. A
+// splat lands on the face of its photon's direction alone: with `only_face` ≥ 0 only the
+// splats onto that face are made (faces stored side by side get the sums of one pass).
+void store_photon_image(const PhotonImage& img, MapTarget& target, const CausticMapOptions& opt,
+                        std::vector<TexelShare>& scratch, int only_face = -1) {
+  CubeMap& m = target.m;
+  const int res = img.res;
+  auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
+  if (opt.filter == CausticFilter::Splat) {
+    for (int y = 0; y < res; ++y)
+      for (int x = 0; x < res; ++x) {
+        const std::size_t i = idx(x, y);
+        if (!img.valid[i]) continue;
+        const glm::vec3 d = img.hit[i] - m.centre;
+        const CubeCoord c = cube_coord(d, m.size);  // what splat() finds again
+        if (only_face >= 0 && c.face != only_face) continue;
+        const float dist = glm::length(d);
+        int radius = opt.splat_radius;
+        if (opt.adaptive) {
+          // The photon's reach: the farthest of its photon-image neighbours on the same
+          // receiver (distances within 20 %), in caustic-map texels, so sparse photons
+          // leave no holes and dense ones stay sharp.
+          float spacing = 0.0f;
+          const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+          for (int k = 0; k < 4; ++k) {
+            if (nx[k] < 0 || ny[k] < 0 || nx[k] >= res || ny[k] >= res) continue;
+            const std::size_t j = idx(nx[k], ny[k]);
+            if (!img.valid[j]) continue;
+            const glm::vec3 dj = img.hit[j] - m.centre;
+            const float lj = glm::length(dj);
+            if (std::max(lj, dist) > 1.2f * std::min(lj, dist)) continue;
+            glm::vec2 pj;
+            if (face_pixel(dj, c.face, m.size, pj)) spacing = std::max(spacing, glm::length(pj - c.pixel));
+          }
+          radius = std::max(radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
+        }
+        splat(target, d, img.flux[i], dist, img.wi[i], radius);
+      }
+    return;
+  }
+  // Caustic triangles (§6.3.2): a cell of four neighbouring photons whose receiver
+  // distances agree within 20 % (one receiver surface) makes two triangles, drawn on the
+  // face of the cell's mean direction. Each photon's flux is shared equally by the cells it
+  // is a corner of; a photon in none is splatted into its texel.
+  const int cells = res - 1;
+  std::vector<std::uint8_t> cell_ok(static_cast<std::size_t>(std::max(cells, 0)) * std::max(cells, 0), 0);
+  std::vector<float> dists(img.valid.size(), 0.0f);
+  for (std::size_t i = 0; i < img.valid.size(); ++i)
+    if (img.valid[i]) dists[i] = glm::length(img.hit[i] - m.centre);
+  std::vector<int> corner_of(img.valid.size(), 0);
+  for (int y = 0; y < cells; ++y)
+    for (int x = 0; x < cells; ++x) {
+      const std::size_t c[4] = {idx(x, y), idx(x + 1, y), idx(x + 1, y + 1), idx(x, y + 1)};
+      bool ok = true;
+      float lo = kInf, hi = 0.0f;
+      for (std::size_t k : c) {
+        ok = ok && img.valid[k];
+        lo = std::min(lo, dists[k]);
+        hi = std::max(hi, dists[k]);
+      }
+      if (!ok || hi > 1.2f * lo) continue;
+      cell_ok[static_cast<std::size_t>(y) * cells + x] = 1;
+      for (std::size_t k : c) ++corner_of[k];
+    }
+  for (std::size_t i = 0; i < img.valid.size(); ++i)
+    if (img.valid[i] && corner_of[i] == 0) splat(target, img.hit[i] - m.centre, img.flux[i], dists[i], img.wi[i], 0);
+  for (int y = 0; y < cells; ++y)
+    for (int x = 0; x < cells; ++x) {
+      if (!cell_ok[static_cast<std::size_t>(y) * cells + x]) continue;
+      const std::size_t c[4] = {idx(x, y), idx(x + 1, y), idx(x + 1, y + 1), idx(x, y + 1)};
+      glm::vec3 flux(0.0f), wi(0.0f);
+      float dist = 0.0f;
+      glm::vec2 p[4];
+      glm::vec3 mean_dir(0.0f);
+      for (int k = 0; k < 4; ++k) {
+        flux += img.flux[c[k]] / static_cast<float>(corner_of[c[k]]);
+        dist += 0.25f * dists[c[k]];
+        wi += 0.25f * img.wi[c[k]];
+        mean_dir += (img.hit[c[k]] - m.centre) / dists[c[k]];
+      }
+      const int face = cube_coord(mean_dir, m.size).face;
+      bool projected = true;
+      for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, face, m.size, p[k]);
+      if (!projected) {  // a cell wider than a face's half space: its corners as points
+        for (int k = 0; k < 4; ++k)
+          splat(target, img.hit[c[k]] - m.centre, img.flux[c[k]] / static_cast<float>(corner_of[c[k]]), dists[c[k]],
+                img.wi[c[k]], 0);
+        continue;
+      }
+      const glm::vec2 t0[3] = {p[0], p[1], p[2]}, t1[3] = {p[0], p[2], p[3]};
+      raster_triangle(target, face, t0, flux * 0.5f, dist, wi, scratch);
+      raster_triangle(target, face, t1, flux * 0.5f, dist, wi, scratch);
+    }
+}
+
+// Face f's flux-weighted mean distances (+inf where nothing landed) and unit incident
+// directions; the weights' sums are done with.
+void finish_face(CubeMap& m, CubeDirections& incident, int f) {
+  for (std::size_t i = 0; i < m.distance[f].pixels.size(); ++i) {
+    glm::vec4& c = m.colour[f].pixels[i];
+    float& d = m.distance[f].pixels[i];
+    glm::vec3& wi = incident[f].pixels[i];
+    d = c.w > 0.0f ? d / c.w : kInf;
+    wi = glm::dot(wi, wi) > 0.0f ? glm::normalize(wi) : glm::vec3(0.0f);
+    c.w = 1.0f;
+  }
+}
+
+CausticMaps build_caustic_maps(par::Executor& executor, const Scene& scene, const CausticPhotons& photons,
                                const CausticMapOptions& opt) {
   if (opt.size < 1 || opt.size > 4096) throw InputError("caustic_map", "size out of range (1..4096)");
   CausticMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
-  std::vector<TexelShare> scratch;
-  // One map per generator (cube storage), or per generator and light (light storage).
+  // One map per generator (cube storage), or per generator and light (light storage), in the
+  // order the images first name them; each map's images in image order.
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> map_index;
+  std::vector<std::vector<const PhotonImage*>> images_of;
   const bool light_space = opt.storage == CausticStorage::Light;
-  // The photons land in the order of the images and their texels (a serial blend stage:
-  // the same sums for any thread count).
   for (const PhotonImage& img : photons.images) {
     const std::pair<std::uint32_t, std::uint32_t> key{img.object, light_space ? img.light : 0u};
     if (!map_index.count(key)) {
@@ -529,112 +636,27 @@ CausticMaps build_caustic_maps(par::Executor&, const Scene& scene, const Caustic
       CubeDirections inc;
       for (int f = 0; f < kCubeFaces; ++f) inc[f] = Buffer2D<glm::vec3>(opt.size, opt.size, glm::vec3(0.0f));
       out.incident.push_back(std::move(inc));
+      images_of.emplace_back();
     }
-    const std::size_t mi = map_index[key];
-    CubeMap& m = out.cubes[mi];
-    MapTarget target{m, out.incident[mi]};
-    const int res = img.res;
-    auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
-    if (opt.filter == CausticFilter::Splat) {
-      for (int y = 0; y < res; ++y)
-        for (int x = 0; x < res; ++x) {
-          const std::size_t i = idx(x, y);
-          if (!img.valid[i]) continue;
-          const glm::vec3 d = img.hit[i] - m.centre;
-          const float dist = glm::length(d);
-          int radius = opt.splat_radius;
-          if (opt.adaptive) {
-            // The photon's reach: the farthest of its photon-image neighbours on the same
-            // receiver (distances within 20 %), in caustic-map texels, so sparse photons
-            // leave no holes and dense ones stay sharp.
-            const CubeCoord c = cube_coord(d, m.size);
-            float spacing = 0.0f;
-            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-            for (int k = 0; k < 4; ++k) {
-              if (nx[k] < 0 || ny[k] < 0 || nx[k] >= res || ny[k] >= res) continue;
-              const std::size_t j = idx(nx[k], ny[k]);
-              if (!img.valid[j]) continue;
-              const glm::vec3 dj = img.hit[j] - m.centre;
-              const float lj = glm::length(dj);
-              if (std::max(lj, dist) > 1.2f * std::min(lj, dist)) continue;
-              glm::vec2 pj;
-              if (face_pixel(dj, c.face, m.size, pj)) spacing = std::max(spacing, glm::length(pj - c.pixel));
-            }
-            radius = std::max(radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
-          }
-          splat(target, d, img.flux[i], dist, img.wi[i], radius);
-        }
-      continue;
-    }
-    // Caustic triangles (§6.3.2): a cell of four neighbouring photons whose receiver
-    // distances agree within 20 % (one receiver surface) makes two triangles, drawn on the
-    // face of the cell's mean direction. Each photon's flux is shared equally by the cells it
-    // is a corner of; a photon in none is splatted into its texel.
-    const int cells = res - 1;
-    std::vector<std::uint8_t> cell_ok(static_cast<std::size_t>(std::max(cells, 0)) * std::max(cells, 0), 0);
-    std::vector<float> dists(img.valid.size(), 0.0f);
-    for (std::size_t i = 0; i < img.valid.size(); ++i)
-      if (img.valid[i]) dists[i] = glm::length(img.hit[i] - m.centre);
-    std::vector<int> corner_of(img.valid.size(), 0);
-    for (int y = 0; y < cells; ++y)
-      for (int x = 0; x < cells; ++x) {
-        const std::size_t c[4] = {idx(x, y), idx(x + 1, y), idx(x + 1, y + 1), idx(x, y + 1)};
-        bool ok = true;
-        float lo = kInf, hi = 0.0f;
-        for (std::size_t k : c) {
-          ok = ok && img.valid[k];
-          lo = std::min(lo, dists[k]);
-          hi = std::max(hi, dists[k]);
-        }
-        if (!ok || hi > 1.2f * lo) continue;
-        cell_ok[static_cast<std::size_t>(y) * cells + x] = 1;
-        for (std::size_t k : c) ++corner_of[k];
-      }
-    for (std::size_t i = 0; i < img.valid.size(); ++i)
-      if (img.valid[i] && corner_of[i] == 0) splat(target, img.hit[i] - m.centre, img.flux[i], dists[i], img.wi[i], 0);
-    for (int y = 0; y < cells; ++y)
-      for (int x = 0; x < cells; ++x) {
-        if (!cell_ok[static_cast<std::size_t>(y) * cells + x]) continue;
-        const std::size_t c[4] = {idx(x, y), idx(x + 1, y), idx(x + 1, y + 1), idx(x, y + 1)};
-        glm::vec3 flux(0.0f), wi(0.0f);
-        float dist = 0.0f;
-        glm::vec2 p[4];
-        glm::vec3 mean_dir(0.0f);
-        for (int k = 0; k < 4; ++k) {
-          flux += img.flux[c[k]] / static_cast<float>(corner_of[c[k]]);
-          dist += 0.25f * dists[c[k]];
-          wi += 0.25f * img.wi[c[k]];
-          mean_dir += (img.hit[c[k]] - m.centre) / dists[c[k]];
-        }
-        const int face = cube_coord(mean_dir, m.size).face;
-        bool projected = true;
-        for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, face, m.size, p[k]);
-        if (!projected) {  // a cell wider than a face's half space: its corners as points
-          for (int k = 0; k < 4; ++k)
-            splat(target, img.hit[c[k]] - m.centre, img.flux[c[k]] / static_cast<float>(corner_of[c[k]]), dists[c[k]],
-                  img.wi[c[k]], 0);
-          continue;
-        }
-        const glm::vec2 t0[3] = {p[0], p[1], p[2]}, t1[3] = {p[0], p[2], p[3]};
-        raster_triangle(target, face, t0, flux * 0.5f, dist, wi, scratch);
-        raster_triangle(target, face, t1, flux * 0.5f, dist, wi, scratch);
-      }
+    images_of[map_index[key]].push_back(&img);
   }
-  if (opt.filter == CausticFilter::Triangles)
-    for (std::size_t k = 0; k < out.cubes.size(); ++k) blur(out.cubes[k], out.incident[k]);
-  // Distances: the flux-weighted means; +inf where nothing landed.
-  for (std::size_t k = 0; k < out.cubes.size(); ++k)
-    for (int f = 0; f < kCubeFaces; ++f) {
-      CubeMap& m = out.cubes[k];
-      for (std::size_t i = 0; i < m.distance[f].pixels.size(); ++i) {
-        glm::vec4& c = m.colour[f].pixels[i];
-        float& d = m.distance[f].pixels[i];
-        glm::vec3& wi = out.incident[k][f].pixels[i];
-        d = c.w > 0.0f ? d / c.w : kInf;
-        wi = glm::dot(wi, wi) > 0.0f ? glm::normalize(wi) : glm::vec3(0.0f);
-        c.w = 1.0f;
-      }
+  // The maps side by side (splats: each face of each map); in each the photons land in the
+  // order of its images and their texels (a serial blend per map or face: the same sums for
+  // any thread count).
+  const bool per_face = opt.filter == CausticFilter::Splat;
+  const std::size_t parts = per_face ? kCubeFaces : 1;
+  executor.parallel_for("caustic_map.store", out.cubes.size() * parts, 1, [&](std::size_t begin, std::size_t end) {
+    std::vector<TexelShare> scratch;
+    for (std::size_t task = begin; task < end; ++task) {
+      const std::size_t k = task / parts;
+      const int face = per_face ? static_cast<int>(task % parts) : -1;
+      MapTarget target{out.cubes[k], out.incident[k]};
+      for (const PhotonImage* img : images_of[k]) store_photon_image(*img, target, opt, scratch, face);
+      if (!per_face) blur(out.cubes[k], out.incident[k]);
+      for (int f = 0; f < kCubeFaces; ++f)
+        if (face < 0 || f == face) finish_face(out.cubes[k], out.incident[k], f);
     }
+  });
   return out;
 }
 
