@@ -20,6 +20,7 @@
 #include "raster/frame_plane.h"
 #include "raster/gbuffer_normals.h"
 #include "raster/gbuffer_stream.h"
+#include "raster/transpose8.h"
 
 namespace speculum::raster {
 namespace {
@@ -157,6 +158,12 @@ struct RecordCorners {
   }
 };
 
+// The unit normal of the triangle's plane (corner order): for a degenerate interpolated normal.
+glm::vec3 face_normal(const TriangleRecord& r) {
+  const glm::vec3 a = r.corner[0].position;
+  return glm::normalize(glm::cross(r.corner[1].position - a, r.corner[2].position - a));
+}
+
 // TEXCOORD_1 of triangle t at barycentrics (1 − b.x − b.y, b.x, b.y), from the mesh (the
 // records carry TEXCOORD_0 only); 0 when the mesh has none.
 glm::vec2 second_uv(const TriangleMesh& m, std::uint32_t t, glm::vec2 b) {
@@ -173,16 +180,15 @@ inline void resolve_sample(const SampleContext& c, std::size_t i, std::uint32_t 
   const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
   const float b0 = 1.0f - b.x - b.y;
-  auto lerp3 = [&](const auto& a) { return b0 * a[0] + b.x * a[1] + b.y * a[2]; };
-  const glm::vec3 p = lerp3(r.position);
-  glm::vec3 n = lerp3(r.normal);
+  const glm::vec3 p = r.lerp(&TriangleCorner::position, b0, b);
+  glm::vec3 n = r.lerp(&TriangleCorner::normal, b0, b);
   const float nl = glm::length(n);
   if (nl > 1e-12f) {
     n = n / nl;
   } else {  // degenerate interpolated normal: fall back to the face normal
-    n = glm::normalize(glm::cross(r.position[1] - r.position[0], r.position[2] - r.position[0]));
+    n = face_normal(r);
   }
-  const glm::vec2 uv = lerp3(r.uv);
+  const glm::vec2 uv = r.lerp(&TriangleCorner::uv, b0, b);
   const MaterialInfo& info = c.materials[mat];
   SurfaceParams sp;
   const glm::vec3 unmapped = n;  // decides the side (below); the map tilts within it
@@ -255,15 +261,14 @@ inline void interpolate_sample(const SampleContext& c, std::size_t i, std::uint3
   const std::uint32_t object = c.vis.object.pixels[i];
   const glm::vec2 b = c.vis.bary.pixels[i];
   const float b0 = 1.0f - b.x - b.y;
-  auto lerp3 = [&](const auto& a) { return b0 * a[0] + b.x * a[1] + b.y * a[2]; };
-  const glm::vec3 p = lerp3(r.position);
-  const glm::vec3 n = lerp3(r.normal);
+  const glm::vec3 p = r.lerp(&TriangleCorner::position, b0, b);
+  const glm::vec3 n = r.lerp(&TriangleCorner::normal, b0, b);
   lanes.nx[j] = n.x, lanes.ny[j] = n.y, lanes.nz[j] = n.z;
   lanes.px[j] = p.x, lanes.py[j] = p.y, lanes.pz[j] = p.z;
   lanes.keep_side[j] = info.keep_side;
   out.object[j] = object;
   out.position[j] = p;
-  const glm::vec2 uv = lerp3(r.uv);
+  const glm::vec2 uv = r.lerp(&TriangleCorner::uv, b0, b);
   out.uv[j] = uv;
   if (info.colour_textured) {  // its texels are asked for now and read after the block
     const BilinearTaps taps =
@@ -296,8 +301,8 @@ inline void store_vec3x8(glm::vec3* dst, __m256 x, __m256 y, __m256 z) {
 }
 
 // interpolate_sample for 8 covered samples i .. i+7 of simple or colour-textured materials
-// at once, the triangles' corners gathered from their records in lanes: the same IEEE
-// operations per component in the same order (b0 = (1 − b1) − b2, then
+// at once, each sample's attributes interpolated from its record's corners in one register:
+// the same IEEE operations per component in the same order (b0 = (1 − b1) − b2, then
 // (b0·a0 + b1·a1) + b2·a2), so the same bytes; the colour-textured samples' texels are asked
 // for from the interpolated uv, as there. Returns kGroupSkipped, writing nothing, if a sample
 // is background or neither kind; kGroupNormalsPending when a normal is degenerate (the
@@ -307,15 +312,12 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
                                const std::uint32_t* materials, std::size_t i,
                                const StagingBlock& out, detail::NormalLanes<kBlock>& lanes,
                                std::size_t j, PendingColour& pending) {
-  static_assert(sizeof(TriangleRecord) == 24 * sizeof(float) &&
-                offsetof(TriangleRecord, normal) == 36 && offsetof(TriangleRecord, uv) == 72,
-                "the gathers below index the record as 24 dwords");
+  static_assert(sizeof(TriangleRecord) == 24 * sizeof(float) && alignof(TriangleRecord) == 32 &&
+                    offsetof(TriangleCorner, normal) == 12 && offsetof(TriangleCorner, uv) == 24,
+                "the loads below read each corner as one register of 8 floats");
   const __m256i tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.triangle.pixels[i]));
   const __m256i none = _mm256_set1_epi32(static_cast<int>(kNoId));
   if (!_mm256_testz_si256(_mm256_cmpeq_epi32(tri, none), _mm256_cmpeq_epi32(tri, none))) return kGroupSkipped;
-  const float* base = reinterpret_cast<const float*>(records);
-  // Dword index of each record, 24·t (below 2^29: at most 2^24 triangles).
-  const __m256i at = _mm256_add_epi32(_mm256_slli_epi32(tri, 4), _mm256_slli_epi32(tri, 3));
   const __m256i mat = _mm256_i32gather_epi32(reinterpret_cast<const int*>(materials), tri, 4);
   const __m256i flags =
       _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.material_flags.data()), mat, 4);
@@ -333,18 +335,24 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   const __m256 b1 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0x88)), 0xd8));
   const __m256 b2 = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, 0xdd)), 0xd8));
   const __m256 b0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), b1), b2);
-  // Component `f` of corner 0 is dword f; corner k adds `stride`·k.
-  auto lerp = [&](int f, int stride) {
-    const __m256i k0 = _mm256_add_epi32(at, _mm256_set1_epi32(f));
-    const __m256 a0 = _mm256_i32gather_ps(base, k0, 4);
-    const __m256 a1 = _mm256_i32gather_ps(base, _mm256_add_epi32(k0, _mm256_set1_epi32(stride)), 4);
-    const __m256 a2 = _mm256_i32gather_ps(base, _mm256_add_epi32(k0, _mm256_set1_epi32(2 * stride)), 4);
-    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(b0, a0), _mm256_mul_ps(b1, a1)),
-                         _mm256_mul_ps(b2, a2));
-  };
-  const __m256 px = lerp(0, 3), py = lerp(1, 3), pz = lerp(2, 3);
-  const __m256 nx = lerp(9, 3), ny = lerp(10, 3), nz = lerp(11, 3);
-  const __m256 u = lerp(18, 2), v = lerp(19, 2);
+  // Each sample's attributes (position, normal, uv: a corner's eight floats) interpolated in
+  // one register from its record's three corners, then transposed to one register per
+  // component.
+  alignas(32) std::uint32_t triangle[8];
+  alignas(32) float w0[8], w1[8], w2[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(triangle), tri);
+  _mm256_store_ps(w0, b0), _mm256_store_ps(w1, b1), _mm256_store_ps(w2, b2);
+  __m256 sample[8], component[8];
+  for (int k = 0; k < 8; ++k) {
+    const float* corner = &records[triangle[k]].corner[0].position.x;
+    sample[k] = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_broadcast_ss(w0 + k), _mm256_load_ps(corner)),
+                                            _mm256_mul_ps(_mm256_broadcast_ss(w1 + k), _mm256_load_ps(corner + 8))),
+                              _mm256_mul_ps(_mm256_broadcast_ss(w2 + k), _mm256_load_ps(corner + 16)));
+  }
+  detail::transpose8(sample, component);
+  const __m256 px = component[0], py = component[1], pz = component[2];
+  const __m256 nx = component[3], ny = component[4], nz = component[5];
+  const __m256 u = component[6], v = component[7];
   // The normal step of normalize_and_face_eye in the same registers: the same operations.
   const __m256 len = _mm256_sqrt_ps(_mm256_add_ps(
       _mm256_add_ps(_mm256_mul_ps(nx, nx), _mm256_mul_ps(ny, ny)), _mm256_mul_ps(nz, nz)));
@@ -483,9 +491,7 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
       if (lanes.valid[j]) {
         blk.normal[j] = glm::vec3(lanes.nx[j], lanes.ny[j], lanes.nz[j]);
       } else {  // degenerate interpolated normal: the face normal, turned as in resolve_sample
-        const TriangleRecord& r = corners(tri[b + j]);
-        glm::vec3 fn = glm::normalize(
-            glm::cross(r.position[1] - r.position[0], r.position[2] - r.position[0]));
+        glm::vec3 fn = face_normal(corners(tri[b + j]));
         if (!lanes.keep_side[j] && glm::dot(fn, c.eye - blk.position[j]) < 0.0f) fn = -fn;
         blk.normal[j] = fn;
       }

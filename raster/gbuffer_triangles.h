@@ -16,15 +16,27 @@
 
 namespace speculum::raster {
 
+// One corner of a triangle: its vertex's position, normal and uv, eight floats, the order of
+// the G-buffer's interpolated attributes (so one 8-wide register interpolates a sample).
+struct TriangleCorner {
+  glm::vec3 position;
+  glm::vec3 normal;
+  glm::vec2 uv;
+};
+static_assert(sizeof(TriangleCorner) == 32);
+
 // The three corners of one triangle, copied bit for bit from the mesh arrays, so the resolve
 // reads 96 contiguous bytes (two cache lines, one prefetchable unit, shared with the
 // neighbouring records) instead of chasing indices → vertex arrays through five separate
 // allocations. The material index sits in a separate array: in the record it would pad it to
-// 128 bytes, a third more memory traffic for the resolve's gathers.
+// 128 bytes, a third more memory traffic for the resolve.
 struct alignas(32) TriangleRecord {
-  glm::vec3 position[3];
-  glm::vec3 normal[3];
-  glm::vec2 uv[3];
+  TriangleCorner corner[3];
+  // b0·a0 + b1·a1 + b2·a2 of a corner attribute (b = barycentrics (b1, b2), b0 = 1 − b1 − b2).
+  template <class T>
+  T lerp(T TriangleCorner::*attribute, float b0, glm::vec2 b) const {
+    return b0 * (corner[0].*attribute) + b.x * (corner[1].*attribute) + b.y * (corner[2].*attribute);
+  }
 };
 static_assert(sizeof(TriangleRecord) == 96);
 
@@ -33,9 +45,7 @@ inline TriangleRecord triangle_record(const TriangleMesh& m, std::uint32_t t) {
   TriangleRecord r;
   for (int k = 0; k < 3; ++k) {
     const std::uint32_t v = m.indices[3 * std::size_t(t) + k];
-    r.position[k] = m.positions[v];
-    r.normal[k] = m.normals[v];
-    r.uv[k] = m.uvs[v];
+    r.corner[k] = {m.positions[v], m.normals[v], m.uvs[v]};
   }
   return r;
 }

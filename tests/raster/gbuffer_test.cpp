@@ -311,9 +311,9 @@ TEST(GBuffer, TriangleRecordsCopyTheMeshCorners) {
   for (std::size_t t = 0; t < records.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = m.indices[3 * t + k];
-      EXPECT_TRUE(same_object_bytes(records[t].position[k], m.positions[v]));
-      EXPECT_TRUE(same_object_bytes(records[t].normal[k], m.normals[v]));
-      EXPECT_TRUE(same_object_bytes(records[t].uv[k], m.uvs[v]));
+      EXPECT_TRUE(same_object_bytes(records[t].corner[k].position, m.positions[v]));
+      EXPECT_TRUE(same_object_bytes(records[t].corner[k].normal, m.normals[v]));
+      EXPECT_TRUE(same_object_bytes(records[t].corner[k].uv, m.uvs[v]));
     }
     EXPECT_EQ(records.materials()[t], m.triangle_material[t]);
   }

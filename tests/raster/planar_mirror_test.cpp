@@ -334,7 +334,9 @@ TEST(PlanarMirror, MirroredViewsKeepOnlyTheSamplesTheirParentShows) {
           kept += view.g.covered(i);
           if (shown) {
             ASSERT_EQ(view.g.object.pixels[i], whole.object.pixels[i]) << "view " << child << " sample " << x << "," << y;
-            if (whole.covered(i)) EXPECT_EQ(view.g.position.pixels[i], whole.position.pixels[i]);
+            if (whole.covered(i)) {
+              EXPECT_EQ(view.g.position.pixels[i], whole.position.pixels[i]);
+            }
           } else {
             EXPECT_FALSE(view.g.covered(i)) << "view " << child << " sample " << x << "," << y;
             EXPECT_EQ(view.direct.pixels[i], glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));

@@ -168,7 +168,9 @@ TEST(ReflectorMaps, WideReadsMarkEveryTexelWithinTheirReach) {
         marked += static_cast<long long>(mask.texel_count(0x3fu));
         whole += static_cast<long long>(std::popcount(cube_faces_near(d, reach))) * size * size;
       }
-      if (reach < 1.0f) EXPECT_LT(marked * 10, whole * 9) << size << " " << exponent;
+      if (reach < 1.0f) {
+        EXPECT_LT(marked * 10, whole * 9) << size << " " << exponent;
+      }
       CubeTileMask all = tile_mask_for_reads(size, levels);
       LookupTileMarker first(all, levels), second(all, levels);
       for (std::size_t k = 0; k < directions.size(); ++k) (k % 2 ? first : second).mark(directions[k], exponent);
