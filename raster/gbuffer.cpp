@@ -318,9 +318,16 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   const __m256i tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.triangle.pixels[i]));
   const __m256i none = _mm256_set1_epi32(static_cast<int>(kNoId));
   if (!_mm256_testz_si256(_mm256_cmpeq_epi32(tri, none), _mm256_cmpeq_epi32(tri, none))) return kGroupSkipped;
-  const __m256i mat = _mm256_i32gather_epi32(reinterpret_cast<const int*>(materials), tri, 4);
+  alignas(32) std::uint32_t triangle[8], material[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(triangle), tri);
+  for (int k = 0; k < 8; ++k) material[k] = materials[triangle[k]];
+  const __m256i mat = _mm256_load_si256(reinterpret_cast<const __m256i*>(material));
+  // Eight samples of one material (most groups) read its flags once.
+  const __m256i first = _mm256_permutevar8x32_epi32(mat, _mm256_setzero_si256());
   const __m256i flags =
-      _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.material_flags.data()), mat, 4);
+      _mm256_movemask_epi8(_mm256_cmpeq_epi32(mat, first)) == -1
+          ? _mm256_set1_epi32(static_cast<int>(c.material_flags[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(mat))]))
+          : _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.material_flags.data()), mat, 4);
   auto has = [&](std::uint32_t bit) {
     const __m256i b = _mm256_set1_epi32(static_cast<int>(bit));
     return _mm256_cmpeq_epi32(_mm256_and_si256(flags, b), b);
@@ -338,9 +345,7 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   // Each sample's attributes (position, normal, uv: a corner's eight floats) interpolated in
   // one register from its record's three corners, then transposed to one register per
   // component.
-  alignas(32) std::uint32_t triangle[8];
   alignas(32) float w0[8], w1[8], w2[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(triangle), tri);
   _mm256_store_ps(w0, b0), _mm256_store_ps(w1, b1), _mm256_store_ps(w2, b2);
   __m256 sample[8], component[8];
   for (int k = 0; k < 8; ++k) {
