@@ -183,13 +183,17 @@ std::vector<std::uint8_t> read_texels(const CubeMapOptions& options, int face) {
 }
 
 // Resolves face `face`'s G-buffer from `vis` (the texels outside `read` already background)
-// and shades it.
+// and shades it (`s`: the scratch's G-buffer and records).
 ImageRGBA shade_face(par::Executor& executor, const Scene& scene, const CubeMap& cube, const CubeMapOptions& options,
                      int face, const VisibilityBuffer& vis, const std::vector<std::uint8_t>& read,
-                     const CubeFaceShader& shade, GBuffer& g) {
+                     const CubeFaceShader& shade, CubeMapScratch& s) {
   const Camera cam = cube_face_camera(face, cube.centre, options.znear, options.zfar);
-  resolve_gbuffer(executor, scene, vis, cube.centre, g);
-  return shade(g, cam, face, read.empty() ? nullptr : &read);
+  if (s.records_of != &scene.mesh) {
+    s.records = GBufferTriangles(executor, scene);
+    s.records_of = &scene.mesh;
+  }
+  resolve_gbuffer(executor, scene, s.records, vis, cube.centre, s.g);
+  return shade(s.g, cam, face, read.empty() ? nullptr : &read);
 }
 
 }  // namespace
@@ -241,7 +245,7 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
       kept.coverage = vis.coverage;
     }
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
-    if (shade) cube.colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s.g);
+    if (shade) cube.colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s);
   }
   return cube;
 }
@@ -281,7 +285,7 @@ std::array<ImageRGBA, kCubeFaces> shade_cube_faces(par::Executor& executor, cons
       std::copy(kept.bary.pixels.begin() + std::ptrdiff_t(begin), kept.bary.pixels.begin() + std::ptrdiff_t(end),
                 vis.bary.pixels.begin() + std::ptrdiff_t(begin));
     });
-    colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s.g);
+    colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s);
   }
   return colour;
 }
