@@ -418,6 +418,25 @@ inline void resolve_background(const SampleContext& c, std::size_t i, const Stag
   out.reflector[j] = kNoId;
 }
 
+// resolve_background for 8 samples i .. i+7 at once when all eight are background (a cube
+// face's texels outside the read tiles, the sky): true if it wrote them.
+inline bool background_group8(const SampleContext& c, std::size_t i, const StagingBlock& out, std::size_t j) {
+  const __m256i tri = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.triangle.pixels[i]));
+  const __m256i none = _mm256_set1_epi32(static_cast<int>(kNoId));
+  if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(tri, none)) != -1) return false;
+  const __m256 zero = _mm256_setzero_ps();
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.object + j),
+                      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(&c.vis.object.pixels[i])));
+  float* position = &out.position[j].x;
+  float* normal = &out.normal[j].x;
+  for (int k = 0; k < 24; k += 8) _mm256_storeu_ps(position + k, zero), _mm256_storeu_ps(normal + k, zero);
+  _mm256_storeu_ps(&out.uv[j].x, zero), _mm256_storeu_ps(&out.uv[j].x + 8, zero);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.surface + j),
+                      _mm256_set1_epi32(static_cast<int>(c.materials.size())));  // the background's entry
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.reflector + j), none);
+  return true;
+}
+
 // Resolves samples [begin, end) block by block; `corners` fetches and prefetches triangles.
 template <class Corners>
 void resolve_range(const SampleContext& c, const Corners& corners, std::size_t begin,
@@ -445,6 +464,15 @@ void resolve_range(const SampleContext& c, const Corners& corners, std::size_t b
     bool normals_pending = false;  // a sample left its normal to the block's normal step
     for (std::size_t j = 0; j < n; ++j) {
       const std::size_t i = b + j;
+      if (j + 8 <= n && background_group8(c, i, blk, j)) {
+        for (std::size_t k = i; k < i + 8; ++k) {
+          prefetch_indices_at(k + 2 * kPrefetchAhead);
+          prefetch_at(k + kPrefetchAhead);
+        }
+        std::fill(simple + j, simple + j + 8, false);  // their lanes are not read
+        j += 7;
+        continue;
+      }
       if constexpr (std::is_same_v<Corners, RecordCorners>) {
         const GroupResult group =
             j + 8 <= n ? interpolate_group8(c, corners.records, corners.materials, i, blk, lanes, j, pending)
