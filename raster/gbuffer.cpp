@@ -685,7 +685,11 @@ ImageF glossiness_image(const GBuffer& g) {
 }
 
 GBuffer GBufferPass::operator()(par::NodeContext& c, const VisibilityBuffer& visibility) const {
-  return resolve_gbuffer(c.executor(), *scene, visibility, eye);
+  // The records cost about one pass over the mesh and halve the resolve's time.
+  const GBufferTriangles records(c.executor(), *scene);
+  GBuffer g;
+  resolve_gbuffer(c.executor(), *scene, records, visibility, eye, g);
+  return g;
 }
 
 }  // namespace speculum::raster
