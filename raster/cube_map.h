@@ -189,7 +189,8 @@ struct CubeMapScratch {
   const TriangleMesh* groups_of = nullptr;
   // The scene's G-buffer records (gbuffer_triangles.h), built by the first face shaded with
   // this scratch: the faces' resolves read them instead of the mesh's index and vertex arrays
-  // (the same bytes, about half the time), the build paid once for all of them.
+  // (the same bytes, about half the time), the build paid once for all of them (meshes up to
+  // kMaxFrameRecordTriangles).
   GBufferTriangles records;
   const TriangleMesh* records_of = nullptr;
 };

@@ -686,6 +686,7 @@ ImageF glossiness_image(const GBuffer& g) {
 
 GBuffer GBufferPass::operator()(par::NodeContext& c, const VisibilityBuffer& visibility) const {
   // The records cost about one pass over the mesh and halve the resolve's time.
+  if (scene->mesh.triangle_count() > kMaxFrameRecordTriangles) return resolve_gbuffer(c.executor(), *scene, visibility, eye);
   const GBufferTriangles records(c.executor(), *scene);
   GBuffer g;
   resolve_gbuffer(c.executor(), *scene, records, visibility, eye, g);

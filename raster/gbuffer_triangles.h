@@ -50,6 +50,10 @@ inline TriangleRecord triangle_record(const TriangleMesh& m, std::uint32_t t) {
   return r;
 }
 
+// A frame builds records (96 bytes a triangle) for meshes of at most this many triangles
+// (384 MiB of records); larger meshes resolve from the mesh arrays.
+constexpr std::size_t kMaxFrameRecordTriangles = std::size_t(1) << 22;
+
 // The records of one mesh in huge-page-backed memory (random gathers over 100+ MB would
 // otherwise miss the TLB on nearly every sample). Valid only while the mesh is unchanged:
 // rebuild it after editing the scene.
