@@ -2,6 +2,7 @@
 #include "raster/soff.h"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <utility>
 
@@ -404,11 +405,12 @@ struct DepthImageCounts {
   std::uint64_t set_up = 0, culled = 0;
 };
 
-// Cluster camera `cam`'s depth image into out's pixels from `base` on.
+// Cluster camera `cam`'s depth image into out's pixels from `base` on. `records` (may be
+// null: the mesh arrays) are the scene's G-buffer records.
 DepthImageCounts render_depth_image(par::Executor& executor, const Scene& scene, const std::vector<CullGroup>& groups,
                                     std::uint32_t reflector, const SoffCamera& cam, const SurfaceShader& shade,
                                     const EnvironmentMap& env, std::size_t base, DepthImageScratch& s,
-                                    SoffDepthImages& out) {
+                                    SoffDepthImages& out, const GBufferTriangles* records) {
   const TriangleMesh& m = scene.mesh;
   DepthImageCounts counts;
   // Cull per cluster frustum before setup: whole groups outside one plane are dropped,
@@ -462,7 +464,8 @@ DepthImageCounts render_depth_image(par::Executor& executor, const Scene& scene,
     for (std::size_t i = begin; i < end; ++i)
       if (vis.triangle.pixels[i] != kNoId) vis.triangle.pixels[i] = s.kept[vis.triangle.pixels[i]];
   });
-  resolve_gbuffer(executor, scene, vis, cam.eye, s.gb);
+  if (records) resolve_gbuffer(executor, scene, *records, vis, cam.eye, s.gb);
+  else resolve_gbuffer(executor, scene, vis, cam.eye, s.gb);
   const GBuffer& gb = s.gb;
   executor.parallel_for("soff_depth_images.shade", gb.object.size(), 2048, [&](std::size_t begin, std::size_t end) {
     shade.shade_samples(
@@ -538,9 +541,14 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
   const auto pixels = [&](std::size_t c) { return out.offsets[c + 1] - out.offsets[c]; };
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pixels(a) > pixels(b); });
   std::vector<DepthImageCounts> counts(cameras.size());
+  // The images' resolves read the scene's records (the same bytes, about half the time).
+  const std::optional<GBufferTriangles> records =
+      scene.mesh.triangle_count() <= kMaxFrameRecordTriangles && !order.empty()
+          ? std::optional<GBufferTriangles>(std::in_place, executor, scene)
+          : std::nullopt;
   const auto render = [&](par::Executor& on, std::size_t c, DepthImageScratch& scratch) {
     counts[c] = render_depth_image(on, scene, groups, clusters.reflector[c], cameras[c], shade, env, out.offsets[c],
-                                   scratch, out);
+                                   scratch, out, records ? &*records : nullptr);
   };
   std::size_t large = 0;
   DepthImageScratch scratch;
