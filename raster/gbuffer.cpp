@@ -323,11 +323,10 @@ inline GroupResult interpolate_group8(const SampleContext& c, const TriangleReco
   for (int k = 0; k < 8; ++k) material[k] = materials[triangle[k]];
   const __m256i mat = _mm256_load_si256(reinterpret_cast<const __m256i*>(material));
   // Eight samples of one material (most groups) read its flags once.
-  const __m256i first = _mm256_permutevar8x32_epi32(mat, _mm256_setzero_si256());
+  const bool one_material = _mm256_movemask_epi8(_mm256_cmpeq_epi32(mat, _mm256_set1_epi32(static_cast<int>(material[0])))) == -1;
   const __m256i flags =
-      _mm256_movemask_epi8(_mm256_cmpeq_epi32(mat, first)) == -1
-          ? _mm256_set1_epi32(static_cast<int>(c.material_flags[static_cast<std::uint32_t>(_mm256_cvtsi256_si32(mat))]))
-          : _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.material_flags.data()), mat, 4);
+      one_material ? _mm256_set1_epi32(static_cast<int>(c.material_flags[material[0]]))
+                   : _mm256_i32gather_epi32(reinterpret_cast<const int*>(c.material_flags.data()), mat, 4);
   auto has = [&](std::uint32_t bit) {
     const __m256i b = _mm256_set1_epi32(static_cast<int>(bit));
     return _mm256_cmpeq_epi32(_mm256_and_si256(flags, b), b);
