@@ -81,10 +81,10 @@ void deposit(MapTarget& t, int face, int x, int y, const glm::vec3& flux, float 
 }
 
 // A photon's flux spread by a tent kernel of `radius` texels about its continuous pixel
-// position, the weights normalized over the texels of its face (so they sum to one).
-void splat(MapTarget& t, const glm::vec3& dir, const glm::vec3& flux, float dist, const glm::vec3& wi, int radius) {
+// position c (cube_coord of its direction from the map's centre), the weights normalized over
+// the texels of its face (so they sum to one).
+void splat(MapTarget& t, const CubeCoord& c, const glm::vec3& flux, float dist, const glm::vec3& wi, int radius) {
   const CubeMap& m = t.m;
-  const CubeCoord c = cube_coord(dir, m.size);
   const int cx = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
   const int cy = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
   if (radius <= 0) {
@@ -495,8 +495,9 @@ glm::dvec3 caustic_map_flux(const CubeMap& map) {
 }
 
 // Stores the photons of image `img` into its map (target), in the order of its texels. A
-// splat lands on the face of its photon's direction alone: with `only_face` ≥ 0 only the
-// splats onto that face are made (faces stored side by side get the sums of one pass).
+// splat lands on the face of its photon's direction alone: with the splat filter and
+// `only_face` ≥ 0 only the splats onto that face are made (faces stored side by side get the
+// sums of one pass). Caustic triangles are stored on every face (`only_face` −1).
 void store_photon_image(const PhotonImage& img, MapTarget& target, const CausticMapOptions& opt,
                         std::vector<TexelShare>& scratch, int only_face = -1) {
   CubeMap& m = target.m;
@@ -508,7 +509,7 @@ void store_photon_image(const PhotonImage& img, MapTarget& target, const Caustic
         const std::size_t i = idx(x, y);
         if (!img.valid[i]) continue;
         const glm::vec3 d = img.hit[i] - m.centre;
-        const CubeCoord c = cube_coord(d, m.size);  // what splat() finds again
+        const CubeCoord c = cube_coord(d, m.size);
         if (only_face >= 0 && c.face != only_face) continue;
         const float dist = glm::length(d);
         int radius = opt.splat_radius;
@@ -530,7 +531,7 @@ void store_photon_image(const PhotonImage& img, MapTarget& target, const Caustic
           }
           radius = std::max(radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
         }
-        splat(target, d, img.flux[i], dist, img.wi[i], radius);
+        splat(target, c, img.flux[i], dist, img.wi[i], radius);
       }
     return;
   }
@@ -559,7 +560,7 @@ void store_photon_image(const PhotonImage& img, MapTarget& target, const Caustic
       for (std::size_t k : c) ++corner_of[k];
     }
   for (std::size_t i = 0; i < img.valid.size(); ++i)
-    if (img.valid[i] && corner_of[i] == 0) splat(target, img.hit[i] - m.centre, img.flux[i], dists[i], img.wi[i], 0);
+    if (img.valid[i] && corner_of[i] == 0) splat(target, cube_coord(img.hit[i] - m.centre, m.size), img.flux[i], dists[i], img.wi[i], 0);
   for (int y = 0; y < cells; ++y)
     for (int x = 0; x < cells; ++x) {
       if (!cell_ok[static_cast<std::size_t>(y) * cells + x]) continue;
@@ -579,8 +580,8 @@ void store_photon_image(const PhotonImage& img, MapTarget& target, const Caustic
       for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, face, m.size, p[k]);
       if (!projected) {  // a cell wider than a face's half space: its corners as points
         for (int k = 0; k < 4; ++k)
-          splat(target, img.hit[c[k]] - m.centre, img.flux[c[k]] / static_cast<float>(corner_of[c[k]]), dists[c[k]],
-                img.wi[c[k]], 0);
+          splat(target, cube_coord(img.hit[c[k]] - m.centre, m.size), img.flux[c[k]] / static_cast<float>(corner_of[c[k]]),
+                dists[c[k]], img.wi[c[k]], 0);
         continue;
       }
       const glm::vec2 t0[3] = {p[0], p[1], p[2]}, t1[3] = {p[0], p[2], p[3]};

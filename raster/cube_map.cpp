@@ -188,15 +188,7 @@ ImageRGBA shade_face(par::Executor& executor, const Scene& scene, const CubeMap&
                      int face, const VisibilityBuffer& vis, const std::vector<std::uint8_t>& read,
                      const CubeFaceShader& shade, CubeMapScratch& s) {
   const Camera cam = cube_face_camera(face, cube.centre, options.znear, options.zfar);
-  if (scene.mesh.triangle_count() > kMaxFrameRecordTriangles) {
-    resolve_gbuffer(executor, scene, vis, cube.centre, s.g);
-  } else {
-    if (s.records_of != &scene.mesh) {
-      s.records = GBufferTriangles(executor, scene);
-      s.records_of = &scene.mesh;
-    }
-    resolve_gbuffer(executor, scene, s.records, vis, cube.centre, s.g);
-  }
+  resolve_gbuffer(executor, scene, s.records.of(executor, scene), vis, cube.centre, s.g);
   return shade(s.g, cam, face, read.empty() ? nullptr : &read);
 }
 

@@ -187,12 +187,10 @@ struct CubeMapScratch {
   // sets up only the groups that reach it (a cube face sees about a sixth of the scene).
   TriangleGroups groups;
   const TriangleMesh* groups_of = nullptr;
-  // The scene's G-buffer records (gbuffer_triangles.h), built by the first face shaded with
-  // this scratch: the faces' resolves read them instead of the mesh's index and vertex arrays
-  // (the same bytes, about half the time), the build paid once for all of them (meshes up to
-  // kMaxFrameRecordTriangles).
-  GBufferTriangles records;
-  const TriangleMesh* records_of = nullptr;
+  // The scene's G-buffer records, built by the first face shaded with this scratch: the
+  // faces' resolves read them instead of the mesh's index and vertex arrays (the same bytes,
+  // about half the time), the build paid once for all of them.
+  FrameRecords records;
 };
 
 // Renders the six faces: visibility → G-buffer → `shade` (skipped when empty: a

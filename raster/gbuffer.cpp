@@ -608,11 +608,11 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visibili
   resolve(executor, scene, nullptr, vis, eye, g);
 }
 
-void resolve_gbuffer(par::Executor& executor, const Scene& scene, const GBufferTriangles& triangles,
+void resolve_gbuffer(par::Executor& executor, const Scene& scene, const GBufferTriangles* triangles,
                      const VisibilityBuffer& vis, const glm::vec3& eye, GBuffer& g) {
-  if (!triangles.matches(scene.mesh))
+  if (triangles && !triangles->matches(scene.mesh))
     throw InputError(scene.name, "G-buffer triangle records were built from another mesh");
-  resolve(executor, scene, &triangles, vis, eye, g);
+  resolve(executor, scene, triangles, vis, eye, g);
 }
 
 void visible_distances(const TriangleMesh& m, const VisibilityBuffer& vis, const glm::vec3& from, std::size_t begin,
@@ -685,10 +685,9 @@ ImageF glossiness_image(const GBuffer& g) {
 
 GBuffer GBufferPass::operator()(par::NodeContext& c, const VisibilityBuffer& visibility) const {
   // The records cost about one pass over the mesh and halve the resolve's time.
-  if (scene->mesh.triangle_count() > kMaxFrameRecordTriangles) return resolve_gbuffer(c.executor(), *scene, visibility, eye);
-  const GBufferTriangles records(c.executor(), *scene);
+  FrameRecords records;
   GBuffer g;
-  resolve_gbuffer(c.executor(), *scene, records, visibility, eye, g);
+  resolve_gbuffer(c.executor(), *scene, records.of(c.executor(), *scene), visibility, eye, g);
   return g;
 }
 

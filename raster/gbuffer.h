@@ -51,8 +51,9 @@ void resolve_gbuffer(par::Executor& executor, const Scene& scene, const Visibili
                      const glm::vec3& eye, GBuffer& out);
 // The same reading the scene-static per-triangle records (built once per static scene, see
 // gbuffer_triangles.h) instead of gathering through the mesh's index and vertex arrays: the
-// same bytes, fewer cache and TLB misses. Throws InputError if they come from another mesh.
-void resolve_gbuffer(par::Executor& executor, const Scene& scene, const GBufferTriangles& triangles,
+// same bytes, fewer cache and TLB misses. `triangles` null: the mesh arrays (as above).
+// Throws InputError if they come from another mesh.
+void resolve_gbuffer(par::Executor& executor, const Scene& scene, const GBufferTriangles* triangles,
                      const VisibilityBuffer& vis, const glm::vec3& eye, GBuffer& out);
 
 // World position of covered visibility sample i (barycentric interpolation only): what

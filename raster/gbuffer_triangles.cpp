@@ -24,4 +24,13 @@ GBufferTriangles::GBufferTriangles(par::Executor& executor, const Scene& scene) 
   vertices_ = m.vertex_count();
 }
 
+const GBufferTriangles* FrameRecords::of(par::Executor& executor, const Scene& scene) {
+  if (scene.mesh.triangle_count() > kMaxFrameRecordTriangles) return nullptr;
+  if (mesh_ != &scene.mesh) {
+    records_ = GBufferTriangles(executor, scene);
+    mesh_ = &scene.mesh;
+  }
+  return &records_;
+}
+
 }  // namespace speculum::raster

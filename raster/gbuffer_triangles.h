@@ -50,9 +50,6 @@ inline TriangleRecord triangle_record(const TriangleMesh& m, std::uint32_t t) {
   return r;
 }
 
-// A frame builds records (96 bytes a triangle) for meshes of at most this many triangles
-// (384 MiB of records); larger meshes resolve from the mesh arrays.
-constexpr std::size_t kMaxFrameRecordTriangles = std::size_t(1) << 22;
 
 // The records of one mesh in huge-page-backed memory (random gathers over 100+ MB would
 // otherwise miss the TLB on nearly every sample). Valid only while the mesh is unchanged:
@@ -80,6 +77,22 @@ class GBufferTriangles {
   std::vector<std::uint32_t> materials_;
   std::size_t count_ = 0;
   std::size_t vertices_ = 0;
+};
+
+// A frame builds records (96 bytes a triangle) for meshes of at most this many triangles
+// (384 MiB of records); larger meshes resolve from the mesh arrays.
+constexpr std::size_t kMaxFrameRecordTriangles = std::size_t(1) << 22;
+
+// The records a frame's resolves read: built by the first call for a mesh and kept for the
+// calls after it on that mesh (so a pass resolving many images pays the build once); none
+// (null) for a mesh over kMaxFrameRecordTriangles.
+class FrameRecords {
+ public:
+  const GBufferTriangles* of(par::Executor& executor, const Scene& scene);
+
+ private:
+  GBufferTriangles records_;
+  const TriangleMesh* mesh_ = nullptr;
 };
 
 }  // namespace speculum::raster

@@ -2,7 +2,6 @@
 #include "raster/soff.h"
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
 #include <utility>
 
@@ -464,8 +463,7 @@ DepthImageCounts render_depth_image(par::Executor& executor, const Scene& scene,
     for (std::size_t i = begin; i < end; ++i)
       if (vis.triangle.pixels[i] != kNoId) vis.triangle.pixels[i] = s.kept[vis.triangle.pixels[i]];
   });
-  if (records) resolve_gbuffer(executor, scene, *records, vis, cam.eye, s.gb);
-  else resolve_gbuffer(executor, scene, vis, cam.eye, s.gb);
+  resolve_gbuffer(executor, scene, records, vis, cam.eye, s.gb);
   const GBuffer& gb = s.gb;
   executor.parallel_for("soff_depth_images.shade", gb.object.size(), 2048, [&](std::size_t begin, std::size_t end) {
     shade.shade_samples(
@@ -542,13 +540,11 @@ SoffDepthImages soff_depth_images(par::Executor& executor, const Scene& scene, c
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pixels(a) > pixels(b); });
   std::vector<DepthImageCounts> counts(cameras.size());
   // The images' resolves read the scene's records (the same bytes, about half the time).
-  const std::optional<GBufferTriangles> records =
-      scene.mesh.triangle_count() <= kMaxFrameRecordTriangles && !order.empty()
-          ? std::optional<GBufferTriangles>(std::in_place, executor, scene)
-          : std::nullopt;
+  FrameRecords frame_records;
+  const GBufferTriangles* records = order.empty() ? nullptr : frame_records.of(executor, scene);
   const auto render = [&](par::Executor& on, std::size_t c, DepthImageScratch& scratch) {
     counts[c] = render_depth_image(on, scene, groups, clusters.reflector[c], cameras[c], shade, env, out.offsets[c],
-                                   scratch, out, records ? &*records : nullptr);
+                                   scratch, out, records);
   };
   std::size_t large = 0;
   DepthImageScratch scratch;

@@ -110,8 +110,7 @@ void run_bench_raster(const BenchRasterOptions& o, const GlobalOptions& global) 
     const auto t0 = executor.now_ns();
     raster::render_visibility(executor, scene, camera, o.width, o.height, raster_options,
                               workspace, vis);
-    if (use_records) raster::resolve_gbuffer(executor, scene, records, vis, camera.eye, g);
-    else raster::resolve_gbuffer(executor, scene, vis, camera.eye, g);
+    raster::resolve_gbuffer(executor, scene, use_records ? &records : nullptr, vis, camera.eye, g);
     const auto t1 = executor.now_ns();
     if (run == 0) {
       for (std::size_t i = 0; i < g.object.size(); ++i) covered += g.covered(i);

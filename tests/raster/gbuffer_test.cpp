@@ -222,7 +222,7 @@ TEST(GBuffer, EveryByteMatchesAPerSampleOracle) {
       par::Executor ex(threads);
       GBuffer g = fresh;
       scribble(g);
-      resolve_gbuffer(ex, scene, records, vis, cam.eye, g);
+      resolve_gbuffer(ex, scene, &records, vis, cam.eye, g);
       EXPECT_EQ(mismatches(scene, vis, cam.eye, g), 0u) << w << "x" << h << " records, " << threads;
       scribble(g);
       resolve_gbuffer(ex, scene, vis, cam.eye, g);
@@ -328,7 +328,7 @@ TEST(GBuffer, RecordsOfAnotherMeshAreRejected) {
   Camera cam;
   const auto vis = render_visibility(ex, scene, cam, 16, 16);
   GBuffer g;
-  EXPECT_THROW(resolve_gbuffer(ex, scene, records, vis, cam.eye, g), InputError);
+  EXPECT_THROW(resolve_gbuffer(ex, scene, &records, vis, cam.eye, g), InputError);
   Scene broken = other;
   broken.mesh.normals.pop_back();
   EXPECT_THROW(GBufferTriangles(ex, broken), InputError);
