@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -160,12 +161,26 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
   return out;
 }
 
-DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
-                                     const DistanceSearchOptions& options, FallbackMask* fallbacks,
-                                     std::vector<CubeTileMask>* mark_into) {
+namespace {
+
+// The map sample i of g searches in (-1: none: not covered, not specular, or no map).
+int searched_map(const GBuffer& g, const ReflectorMaps& maps, std::size_t i) {
+  return g.covered(i) && is_specular(g.surface[i]) ? map_of_sample(g, maps, i) : -1;
+}
+
+// distance_map_search, and distance_map_search_reusing when `earlier_g` is not null: the samples
+// both G-buffers search take their directions from `earlier` instead of searching again. Each
+// chunk walks `earlier`'s records of the chunk in sample order beside its own, so a sample
+// only earlier_g searches replays its lookups to skip its records.
+DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
+                                const DistanceSearchOptions& options, FallbackMask* fallbacks,
+                                std::vector<CubeTileMask>* mark_into, const GBuffer* earlier_g,
+                                const DistanceSearches* earlier) {
   DistanceSearches out;
   const std::size_t n = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
   out.found.resize(par::Executor::chunk_count(n, kChunk));
+  if (earlier_g && (earlier_g->width != g.width || earlier_g->height != g.height || earlier->found.size() != out.found.size()))
+    throw std::logic_error("distance_map_search_reusing: the earlier searches are of another G-buffer's size");
   if (!mark_into)
     for (std::size_t m = 0; m < maps.cubes.size(); ++m)
       out.tiles.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
@@ -174,37 +189,58 @@ DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, 
   executor.parallel_for("distance_map_search.search", n, kChunk, [&](std::size_t begin, std::size_t end) {
     DistanceReflectStats& st = per_chunk[begin / kChunk];
     std::vector<glm::vec3>& found = out.found[begin / kChunk];
+    const glm::vec3* before = earlier_g ? earlier->found[begin / kChunk].data() : nullptr;
     std::vector<LookupTileMarker> markers;
     for (std::size_t m = 0; m < maps.cubes.size(); ++m) markers.emplace_back(tiles[m], maps.levels[m]);
     SubLobeAxes axes(options.lobe_directions);
     for (std::size_t i = begin; i < end; ++i) {
-      if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface[i];
-      const int m = is_specular(s) ? map_of_sample(g, maps, i) : -1;
-      if (m < 0) continue;
-      const glm::vec3 x = g.position.pixels[i], n = g.normal.pixels[i];
+      const int m_now = searched_map(g, maps, i);
+      const int m_before = earlier_g ? searched_map(*earlier_g, maps, i) : -1;
+      if (m_now < 0 && m_before < 0) continue;
+      const GBuffer& src = m_now >= 0 ? g : *earlier_g;
+      const int m = m_now >= 0 ? m_now : m_before;
+      const glm::vec3 x = src.position.pixels[i], n = src.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return searched_lookup(n, d, exponent, axes,
                                [&](const glm::vec3* dk, int count, float e, glm::vec3* radiance) {
           glm::vec3 along[kLobeBatch];
-          search_counted(maps, m, x, dk, count, options, st, along);
-          for (int j = 0; j < count; ++j) {
+          if (m_before >= 0) {
+            std::copy(before, before + count, along);
+            before += count;
+          } else {
+            search_counted(maps, m, x, dk, count, options, st, along);
+          }
+          for (int j = 0; j < count && m_now >= 0; ++j) {
             found.push_back(along[j]);
             markers[m].mark(along[j], e);
-            radiance[j] = glm::vec3(0.0f);
           }
+          std::fill(radiance, radiance + count, glm::vec3(0.0f));
         });
       };
       const std::uint64_t missed_before = st.missed;
       // Its value is not needed here: it makes the lookups (R, and T for a refractor) in the
       // order distance_map_lookup replays them.
-      specular_radiance(s, n, g.view_direction(i), lookup);
+      specular_radiance(src.surface[i], n, src.view_direction(i), lookup);
       if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
     }
   });
   for (CubeTileMask& mask : tiles) settle_wide_reads(executor, mask);
   add_stats(out.stats, per_chunk);
   return out;
+}
+
+}  // namespace
+
+DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
+                                     const DistanceSearchOptions& options, FallbackMask* fallbacks,
+                                     std::vector<CubeTileMask>* mark_into) {
+  return search_samples(executor, g, maps, options, fallbacks, mark_into, nullptr, nullptr);
+}
+
+DistanceSearches distance_map_search_reusing(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
+                                             const DistanceSearchOptions& options, const GBuffer& earlier_g,
+                                             const DistanceSearches& earlier, std::vector<CubeTileMask>* mark_into) {
+  return search_samples(executor, g, maps, options, nullptr, mark_into, &earlier_g, &earlier);
 }
 
 ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,

@@ -74,6 +74,14 @@ struct DistanceSearches {
 DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
                                      const DistanceSearchOptions& options, FallbackMask* fallbacks = nullptr,
                                      std::vector<CubeTileMask>* mark_into = nullptr);
+// distance_map_search of g taking, for the samples `earlier_g` also searches, the directions
+// `earlier` found (distance_map_search of earlier_g in the same maps with the same options;
+// earlier_g: g's samples — positions, normals, surfaces — with others uncovered): the same
+// result, with only the samples earlier_g leaves out searched (and counted in its stats).
+DistanceSearches distance_map_search_reusing(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
+                                             const DistanceSearchOptions& options, const GBuffer& earlier_g,
+                                             const DistanceSearches& earlier,
+                                             std::vector<CubeTileMask>* mark_into = nullptr);
 ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,
                               const ReflectorMaps& maps, const DistanceSearches& searches,
                               const DistanceSearchOptions& options);

@@ -200,7 +200,13 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
           s.texels = GBuffer{};
           continue;
         }
-        s.found = distance_map_search(executor, s.texels, distances, face_search, nullptr, &read[k - 1]);
+        // A texel's searches are the same in every round (the same distances): those the next
+        // round searched too are taken from it.
+        const FaceSearches* later = k < rounds ? &searched[k + 1][m][f] : nullptr;
+        s.found = later && later->texels.width > 0
+                      ? distance_map_search_reusing(executor, s.texels, distances, face_search, later->texels,
+                                                    later->found, &read[k - 1])
+                      : distance_map_search(executor, s.texels, distances, face_search, nullptr, &read[k - 1]);
         st += s.found.stats;
       }
   }

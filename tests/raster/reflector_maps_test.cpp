@@ -261,6 +261,48 @@ TEST(ReflectorMaps, ColourShadedWhereSearchesReadChangesNoSample) {
   }
 }
 
+// Searches taken from an earlier search of other samples of the same G-buffer: what both
+// G-buffers search is reused, the rest searched, and the result is the direct search's — the
+// same directions in the same order, the same tiles marked — with only the new samples counted.
+TEST(ReflectorMaps, SearchesReusedFromOtherSamplesOfTheGBufferAreTheSame) {
+  par::Executor ex(2);
+  for (const char* name : {"glossy-plane", "living-room", "glass-sphere"}) {
+    SCOPED_TRACE(name);
+    const View v = view_of(name, 128, 96, ex);
+    DistanceSearchOptions search;
+    const ReflectorMaps distances = render_reflector_maps(ex, v.scene, v.shadows, v.env, 64, &v.g,
+                                                          ReflectorSelection::all, {}, nullptr,
+                                                          searched_distance_maps(true, false));
+    // Two overlapping column ranges of the view: the earlier the left two thirds, the later
+    // the right two thirds.
+    const auto columns = [&](int x0, int x1) {
+      GBuffer g = v.g;
+      for (std::size_t i = 0; i < g.object.size(); ++i) {
+        const int x = static_cast<int>(i % std::size_t(g.width));
+        if (x < x0 || x >= x1) g.object.pixels[i] = kNoId;
+      }
+      return g;
+    };
+    const GBuffer earlier_g = columns(0, 2 * v.g.width / 3), later_g = columns(v.g.width / 3, v.g.width);
+    const DistanceSearches earlier = distance_map_search(ex, earlier_g, distances, search);
+    const DistanceSearches direct = distance_map_search(ex, later_g, distances, search);
+    const DistanceSearches reused = distance_map_search_reusing(ex, later_g, distances, search, earlier_g, earlier);
+    ASSERT_EQ(reused.found.size(), direct.found.size());
+    for (std::size_t c = 0; c < direct.found.size(); ++c) {
+      ASSERT_EQ(reused.found[c].size(), direct.found[c].size());
+      EXPECT_EQ(std::memcmp(reused.found[c].data(), direct.found[c].data(), direct.found[c].size() * sizeof(glm::vec3)), 0);
+    }
+    ASSERT_EQ(reused.tiles.size(), direct.tiles.size());
+    for (std::size_t m = 0; m < direct.tiles.size(); ++m)
+      for (int f = 0; f < kCubeFaces; ++f) EXPECT_EQ(reused.tiles[m].tiles[f], direct.tiles[m].tiles[f]);
+    // The middle third was searched earlier: only the right third is searched again.
+    const DistanceSearches right = distance_map_search(ex, columns(2 * v.g.width / 3, v.g.width), distances, search);
+    EXPECT_GT(direct.stats.searches, right.stats.searches);
+    EXPECT_EQ(reused.stats.searches, right.stats.searches);
+    EXPECT_EQ(reused.stats.lookups, right.stats.lookups);
+  }
+}
+
 // A reflector with no sample in the camera's view gets no map under skip_unseen (nothing
 // reads it), and the specular layer is unchanged.
 TEST(ReflectorMaps, ReflectorsTheCameraDoesNotSeeGetNoMap) {
