@@ -163,23 +163,25 @@ ImageRGBA distance_map_reflect(par::Executor& executor, const GBuffer& g,
 
 namespace {
 
-// The map sample i of g searches in (-1: none: not covered, not specular, or no map).
-int searched_map(const GBuffer& g, const ReflectorMaps& maps, std::size_t i) {
-  return g.covered(i) && is_specular(g.surface[i]) ? map_of_sample(g, maps, i) : -1;
+// The map sample i of g searches in when its object id is `object` (-1: none: not covered, not
+// specular, or no map).
+int searched_map(const GBuffer& g, std::uint32_t object, const ReflectorMaps& maps, std::size_t i) {
+  if (object == kNoId || !is_specular(g.surface[i])) return -1;
+  return object < maps.map_of_object.size() ? maps.map_of_object[object] : -1;
 }
 
-// distance_map_search, and distance_map_search_reusing when `earlier_g` is not null: the samples
-// both G-buffers search take their directions from `earlier` instead of searching again. Each
-// chunk walks `earlier`'s records of the chunk in sample order beside its own, so a sample
-// only earlier_g searches replays its lookups to skip its records.
+// distance_map_search, and distance_map_search_reusing when `earlier_object` is not null: the
+// samples searched under both object planes take their directions from `earlier` instead of
+// searching again. Each chunk walks `earlier`'s records of the chunk in sample order beside its
+// own, so a sample searched only under earlier_object replays its lookups to skip its records.
 DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
                                 const DistanceSearchOptions& options, FallbackMask* fallbacks,
-                                std::vector<CubeTileMask>* mark_into, const GBuffer* earlier_g,
+                                std::vector<CubeTileMask>* mark_into, const IdBuffer* earlier_object,
                                 const DistanceSearches* earlier) {
   DistanceSearches out;
   const std::size_t n = static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height);
   out.found.resize(par::Executor::chunk_count(n, kChunk));
-  if (earlier_g && (earlier_g->width != g.width || earlier_g->height != g.height || earlier->found.size() != out.found.size()))
+  if (earlier_object && (earlier_object->size() != n || earlier->found.size() != out.found.size()))
     throw std::logic_error("distance_map_search_reusing: the earlier searches are of another G-buffer's size");
   if (!mark_into)
     for (std::size_t m = 0; m < maps.cubes.size(); ++m)
@@ -189,17 +191,16 @@ DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const
   executor.parallel_for("distance_map_search.search", n, kChunk, [&](std::size_t begin, std::size_t end) {
     DistanceReflectStats& st = per_chunk[begin / kChunk];
     std::vector<glm::vec3>& found = out.found[begin / kChunk];
-    const glm::vec3* before = earlier_g ? earlier->found[begin / kChunk].data() : nullptr;
+    const glm::vec3* before = earlier_object ? earlier->found[begin / kChunk].data() : nullptr;
     std::vector<LookupTileMarker> markers;
     for (std::size_t m = 0; m < maps.cubes.size(); ++m) markers.emplace_back(tiles[m], maps.levels[m]);
     SubLobeAxes axes(options.lobe_directions);
     for (std::size_t i = begin; i < end; ++i) {
-      const int m_now = searched_map(g, maps, i);
-      const int m_before = earlier_g ? searched_map(*earlier_g, maps, i) : -1;
+      const int m_now = searched_map(g, g.object.pixels[i], maps, i);
+      const int m_before = earlier_object ? searched_map(g, earlier_object->pixels[i], maps, i) : -1;
       if (m_now < 0 && m_before < 0) continue;
-      const GBuffer& src = m_now >= 0 ? g : *earlier_g;
       const int m = m_now >= 0 ? m_now : m_before;
-      const glm::vec3 x = src.position.pixels[i], n = src.normal.pixels[i];
+      const glm::vec3 x = g.position.pixels[i], n = g.normal.pixels[i];
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return searched_lookup(n, d, exponent, axes,
                                [&](const glm::vec3* dk, int count, float e, glm::vec3* radiance) {
@@ -220,7 +221,7 @@ DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const
       const std::uint64_t missed_before = st.missed;
       // Its value is not needed here: it makes the lookups (R, and T for a refractor) in the
       // order distance_map_lookup replays them.
-      specular_radiance(src.surface[i], n, src.view_direction(i), lookup);
+      specular_radiance(g.surface[i], n, g.view_direction(i), lookup);
       if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
     }
   });
@@ -238,9 +239,9 @@ DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, 
 }
 
 DistanceSearches distance_map_search_reusing(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
-                                             const DistanceSearchOptions& options, const GBuffer& earlier_g,
+                                             const DistanceSearchOptions& options, const IdBuffer& earlier_object,
                                              const DistanceSearches& earlier, std::vector<CubeTileMask>* mark_into) {
-  return search_samples(executor, g, maps, options, nullptr, mark_into, &earlier_g, &earlier);
+  return search_samples(executor, g, maps, options, nullptr, mark_into, &earlier_object, &earlier);
 }
 
 ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,

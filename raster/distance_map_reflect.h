@@ -74,12 +74,12 @@ struct DistanceSearches {
 DistanceSearches distance_map_search(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
                                      const DistanceSearchOptions& options, FallbackMask* fallbacks = nullptr,
                                      std::vector<CubeTileMask>* mark_into = nullptr);
-// distance_map_search of g taking, for the samples `earlier_g` also searches, the directions
-// `earlier` found (distance_map_search of earlier_g in the same maps with the same options;
-// earlier_g: g's samples — positions, normals, surfaces — with others uncovered): the same
-// result, with only the samples earlier_g leaves out searched (and counted in its stats).
+// distance_map_search of g taking, for the samples it would also search with the object ids
+// `earlier_object` (kNoId: uncovered) in place of its own, the directions `earlier` found
+// (distance_map_search of g so changed, in the same maps with the same options): the same
+// result, with only the other samples searched (and counted in its stats).
 DistanceSearches distance_map_search_reusing(par::Executor& executor, const GBuffer& g, const ReflectorMaps& maps,
-                                             const DistanceSearchOptions& options, const GBuffer& earlier_g,
+                                             const DistanceSearchOptions& options, const IdBuffer& earlier_object,
                                              const DistanceSearches& earlier,
                                              std::vector<CubeTileMask>* mark_into = nullptr);
 ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const EnvironmentMap& env,

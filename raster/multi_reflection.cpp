@@ -1,6 +1,8 @@
 // Inter-object multiple reflections by rounds of cube-map re-rendering: see multi_reflection.h.
 #include "raster/multi_reflection.h"
 
+#include <utility>
+
 #include <glm/geometric.hpp>
 
 #include "raster/composite.h"
@@ -8,6 +10,23 @@
 #include "raster/envmap_reflect.h"
 
 namespace speculum::raster {
+
+namespace {
+
+// Gives a G-buffer other object ids (kNoId: uncovered) for the scope: swapped in, and back.
+class ObjectsSwapped {
+ public:
+  ObjectsSwapped(GBuffer& g, IdBuffer& object) : g_(g), object_(object) { std::swap(g_.object, object_); }
+  ~ObjectsSwapped() { std::swap(g_.object, object_); }
+  ObjectsSwapped(const ObjectsSwapped&) = delete;
+  ObjectsSwapped& operator=(const ObjectsSwapped&) = delete;
+
+ private:
+  GBuffer& g_;
+  IdBuffer& object_;
+};
+
+}  // namespace
 
 ReflectorMaps rerender_reflector_maps(par::Executor& executor, const Scene& scene,
                                       const std::vector<ShadowMap>& shadows,
@@ -172,8 +191,10 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
   // camera reads the last round), and the searches round k's texels on them make in round k − 1.
   std::vector<std::vector<CubeTileMask>> read(static_cast<std::size_t>(rounds) + 1);
   read[rounds] = camera.tiles;
+  // A round's searches on a face: its specular texels' object ids, kNoId for those on unread
+  // tiles (empty: none read), swapped into the face's texels to search and look up.
   struct FaceSearches {
-    GBuffer texels;  // the face's specular texels, those on unread tiles uncovered
+    IdBuffer object;
     DistanceSearches found;
   };
   std::vector<std::vector<std::array<FaceSearches, kCubeFaces>>> searched(
@@ -184,29 +205,30 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
       read[k - 1].push_back(tile_mask_for_reads(distances.cubes[m].size, distances.levels[m]));
     for (std::size_t m = 0; m < count; ++m)
       for (int f = 0; f < kCubeFaces; ++f) {
-        const GBuffer& all = layers[m].specular[f];
+        GBuffer& texels = layers[m].specular[f];
         const std::vector<std::uint32_t>& texel = layers[m].specular_texel[f];
         if (texel.empty() || !((distances.faces[m] >> f) & 1u)) continue;
         FaceSearches& s = searched[k][m][f];
-        s.texels = all;
+        s.object = texels.object;
         const int size = distances.cubes[m].size;
         bool any = false;
         for (std::size_t j = 0; j < texel.size(); ++j) {
           const int x = static_cast<int>(texel[j] % std::uint32_t(size)), y = static_cast<int>(texel[j] / std::uint32_t(size));
           if (read[k][m].covers(f, 0, x, y)) any = true;
-          else s.texels.object.pixels[j] = kNoId;
+          else s.object.pixels[j] = kNoId;
         }
         if (!any) {
-          s.texels = GBuffer{};
+          s.object = IdBuffer{};
           continue;
         }
         // A texel's searches are the same in every round (the same distances): those the next
         // round searched too are taken from it.
         const FaceSearches* later = k < rounds ? &searched[k + 1][m][f] : nullptr;
-        s.found = later && later->texels.width > 0
-                      ? distance_map_search_reusing(executor, s.texels, distances, face_search, later->texels,
+        const ObjectsSwapped round_texels(texels, s.object);
+        s.found = later && later->object.width > 0
+                      ? distance_map_search_reusing(executor, texels, distances, face_search, later->object,
                                                     later->found, &read[k - 1])
-                      : distance_map_search(executor, s.texels, distances, face_search, nullptr, &read[k - 1]);
+                      : distance_map_search(executor, texels, distances, face_search, nullptr, &read[k - 1]);
         st += s.found.stats;
       }
   }
@@ -243,9 +265,10 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
           cube.colour[f] = std::move(specular);
           continue;
         }
-        const FaceSearches& s = searched[k][m][f];
-        if (s.texels.width > 0) {
-          const ImageRGBA seen = distance_map_lookup(executor, s.texels, env, maps, s.found, face_search);
+        FaceSearches& s = searched[k][m][f];
+        if (s.object.width > 0) {
+          const ObjectsSwapped round_texels(layers[m].specular[f], s.object);
+          const ImageRGBA seen = distance_map_lookup(executor, layers[m].specular[f], env, maps, s.found, face_search);
           const std::vector<std::uint32_t>& texel = layers[m].specular_texel[f];
           for (std::size_t j = 0; j < texel.size(); ++j) specular.pixels[texel[j]] = seen.pixels[j];
         }

@@ -261,8 +261,8 @@ TEST(ReflectorMaps, ColourShadedWhereSearchesReadChangesNoSample) {
   }
 }
 
-// Searches taken from an earlier search of other samples of the same G-buffer: what both
-// G-buffers search is reused, the rest searched, and the result is the direct search's — the
+// Searches taken from an earlier search of other samples of the same G-buffer (other object
+// ids, kNoId for the samples left out): what both search is reused, the rest searched, and the result is the direct search's — the
 // same directions in the same order, the same tiles marked — with only the new samples counted.
 TEST(ReflectorMaps, SearchesReusedFromOtherSamplesOfTheGBufferAreTheSame) {
   par::Executor ex(2);
@@ -286,7 +286,7 @@ TEST(ReflectorMaps, SearchesReusedFromOtherSamplesOfTheGBufferAreTheSame) {
     const GBuffer earlier_g = columns(0, 2 * v.g.width / 3), later_g = columns(v.g.width / 3, v.g.width);
     const DistanceSearches earlier = distance_map_search(ex, earlier_g, distances, search);
     const DistanceSearches direct = distance_map_search(ex, later_g, distances, search);
-    const DistanceSearches reused = distance_map_search_reusing(ex, later_g, distances, search, earlier_g, earlier);
+    const DistanceSearches reused = distance_map_search_reusing(ex, later_g, distances, search, earlier_g.object, earlier);
     ASSERT_EQ(reused.found.size(), direct.found.size());
     for (std::size_t c = 0; c < direct.found.size(); ++c) {
       ASSERT_EQ(reused.found[c].size(), direct.found[c].size());
