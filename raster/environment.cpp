@@ -28,6 +28,20 @@ float lobe_angle(float n) { return std::sqrt(2.0f * kLn2 / std::max(n, 1e-6f)); 
 float lobe_exponent(float angle) { return 2.0f * kLn2 / (angle * angle); }
 float texel_angle(int size) { return 0.5f * kPi / static_cast<float>(size); }
 
+// The Phong exponent of the cascade's step to level l ≥ 1 of a map of side `size`: the lobe
+// that widens level l − 1's (none at level 0) to a half-power angle of one level-l texel.
+float step_lobe_exponent(int size, int l) {
+  const float target = texel_angle(std::max(1, size >> l));
+  const float previous = l == 1 ? 0.0f : texel_angle(std::max(1, size >> (l - 1)));
+  return lobe_exponent(std::sqrt(target * target - previous * previous));
+}
+
+// The widest of the prefiltering step's samples from its axis: the Hamersley point
+// u.x = (N−1)/N of sample_phong_lobe, at cos θ = (1/N)^(1/(n+1)).
+float widest_step_sample(int size, int l) {
+  return std::acos(std::pow(1.0f / kPrefilterSamples, 1.0f / (step_lobe_exponent(size, l) + 1.0f)));
+}
+
 glm::vec4 bilinear_face(const ImageRGBA& img, glm::vec2 pixel) {
   const int s = img.width;
   const float fx = std::clamp(pixel.x - 0.5f, 0.0f, float(s - 1));
@@ -179,7 +193,8 @@ EnvironmentMap build_environment(par::Executor& executor, const Environment& env
 
 EnvironmentMap environment_from_faces(par::Executor& executor,
                                       std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
-                                      int level_count, unsigned face_mask, const CubeTileMask* tiles) {
+                                      int level_count, unsigned face_mask, const CubeTileMask* tiles,
+                                      const PrefilterReuse* reuse) {
   EnvironmentMap map;
   const int size = faces[0].width;
   map.size = size;
@@ -190,8 +205,7 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
   // Coarser levels: glossy prefiltering of the previous level.
   for (int l = 1; l < levels; ++l) {
     const int s = std::max(1, size >> l);
-    const float target = texel_angle(s), previous = l == 1 ? 0.0f : texel_angle(size >> (l - 1));
-    const float step_exponent = lobe_exponent(std::sqrt(target * target - previous * previous));
+    const float step_exponent = step_lobe_exponent(size, l);
     // The lobe's sample directions in the lobe's own frame are the same for every texel.
     std::array<glm::vec3, kPrefilterSamples> local;
     for (int k = 0; k < kPrefilterSamples; ++k)
@@ -200,26 +214,39 @@ EnvironmentMap environment_from_faces(par::Executor& executor,
       ImageRGBA& img = map.levels[l][face];
       img = ImageRGBA(s, s);
       if (!((face_mask >> face) & 1u)) continue;
+      // The texels `reuse` gives: prefiltered there (its faces and tiles), no input changed.
+      const ImageRGBA* before = reuse && ((reuse->faces >> face) & 1u) && static_cast<std::size_t>(l) < reuse->from->levels.size() &&
+                                        static_cast<std::size_t>(l) < reuse->changed.size()
+                                    ? &reuse->from->levels[l][face]
+                                    : nullptr;
       executor.parallel_for("environment.prefilter", img.size(), 256,
                             [&](std::size_t begin, std::size_t end) {
         const auto wanted = [&](std::size_t i) {
           return !tiles || tiles->covers(face, l, static_cast<int>(i % s), static_cast<int>(i / s));
         };
+        const auto taken = [&](std::size_t i) {
+          const int x = static_cast<int>(i % s), y = static_cast<int>(i / s);
+          return before && (!reuse->tiles || reuse->tiles->covers(face, l, x, y)) && !reuse->changed[l].covers(face, l, x, y);
+        };
         std::size_t i = begin;
         glm::vec3 sums[8];
         for (; i + 8 <= end; i += 8) {
-          bool any = false;
-          for (std::size_t j = 0; j < 8 && !any; ++j) any = wanted(i + j);
-          if (!any) continue;
-          prefilter_texels8(map.levels[l - 1], face, s, i, local.data(), kPrefilterSamples, sums);
+          unsigned from_before = 0, computed = 0;
           for (std::size_t j = 0; j < 8; ++j)
-            if (wanted(i + j)) img.pixels[i + j] = glm::vec4(sums[j] / float(kPrefilterSamples), 1.0f);
+            if (wanted(i + j)) (taken(i + j) ? from_before : computed) |= 1u << j;
+          if (computed) prefilter_texels8(map.levels[l - 1], face, s, i, local.data(), kPrefilterSamples, sums);
+          for (std::size_t j = 0; j < 8; ++j) {
+            if ((from_before >> j) & 1u) img.pixels[i + j] = before->pixels[i + j];
+            else if ((computed >> j) & 1u) img.pixels[i + j] = glm::vec4(sums[j] / float(kPrefilterSamples), 1.0f);
+          }
         }
-        for (; i < end; ++i)
-          if (wanted(i))
-            img.pixels[i] = glm::vec4(prefilter_texel(map.levels[l - 1], face, s, i, local.data(), kPrefilterSamples) /
-                                          float(kPrefilterSamples),
-                                      1.0f);
+        for (; i < end; ++i) {
+          if (!wanted(i)) continue;
+          img.pixels[i] = taken(i) ? before->pixels[i]
+                                   : glm::vec4(prefilter_texel(map.levels[l - 1], face, s, i, local.data(), kPrefilterSamples) /
+                                                   float(kPrefilterSamples),
+                                               1.0f);
+        }
       });
     }
   }
@@ -277,15 +304,14 @@ float lookup_reach(int size, int level_count, float phong_exponent) {
   // bounds it (a texel is 2/side wide on the unit-distance face plane).
   const auto texel_reach = [&](int l) { return 2.0f * 1.4142136f / static_cast<float>(std::max(1, size >> l)); };
   float reach = texel_reach(read);
-  for (int l = 1; l <= read; ++l) {
-    // The cascade's step l (environment_from_faces): its widest sample is the Hamersley
-    // point u.x = (N−1)/N, at cos θ = (1/N)^(1/(n+1)).
-    const float target = texel_angle(std::max(1, size >> l));
-    const float previous = l == 1 ? 0.0f : texel_angle(std::max(1, size >> (l - 1)));
-    const float step_exponent = lobe_exponent(std::sqrt(target * target - previous * previous));
-    reach += std::acos(std::pow(1.0f / kPrefilterSamples, 1.0f / (step_exponent + 1.0f))) + texel_reach(l - 1);
-  }
+  for (int l = 1; l <= read; ++l) reach += widest_step_sample(size, l) + texel_reach(l - 1);  // the cascade's steps
   return reach;
+}
+
+float prefilter_reach(int size, int level) {
+  // A sample's bilinear taps: within 1.5 texels of its point along each axis of the face
+  // plane (clamped taps at the face's edge), 2/side per texel there, so 3√2 / side radians.
+  return widest_step_sample(size, level) + 3.0f * 1.4142136f / static_cast<float>(std::max(1, size >> (level - 1)));
 }
 
 glm::vec3 EnvironmentMap::radiance(const glm::vec3& d, float phong_exponent) const {

@@ -44,10 +44,28 @@ struct EnvironmentMap {
 // be null) limits it further to the texels over read tiles (CubeTileMask::covers): a texel
 // that a lookup within lookup_reach of a read tile depends on lies over a read tile at every
 // level, so what is left black is never read.
+// A map prefiltered before from other level-0 faces, whose texels environment_from_faces takes
+// instead of prefiltering them again where their inputs are the same: `from`, prefiltered with
+// face mask `faces` and tiles `tiles` (null: every texel of those faces), and per level l ≥ 1
+// `changed[l]`, tiles (CubeTileMask::covers at level l) over every level-l texel whose inputs
+// may differ from `from`'s. A texel `from` prefiltered and no changed tile covers has the
+// bits `from` has (prefiltering is a function of a texel's inputs alone).
+struct PrefilterReuse {
+  const EnvironmentMap* from = nullptr;
+  unsigned faces = 0;
+  const CubeTileMask* tiles = nullptr;
+  std::vector<CubeTileMask> changed;  // [level]; level 0 unused
+};
+
 EnvironmentMap environment_from_faces(par::Executor& executor,
                                       std::array<ImageRGBA, kCubeFaces> faces, bool with_sh,
                                       int level_count = 0, unsigned face_mask = 0x3fu,
-                                      const CubeTileMask* tiles = nullptr);
+                                      const CubeTileMask* tiles = nullptr, const PrefilterReuse* reuse = nullptr);
+
+// The angle from the centre of a level-`level` texel (level ≥ 1, on a map of side `size`)
+// within which lie the centres of all level-(level − 1) texels its prefiltering reads: the
+// step's widest lobe sample and its bilinear taps (clamped ones at a face's edge included).
+float prefilter_reach(int size, int level);
 
 // An angle around d within which every level-0 texel lies that radiance(d, n) on a map of
 // side `size` with `level_count` levels depends on: the bilinear taps of the levels it reads

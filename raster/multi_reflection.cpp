@@ -252,6 +252,10 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
     maps.cubes.emplace_back().colour = colour;
   }
   // Rounds 2 ..: the direct light plus what round k's searches find in round k − 1's maps.
+  // A round's map differs from the round before's only where its searches found other colour,
+  // so its prefiltered texels whose inputs did not change are taken from that round's.
+  std::vector<unsigned> faces_before(count);
+  for (std::size_t m = 0; m < count; ++m) faces_before[m] = distances.faces[m] & read[1][m].faces();
   for (int k = 2; k <= rounds; ++k) {
     ReflectorMaps next;
     next.map_of_object = distances.map_of_object;
@@ -274,7 +278,11 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
         }
         cube.colour[f] = composite(executor, direct[m][f], specular);
       }
-      next.maps.push_back(environment_from_faces(executor, cube.colour, false, distances.levels[m], faces, &read[k][m]));
+      const PrefilterReuse reuse =
+          prefilter_reuse(executor, cube.colour, faces, &read[k][m], maps.maps[m], faces_before[m], &read[k - 1][m],
+                          distances.levels[m]);
+      next.maps.push_back(environment_from_faces(executor, cube.colour, false, distances.levels[m], faces, &read[k][m], &reuse));
+      faces_before[m] = faces;
     }
     maps = std::move(next);
   }

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -186,11 +187,26 @@ float texel_reach(int size) { return 2.0f * 1.4142136f / static_cast<float>(size
 // repeated whole-face marks.
 // `last` (may be null): per face the rectangle of tiles the caller's previous mark set there
 // (x0, y0, x1, y1), updated here; a rectangle within it is not marked again.
+// The rectangle of tiles (x0, y0, x1, y1) of face f that mark_near marks for d and `margin`
+// (below kWholeFaceMargin); false when it is empty.
+bool tiles_near_on_face(int f, int tile, int n, int size, const glm::vec3& d, float margin, std::array<int, 4>& rect) {
+  constexpr float kFaceHalfAngle = 0.95531662f;  // acos(1/√3)
+  const float theta_d = std::acos(std::clamp(glm::dot(d, cube_direction(f, {0.5f, 0.5f}, 1)), -1.0f, 1.0f));
+  const float z = std::cos(std::min(kFaceHalfAngle, theta_d) + margin);
+  const float half = margin * static_cast<float>(size) / (2.0f * z * z) + 1.0f;
+  const glm::vec2 p = cube_face_plane_pixel(f, d, size);
+  const float lo_x = (p.x - half) / tile, hi_x = (p.x + half) / tile;
+  const float lo_y = (p.y - half) / tile, hi_y = (p.y + half) / tile;
+  if (!(hi_x >= 0.0f && hi_y >= 0.0f && lo_x < float(n) && lo_y < float(n))) return false;
+  rect = {std::max(0, static_cast<int>(std::floor(lo_x))), std::max(0, static_cast<int>(std::floor(lo_y))),
+          std::min(n - 1, static_cast<int>(hi_x)), std::min(n - 1, static_cast<int>(hi_y))};
+  return true;
+}
+
 void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int tile, int n, int size,
                const glm::vec3& d, float margin, unsigned& whole,
                std::array<std::array<int, 4>, kCubeFaces>* last = nullptr) {
   const unsigned faces = cube_faces_near(d, margin) & ~whole;
-  constexpr float kFaceHalfAngle = 0.95531662f;  // acos(1/√3)
   for (int f = 0; f < kCubeFaces; ++f) {
     if (!((faces >> f) & 1u)) continue;
     std::vector<std::uint8_t>& t = tiles[f];
@@ -199,19 +215,13 @@ void mark_near(std::array<std::vector<std::uint8_t>, kCubeFaces>& tiles, int til
       whole |= 1u << f;
       continue;
     }
-    const float theta_d = std::acos(std::clamp(glm::dot(d, cube_direction(f, {0.5f, 0.5f}, 1)), -1.0f, 1.0f));
-    const float z = std::cos(std::min(kFaceHalfAngle, theta_d) + margin);
-    const float half = margin * static_cast<float>(size) / (2.0f * z * z) + 1.0f;
-    const glm::vec2 p = cube_face_plane_pixel(f, d, size);
-    const float lo_x = (p.x - half) / tile, hi_x = (p.x + half) / tile;
-    const float lo_y = (p.y - half) / tile, hi_y = (p.y + half) / tile;
-    if (!(hi_x >= 0.0f && hi_y >= 0.0f && lo_x < float(n) && lo_y < float(n))) continue;
-    const int x0 = std::max(0, static_cast<int>(std::floor(lo_x))), x1 = std::min(n - 1, static_cast<int>(hi_x));
-    const int y0 = std::max(0, static_cast<int>(std::floor(lo_y))), y1 = std::min(n - 1, static_cast<int>(hi_y));
+    std::array<int, 4> rect;
+    if (!tiles_near_on_face(f, tile, n, size, d, margin, rect)) continue;
+    const auto [x0, y0, x1, y1] = rect;
     if (last) {
       std::array<int, 4>& r = (*last)[f];
       if (x0 >= r[0] && y0 >= r[1] && x1 <= r[2] && y1 <= r[3]) continue;
-      r = {x0, y0, x1, y1};
+      r = rect;
     }
     for (int y = y0; y <= y1; ++y) mark(t, static_cast<std::size_t>(y) * n + x0, static_cast<std::size_t>(x1 - x0 + 1));
   }
@@ -420,6 +430,117 @@ void settle_wide_reads(par::Executor& executor, CubeTileMask& mask) {
   // Settled: a later call (marks into the same masks, e.g. each face's searches of a
   // multi-reflection round) tests only what is recorded after this one.
   for (auto& w : mask.wide) std::fill(w.begin(), w.end(), 0u);
+}
+
+namespace {
+
+// Whether a level ≥ 1 texel over tile `i` of face f is prefiltered under a face mask and tiles
+// (null: all).
+bool prefiltered_over(unsigned faces, const CubeTileMask* tiles, int f, std::size_t i) {
+  return ((faces >> f) & 1u) && (!tiles || !tiles->active() || tiles->tiles[f][i]);
+}
+
+}  // namespace
+
+PrefilterReuse prefilter_reuse(par::Executor& executor, const std::array<ImageRGBA, kCubeFaces>& faces,
+                               unsigned face_mask, const CubeTileMask* tiles, const EnvironmentMap& from,
+                               unsigned from_faces, const CubeTileMask* from_tiles, int level_count) {
+  PrefilterReuse reuse;
+  reuse.from = &from;
+  reuse.faces = from_faces;
+  reuse.tiles = from_tiles;
+  const int size = faces[0].width;
+  const int levels = std::min<int>(level_count, static_cast<int>(from.levels.size()));
+  CubeTileMask changed = tile_mask_for_reads(std::max(size, 1), 2);
+  const int n = changed.tiles_per_side(), tile = changed.tile;
+  const bool same_tiles = [&] {  // both masks tile the faces alike (else nothing is taken)
+    for (const CubeTileMask* t : {tiles, from_tiles})
+      if (t && t->active() && (t->size != size || t->tile != tile)) return false;
+    return true;
+  }();
+  if (size < 1 || levels < 2 || from.size != size || !same_tiles) {
+    reuse.faces = 0;  // nothing to take
+    return reuse;
+  }
+  // Level 0: the tiles holding a texel whose bits differ (or a face of another size).
+  executor.parallel_for("environment.changed_texels", static_cast<std::size_t>(kCubeFaces) * n, 1,
+                        [&](std::size_t begin, std::size_t end) {
+    for (std::size_t row = begin; row < end; ++row) {
+      const int f = static_cast<int>(row / n), ty = static_cast<int>(row % n);
+      const ImageRGBA &now = faces[f], &was = from.levels[0][f];
+      std::uint8_t* marks = &changed.tiles[f][static_cast<std::size_t>(ty) * n];
+      if (now.width != size || was.width != size || now.height != size || was.height != size) {
+        std::fill(marks, marks + n, std::uint8_t(1));
+        continue;
+      }
+      for (int y = ty * tile; y < std::min(size, (ty + 1) * tile); ++y)
+        for (int tx = 0; tx < n; ++tx) {
+          if (marks[tx]) continue;
+          const int x0 = tx * tile, count = std::min(size, x0 + tile) - x0;
+          const std::size_t at = static_cast<std::size_t>(y) * size + x0;
+          marks[tx] = std::memcmp(&now.pixels[at], &was.pixels[at], count * sizeof(glm::vec4)) != 0;
+        }
+    }
+  });
+  // Level l: every level-l texel with an input (prefilter_reach of its centre) in a texel of
+  // level l − 1 under a changed tile. Such an input's centre is within the tile's radius and
+  // its own diagonal of the tile's centre, and the level-l texel covers a level-0 texel centre
+  // within a level-0 diagonal of its own centre: every tile holding a texel centre within all
+  // of these added of the tile's centre is marked, so a tile that texel covers is. Once most
+  // tiles have changed, the coarser levels are all taken as changed (their marks would cost
+  // more than they save).
+  const float tile_radius = square_radius(size, tile);
+  std::array<std::vector<glm::vec3>, kCubeFaces> centre;  // every tile's centre direction
+  for (int f = 0; f < kCubeFaces; ++f)
+    for (int ty = 0; ty < n; ++ty)
+      for (int tx = 0; tx < n; ++tx) {
+        const float x0 = float(tx * tile), y0 = float(ty * tile);
+        const float x1 = float(std::min(size, (tx + 1) * tile)), y1 = float(std::min(size, (ty + 1) * tile));
+        centre[f].push_back(cube_direction(f, {0.5f * (x0 + x1), 0.5f * (y0 + y1)}, size));
+      }
+  const std::size_t all_tiles = static_cast<std::size_t>(kCubeFaces) * n * n;
+  reuse.changed.resize(static_cast<std::size_t>(levels));
+  bool most = false;
+  for (int l = 1; l < levels; ++l) {
+    CubeTileMask next = tile_mask_for_reads(size, 2);
+    std::size_t marked = 0;
+    if (most) {
+      next.mark_all();
+    } else {
+      const float margin = prefilter_reach(size, l) + tile_radius + texel_reach(std::max(1, size >> (l - 1))) +
+                           texel_reach(size) + 1e-3f;
+      // A tile holds a texel centre within `margin` only if its centre is within margin and
+      // its radius: tested on the tiles of mark_near's rectangles (loose near the corners).
+      const float within = std::cos(std::min(kPi, margin + tile_radius));
+      for (int f = 0; f < kCubeFaces; ++f)
+        for (std::size_t i = 0; i < changed.tiles[f].size(); ++i) {
+          if (!changed.tiles[f][i]) continue;
+          const glm::vec3& c = centre[f][i];
+          const unsigned near = cube_faces_near(c, margin);
+          for (int g = 0; g < kCubeFaces; ++g) {
+            if (!((near >> g) & 1u)) continue;
+            std::array<int, 4> rect{0, 0, n - 1, n - 1};
+            if (margin < kWholeFaceMargin && !tiles_near_on_face(g, tile, n, size, c, margin, rect)) continue;
+            for (int y = rect[1]; y <= rect[3]; ++y)
+              for (int x = rect[0]; x <= rect[2]; ++x) {
+                const std::size_t j = static_cast<std::size_t>(y) * n + x;
+                if (!next.tiles[g][j] && glm::dot(c, centre[g][j]) >= within) next.tiles[g][j] = 1;
+              }
+          }
+        }
+    }
+    // The inputs of level l + 1: level l's changed texels, and those prefiltered in one map
+    // and not in the other (the other holds the default there).
+    changed = next;
+    for (int f = 0; f < kCubeFaces; ++f)
+      for (std::size_t i = 0; i < changed.tiles[f].size(); ++i) {
+        changed.tiles[f][i] |= prefiltered_over(face_mask, tiles, f, i) != prefiltered_over(from_faces, from_tiles, f, i);
+        marked += changed.tiles[f][i];
+      }
+    most = 2 * marked > all_tiles;
+    reuse.changed[static_cast<std::size_t>(l)] = std::move(next);
+  }
+  return reuse;
 }
 
 void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask>& from) {

@@ -171,6 +171,17 @@ void settle_wide_reads(par::Executor& executor, CubeTileMask& mask);
 // Marks in `into` every tile marked in `from` (masks of the same maps, in map order).
 void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask>& from);
 
+// What environment_from_faces can take from `from` (prefiltered with face mask `from_faces`
+// and tiles `from_tiles`, may be null: every texel) when it prefilters `level_count` levels of
+// `faces` with `face_mask` and `tiles`: per level l ≥ 1 the tiles whose level-l texels' inputs
+// may differ, grown level by level from the level-0 tiles where `faces` and from's level 0
+// differ by prefilter_reach (the texels' own extents and the tiles' radii added), and from
+// the texels one map prefilters and the other does not. Named launch
+// "environment.changed_texels".
+PrefilterReuse prefilter_reuse(par::Executor& executor, const std::array<ImageRGBA, kCubeFaces>& faces,
+                               unsigned face_mask, const CubeTileMask* tiles, const EnvironmentMap& from,
+                               unsigned from_faces, const CubeTileMask* from_tiles, int level_count);
+
 // 1 for each object with a specular sample in `camera_view` (what `skip_unseen` keeps).
 std::vector<std::uint8_t> seen_reflectors(const Scene& scene, const GBuffer& camera_view);
 

@@ -8,6 +8,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -301,6 +302,64 @@ TEST(ReflectorMaps, SearchesReusedFromOtherSamplesOfTheGBufferAreTheSame) {
     EXPECT_EQ(reused.stats.searches, right.stats.searches);
     EXPECT_EQ(reused.stats.lookups, right.stats.lookups);
   }
+}
+
+// A map's prefiltered texels taken from a map prefiltered before from other level-0 faces
+// (prefilter_reuse) where no input changed: the same bytes at every level as prefiltering all
+// again, with changed blobs on a face's edge and inside another face, and tiles and faces
+// prefiltered in one map and not the other. Two thirds of level 1 that both prefilter are taken; taking every texel
+// prefiltered before (as if nothing had changed) gives other bytes.
+TEST(ReflectorMaps, PrefilteredTexelsTakenFromAnEarlierMapAreTheSame) {
+  par::Executor ex(2);
+  constexpr int kSize = 64;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::array<ImageRGBA, kCubeFaces> before;
+  for (auto& face : before) {
+    face = ImageRGBA(kSize, kSize);
+    for (auto& p : face.pixels) p = glm::vec4(u(rng), u(rng), u(rng), 1.0f);
+  }
+  std::array<ImageRGBA, kCubeFaces> now = before;
+  for (int y = 20; y < 30; ++y)
+    for (int x = 0; x < 6; ++x) now[0].at(x, y) = glm::vec4(5.0f, 0.0f, 1.0f, 1.0f);  // on face 0's edge
+  for (int y = 40; y < 44; ++y)
+    for (int x = 30; x < 37; ++x) now[3].at(x, y) += glm::vec4(0.5f, 0.5f, 0.5f, 0.0f);
+  const auto random_tiles = [&](float keep) {
+    CubeTileMask mask = tile_mask_for_reads(kSize, 2);
+    for (auto& t : mask.tiles)
+      for (auto& tile : t) tile = u(rng) < keep;
+    return mask;
+  };
+  const CubeTileMask tiles_before = random_tiles(0.8f), tiles_now = random_tiles(0.8f);
+  const unsigned faces_before = 0x3fu & ~(1u << 5), faces_now = 0x3fu & ~(1u << 2);
+  const EnvironmentMap earlier = environment_from_faces(ex, before, false, 0, faces_before, &tiles_before);
+  const int levels = static_cast<int>(earlier.levels.size());
+  const EnvironmentMap expected = environment_from_faces(ex, now, false, 0, faces_now, &tiles_now);
+  const PrefilterReuse reuse =
+      prefilter_reuse(ex, now, faces_now, &tiles_now, earlier, faces_before, &tiles_before, levels);
+  const EnvironmentMap taken = environment_from_faces(ex, now, false, 0, faces_now, &tiles_now, &reuse);
+  ASSERT_EQ(taken.levels.size(), expected.levels.size());
+  for (std::size_t l = 0; l < expected.levels.size(); ++l)
+    for (int f = 0; f < kCubeFaces; ++f) {
+      SCOPED_TRACE(::testing::Message() << "level " << l << " face " << f);
+      EXPECT_TRUE(same_bytes(taken.levels[l][f], expected.levels[l][f]));
+    }
+  // What level 1 takes: of the texels both maps prefilter, those under no changed tile.
+  std::size_t both = 0, from_before = 0;
+  for (int f = 0; f < kCubeFaces; ++f)
+    for (int y = 0; y < kSize / 2; ++y)
+      for (int x = 0; x < kSize / 2; ++x) {
+        if (!((faces_now >> f) & 1u) || !tiles_now.covers(f, 1, x, y)) continue;
+        if (!((faces_before >> f) & 1u) || !tiles_before.covers(f, 1, x, y)) continue;
+        ++both;
+        from_before += !reuse.changed[1].covers(f, 1, x, y);
+      }
+  EXPECT_GT(from_before, both * 2 / 3);
+  PrefilterReuse blind = reuse;
+  for (std::size_t l = 1; l < blind.changed.size(); ++l)
+    for (auto& t : blind.changed[l].tiles) std::fill(t.begin(), t.end(), std::uint8_t(0));
+  const EnvironmentMap stale = environment_from_faces(ex, now, false, 0, faces_now, &tiles_now, &blind);
+  EXPECT_FALSE(same_bytes(stale.levels[1][0], expected.levels[1][0]));
 }
 
 // A reflector with no sample in the camera's view gets no map under skip_unseen (nothing
