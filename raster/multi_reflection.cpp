@@ -210,11 +210,13 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
         if (texel.empty() || !((distances.faces[m] >> f) & 1u)) continue;
         FaceSearches& s = searched[k][m][f];
         s.object = texels.object;
-        const int size = distances.cubes[m].size;
+        const CubeTileMask& on = read[k][m];  // its level-0 tiles, read directly (CubeTileMask::covers)
+        const std::uint32_t size = static_cast<std::uint32_t>(std::max(on.size, 1)), tile = static_cast<std::uint32_t>(on.tile);
+        const std::uint32_t n = static_cast<std::uint32_t>(on.tiles_per_side());
         bool any = false;
         for (std::size_t j = 0; j < texel.size(); ++j) {
-          const int x = static_cast<int>(texel[j] % std::uint32_t(size)), y = static_cast<int>(texel[j] / std::uint32_t(size));
-          if (read[k][m].covers(f, 0, x, y)) any = true;
+          const std::uint32_t x = texel[j] % size, y = texel[j] / size;
+          if (!on.active() || (!on.tiles[f].empty() && on.tiles[f][(y / tile) * n + x / tile])) any = true;
           else s.object.pixels[j] = kNoId;
         }
         if (!any) {

@@ -486,9 +486,10 @@ PrefilterReuse prefilter_reuse(par::Executor& executor, const std::array<ImageRG
   // level l − 1 under a changed tile. Such an input's centre is within the tile's radius and
   // its own diagonal of the tile's centre, and the level-l texel covers a level-0 texel centre
   // within a level-0 diagonal of its own centre: every tile holding a texel centre within all
-  // of these added of the tile's centre is marked, so a tile that texel covers is. Once most
-  // tiles have changed, the coarser levels are all taken as changed (their marks would cost
-  // more than they save).
+  // of these added of the tile's centre is marked, so a tile that texel covers is. Levels past
+  // kReusedLevels, and those after most tiles have changed, are all taken as changed: their
+  // marks, ever wider, would cost more than the few texels they spare.
+  constexpr int kReusedLevels = 2;
   const float tile_radius = square_radius(size, tile);
   std::array<std::vector<glm::vec3>, kCubeFaces> centre;  // every tile's centre direction
   for (int f = 0; f < kCubeFaces; ++f)
@@ -504,30 +505,33 @@ PrefilterReuse prefilter_reuse(par::Executor& executor, const std::array<ImageRG
   for (int l = 1; l < levels; ++l) {
     CubeTileMask next = tile_mask_for_reads(size, 2);
     std::size_t marked = 0;
-    if (most) {
+    if (most || l > kReusedLevels) {
       next.mark_all();
     } else {
       const float margin = prefilter_reach(size, l) + tile_radius + texel_reach(std::max(1, size >> (l - 1))) +
                            texel_reach(size) + 1e-3f;
       // A tile holds a texel centre within `margin` only if its centre is within margin and
       // its radius: tested on the tiles of mark_near's rectangles (loose near the corners).
+      // One task per face marked (each writes its own face).
       const float within = std::cos(std::min(kPi, margin + tile_radius));
-      for (int f = 0; f < kCubeFaces; ++f)
-        for (std::size_t i = 0; i < changed.tiles[f].size(); ++i) {
-          if (!changed.tiles[f][i]) continue;
-          const glm::vec3& c = centre[f][i];
-          const unsigned near = cube_faces_near(c, margin);
-          for (int g = 0; g < kCubeFaces; ++g) {
-            if (!((near >> g) & 1u)) continue;
-            std::array<int, 4> rect{0, 0, n - 1, n - 1};
-            if (margin < kWholeFaceMargin && !tiles_near_on_face(g, tile, n, size, c, margin, rect)) continue;
-            for (int y = rect[1]; y <= rect[3]; ++y)
-              for (int x = rect[0]; x <= rect[2]; ++x) {
-                const std::size_t j = static_cast<std::size_t>(y) * n + x;
-                if (!next.tiles[g][j] && glm::dot(c, centre[g][j]) >= within) next.tiles[g][j] = 1;
-              }
-          }
+      executor.parallel_for("environment.changed_tiles", kCubeFaces, 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t task = begin; task < end; ++task) {
+          const int g = static_cast<int>(task);
+          for (int f = 0; f < kCubeFaces; ++f)
+            for (std::size_t i = 0; i < changed.tiles[f].size(); ++i) {
+              if (!changed.tiles[f][i]) continue;
+              const glm::vec3& c = centre[f][i];
+              if (!((cube_faces_near(c, margin) >> g) & 1u)) continue;
+              std::array<int, 4> rect{0, 0, n - 1, n - 1};
+              if (margin < kWholeFaceMargin && !tiles_near_on_face(g, tile, n, size, c, margin, rect)) continue;
+              for (int y = rect[1]; y <= rect[3]; ++y)
+                for (int x = rect[0]; x <= rect[2]; ++x) {
+                  const std::size_t j = static_cast<std::size_t>(y) * n + x;
+                  if (!next.tiles[g][j] && glm::dot(c, centre[g][j]) >= within) next.tiles[g][j] = 1;
+                }
+            }
         }
+      });
     }
     // The inputs of level l + 1: level l's changed texels, and those prefiltered in one map
     // and not in the other (the other holds the default there).

@@ -176,8 +176,8 @@ void merge_reads(std::vector<CubeTileMask>& into, const std::vector<CubeTileMask
 // `faces` with `face_mask` and `tiles`: per level l ≥ 1 the tiles whose level-l texels' inputs
 // may differ, grown level by level from the level-0 tiles where `faces` and from's level 0
 // differ by prefilter_reach (the texels' own extents and the tiles' radii added), and from
-// the texels one map prefilters and the other does not. Named launch
-// "environment.changed_texels".
+// the texels one map prefilters and the other does not. Named launches
+// "environment.changed_texels" and "environment.changed_tiles".
 PrefilterReuse prefilter_reuse(par::Executor& executor, const std::array<ImageRGBA, kCubeFaces>& faces,
                                unsigned face_mask, const CubeTileMask* tiles, const EnvironmentMap& from,
                                unsigned from_faces, const CubeTileMask* from_tiles, int level_count);
