@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include <glm/geometric.hpp>
@@ -673,6 +674,7 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
       const SurfaceParams& s = g.surface[i];
       if (s.is_refractor()) continue;
       const glm::vec3 p = g.position.pixels[i], nrm = g.normal.pixels[i], v = g.view_direction(i);
+      std::optional<BrdfAtView> view;  // the viewer's BRDF terms, once for every map that lights it
       glm::vec3 sum(0.0f);
       for (std::size_t k = 0; k < maps.cubes.size(); ++k) {
         if (g.object.pixels[i] == maps.objects[k]) continue;  // a generator is not its own receiver
@@ -703,7 +705,8 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
         ls.direction = wi;
         ls.distance = dist;
         ls.irradiance = flux * (cos_alpha / (cube_texel_solid_angle(x, y, m.size) * dist * dist * cos_in));
-        sum += shade_light(s, nrm, v, ls);
+        if (!view) view = brdf_at_view(brdf_params_for_punctual_light(s), nrm, v);
+        sum += shade_light(s, *view, nrm, v, ls);
       }
       out.pixels[i] += glm::vec4(sum, 0.0f);
     }
