@@ -14,6 +14,8 @@
 #include "core/error.h"
 #include "core/optics.h"
 #include "core/shading.h"
+#include "parallel/lanes.h"
+#include "raster/cube_coord_lanes.h"
 #include "raster/refraction_path.h"
 #include "raster/visibility.h"
 
@@ -662,54 +664,99 @@ CausticMaps build_caustic_maps(par::Executor& executor, const Scene& scene, cons
   return out;
 }
 
+namespace {
+
+// The caustic light a receiver gets from one map's texel c, seen at distance `dist` along
+// d = p − centre with |N·d|/dist = cos_alpha: irradiance Φ |cosα| / (Ω d²) from the texel's
+// mean photon direction, shaded (`view`: the receiver's BRDF terms, made on first use).
+// Nothing when that direction is below the surface.
+glm::vec3 texel_caustic(const CausticMaps& maps, std::size_t k, const CubeCoord& c, float dist, float cos_alpha,
+                        const SurfaceParams& s, const glm::vec3& nrm, const glm::vec3& v, std::optional<BrdfAtView>& view) {
+  const CubeMap& m = maps.cubes[k];
+  const int x = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
+  const int y = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
+  const glm::vec3 flux = glm::vec3(m.colour_at(c));
+  const glm::vec3 wi = maps.incident[k][c.face].at(x, y);
+  // The texel's flux lands on the receiver area Ω d² / |cosα| it subtends (α between the
+  // normal and the line from the centre): irradiance Φ |cosα| / (Ω d²), arriving from wi.
+  // shade_light returns f (N·L) E, so it is given E / (N·wi).
+  const float cos_in = glm::dot(nrm, wi);
+  if (cos_in <= 1e-4f) return glm::vec3(0.0f);
+  LightSample ls;
+  ls.direction = wi;
+  ls.distance = dist;
+  ls.irradiance = flux * (cos_alpha / (cube_texel_solid_angle(x, y, m.size) * dist * dist * cos_in));
+  if (!view) view = brdf_at_view(brdf_params_for_punctual_light(s), nrm, v);
+  return shade_light(s, *view, nrm, v, ls);
+}
+
+}  // namespace
+
 ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps& maps, const ImageRGBA& direct,
                           float tolerance) {
   if (direct.width != g.width || direct.height != g.height)
     throw InputError("caustic_gather", "direct light and G-buffer differ in size");
   ImageRGBA out = direct;
   const std::size_t n = static_cast<std::size_t>(g.width) * g.height;
+  using L = par::Lanes<8>;
+  using f32 = L::f32;
   ex.parallel_for("caustic_gather", n, 1024, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface[i];
-      if (s.is_refractor()) continue;
-      const glm::vec3 p = g.position.pixels[i], nrm = g.normal.pixels[i], v = g.view_direction(i);
-      std::optional<BrdfAtView> view;  // the viewer's BRDF terms, once for every map that lights it
-      glm::vec3 sum(0.0f);
-      for (std::size_t k = 0; k < maps.cubes.size(); ++k) {
-        if (g.object.pixels[i] == maps.objects[k]) continue;  // a generator is not its own receiver
-        const CubeMap& m = maps.cubes[k];
-        const glm::vec3 d = p - m.centre;
-        const float dist = glm::length(d);
-        if (!(dist > 0.0f)) continue;
-        const CubeCoord c = cube_coord(d, m.size);  // once for the distance, the texel and the colour
-        const float stored = m.distance_at(c);
+    // The chunk's receivers (covered, not refractors), map by map: eight receivers' distance
+    // tests at once in lanes (each lane with the scalar operations in their order), the
+    // texels that light one shaded one at a time; each receiver's sum in map order.
+    std::vector<std::uint32_t> at;
+    for (std::size_t i = b; i < e; ++i)
+      if (g.covered(i) && !g.surface[i].is_refractor()) at.push_back(static_cast<std::uint32_t>(i));
+    std::vector<glm::vec3> sum(at.size(), glm::vec3(0.0f));
+    std::vector<std::optional<BrdfAtView>> view(at.size());
+    for (std::size_t k = 0; k < maps.cubes.size(); ++k) {
+      const CubeMap& m = maps.cubes[k];
+      const float texel = 2.0f / static_cast<float>(m.size);
+      for (std::size_t first = 0; first < at.size(); first += 8) {
+        const int count = static_cast<int>(std::min<std::size_t>(8, at.size() - first));
+        alignas(32) float p[3][8] = {}, nr[3][8] = {};
+        alignas(32) std::int32_t mine[8] = {};
+        for (int j = 0; j < count; ++j) {
+          const std::size_t i = at[first + j];
+          for (int c = 0; c < 3; ++c) p[c][j] = g.position.pixels[i][c], nr[c][j] = g.normal.pixels[i][c];
+          mine[j] = g.object.pixels[i] == maps.objects[k];  // a generator is not its own receiver
+        }
+        f32 d[3];
+        for (int c = 0; c < 3; ++c) d[c] = L::load_aligned(p[c]) - f32(m.centre[c]);
+        const f32 dist = L::sqrt((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]);
+        const L::mask tested = L::first_n(count) && (L::load_aligned(mine) == 0) && (dist > 0.0f);
+        if (L::none(tested)) continue;
+        const CubeCoordLanes cc = cube_coord8(d, m.size);
+        alignas(32) float stored_at[8];
+        for (int j = 0; j < 8; ++j) {
+          const CubeCoord c{cc.face[j], {cc.x[j], cc.y[j]}};
+          stored_at[j] = tested[j] ? m.distance_at(c) : 0.0f;
+        }
+        const f32 stored = L::load_aligned(stored_at);
         // The shadow-map-like test: only the receiver the photons found is lit. Across one
         // texel (angle ≈ 2/size) a receiver at angle α to the line of sight from the centre
         // changes its distance by about d (2/size) tanα, so grazing receivers are allowed
         // that much more (tanα capped at 16, beyond which no texel resolves the surface).
-        const float cos_view = std::fabs(glm::dot(nrm, d)) / dist;
-        const float tan_view = std::min(16.0f, std::sqrt(std::max(0.0f, 1.0f - cos_view * cos_view)) / std::max(cos_view, 1e-3f));
-        const float slack = tolerance * stored + 2.0f * dist * tan_view * (2.0f / static_cast<float>(m.size));
-        if (!std::isfinite(stored) || std::fabs(dist - stored) > slack) continue;
-        const int x = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
-        const int y = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
-        const glm::vec3 flux = glm::vec3(m.colour_at(c));
-        const glm::vec3 wi = maps.incident[k][c.face].at(x, y);
-        // The texel's flux lands on the receiver area Ω d² / |cosα| it subtends (α between
-        // the normal and the line from the centre): irradiance Φ |cosα| / (Ω d²), arriving
-        // from wi. shade_light returns f (N·L) E, so it is given E / (N·wi).
-        const float cos_alpha = std::fabs(glm::dot(nrm, d)) / dist, cos_in = glm::dot(nrm, wi);
-        if (cos_in <= 1e-4f) continue;
-        LightSample ls;
-        ls.direction = wi;
-        ls.distance = dist;
-        ls.irradiance = flux * (cos_alpha / (cube_texel_solid_angle(x, y, m.size) * dist * dist * cos_in));
-        if (!view) view = brdf_at_view(brdf_params_for_punctual_light(s), nrm, v);
-        sum += shade_light(s, *view, nrm, v, ls);
+        // std::min/max's operand order kept, so NaNs fall as they would.
+        const f32 cos_view =
+            L::abs((L::load_aligned(nr[0]) * d[0] + L::load_aligned(nr[1]) * d[1]) + L::load_aligned(nr[2]) * d[2]) / dist;
+        const f32 sin2 = 1.0f - cos_view * cos_view;
+        const f32 sin_view = L::sqrt(L::select(f32(0.0f) < sin2, sin2, f32(0.0f)));
+        const f32 ratio = sin_view / L::select(cos_view < 1e-3f, f32(1e-3f), cos_view);
+        const f32 tan_view = L::select(ratio < 16.0f, ratio, f32(16.0f));
+        const f32 slack = tolerance * stored + 2.0f * dist * tan_view * texel;
+        const L::mask lit = tested && (L::abs(stored) < std::numeric_limits<float>::infinity()) &&
+                            !(L::abs(dist - stored) > slack);
+        for (int j = 0; j < count; ++j) {
+          if (!lit[j]) continue;
+          const std::size_t i = at[first + j];
+          const CubeCoord c{cc.face[j], {cc.x[j], cc.y[j]}};
+          sum[first + j] += texel_caustic(maps, k, c, dist[j], cos_view[j], g.surface[i], g.normal.pixels[i],
+                                          g.view_direction(i), view[first + j]);
+        }
       }
-      out.pixels[i] += glm::vec4(sum, 0.0f);
     }
+    for (std::size_t r = 0; r < at.size(); ++r) out.pixels[at[r]] += glm::vec4(sum[r], 0.0f);
   });
   return out;
 }
