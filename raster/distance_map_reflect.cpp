@@ -32,9 +32,12 @@ constexpr int kLobeBatch = 8;
 // The radiance arriving along d through a lobe of `exponent` at a sample with normal n, from
 // `search(directions, count, exponent, radiance)`: into radiance[j] the radiance one search
 // along directions[j] (j < count ≤ kLobeBatch) finds, read through a lobe of that exponent.
-// Every user walks the same searches in the same order.
+// Every user walks the same searches in the same order. `averaged` (may be null) is set to the
+// number of searches averaged (0: the value is one search's).
 template <class Search>
-glm::vec3 searched_lookup(const glm::vec3& n, const glm::vec3& d, float exponent, SubLobeAxes& axes, Search&& search) {
+glm::vec3 searched_lookup(const glm::vec3& n, const glm::vec3& d, float exponent, SubLobeAxes& axes, Search&& search,
+                          int* averaged = nullptr) {
+  if (averaged) *averaged = 0;
   glm::vec3 along_d;
   const int directions = axes.count();
   if (directions <= 1 || !(exponent < kGlossySearchExponent)) {
@@ -60,7 +63,10 @@ glm::vec3 searched_lookup(const glm::vec3& n, const glm::vec3& d, float exponent
     if (batched == kLobeBatch) flush();
   }
   if (batched > 0) flush();
-  if (used > 0) return sum / float(used);
+  if (used > 0) {
+    if (averaged) *averaged = used;
+    return sum / float(used);
+  }
   search(&d, 1, exponent, &along_d);
   return along_d;
 }
@@ -250,22 +256,58 @@ ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const E
   ImageRGBA out(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
   executor.parallel_for("distance_map_reflect.lookup", out.size(), kChunk, [&](std::size_t begin, std::size_t end) {
     const std::vector<glm::vec3>& found = searches.found[begin / kChunk];
-    std::size_t next = 0;
+    // The chunk's samples' lookups first (their plans, each found direction's map and lobe,
+    // and how each lookup combines its directions), then the colour along every found
+    // direction, eight at a time along a run of one map (radiance8: each lane the bits of one
+    // lookup, whichever others share the call), then each sample's radiance from its lookups
+    // with searched_lookup's arithmetic in its order.
+    struct Sample {
+      std::size_t i;
+      int map;
+      SpecularLookups plan;
+      int averaged[2] = {0, 0};  // per lookup: searched_lookup's `averaged`
+    };
+    std::vector<Sample> samples;
+    std::vector<int> map_of;
+    std::vector<float> exponent_of;
+    map_of.reserve(found.size());
+    exponent_of.reserve(found.size());
     SubLobeAxes axes(options.lobe_directions);
     for (std::size_t i = begin; i < end; ++i) {
       if (!g.covered(i)) continue;
       const SurfaceParams& s = g.surface[i];
       if (!is_specular(s)) continue;
-      const int m = map_of_sample(g, maps, i);
-      const glm::vec3 n = g.normal.pixels[i];
-      const auto lookup = [&](const glm::vec3& d, float exponent) {
-        if (m < 0) return env.radiance(d, exponent);
-        return searched_lookup(n, d, exponent, axes, [&](const glm::vec3*, int count, float e, glm::vec3* radiance) {
-          read_colour(maps.maps[m], &found[next], count, e, radiance);
-          next += static_cast<std::size_t>(count);
-        });
-      };
-      out.pixels[i] = glm::vec4(specular_radiance(s, n, g.view_direction(i), lookup), 1.0f);
+      Sample& sample = samples.emplace_back(Sample{i, map_of_sample(g, maps, i), SpecularLookups(s, g.normal.pixels[i], g.view_direction(i))});
+      if (sample.map < 0) continue;
+      for (int k = 0; k < sample.plan.count; ++k)
+        searched_lookup(g.normal.pixels[i], sample.plan.direction[k], sample.plan.exponent[k], axes,
+                        [&](const glm::vec3*, int count, float e, glm::vec3* radiance) {
+          for (int j = 0; j < count; ++j) map_of.push_back(sample.map), exponent_of.push_back(e);
+          std::fill(radiance, radiance + count, glm::vec3(0.0f));
+        }, &sample.averaged[k]);
+    }
+    std::vector<glm::vec3> colour(map_of.size());
+    for (std::size_t q = 0; q < map_of.size();) {
+      std::size_t run = 1;
+      while (run < 8 && q + run < map_of.size() && map_of[q + run] == map_of[q]) ++run;
+      maps.maps[static_cast<std::size_t>(map_of[q])].radiance8(&found[q], &exponent_of[q], static_cast<int>(run), &colour[q]);
+      q += run;
+    }
+    std::size_t next = 0;
+    for (const Sample& sample : samples) {
+      glm::vec3 arriving[2];
+      for (int k = 0; k < sample.plan.count; ++k) {
+        if (sample.map < 0) {
+          arriving[k] = env.radiance(sample.plan.direction[k], sample.plan.exponent[k]);
+        } else if (const int used = sample.averaged[k]; used > 0) {
+          glm::vec3 sum(0.0f);
+          for (int j = 0; j < used; ++j) sum += colour[next++];
+          arriving[k] = sum / float(used);
+        } else {
+          arriving[k] = colour[next++];
+        }
+      }
+      out.pixels[sample.i] = glm::vec4(sample.plan.radiance(arriving), 1.0f);
     }
   });
   return out;
