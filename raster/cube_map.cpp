@@ -132,8 +132,7 @@ glm::vec4 CubeMap::colour_at(const CubeCoord& c) const {
          (img.at(x0, y1) * (1 - tx) + img.at(x1, y1) * tx) * ty;
 }
 
-bool CubeTileMask::covers(int face, int level, int x, int y) const {
-  if (!active()) return true;
+bool CubeTileMask::covers_tiles(int face, int level, int x, int y) const {
   const std::vector<std::uint8_t>& t = tiles[face];
   if (t.empty()) return false;
   const int n = tiles_per_side();

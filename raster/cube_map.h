@@ -130,11 +130,20 @@ struct CubeTileMask {
   }
   int tiles_per_side() const { return (size + tile - 1) / tile; }
   // Level-`level` texel (x, y) of `face` (a side of size >> level) overlaps a read tile.
-  bool covers(int face, int level, int x, int y) const;
+  // Inline for a texel inside one tile (the per-texel tests of prefiltering and shading).
+  bool covers(int face, int level, int x, int y) const {
+    if (!active()) return true;
+    if ((1 << level) > tile) return covers_tiles(face, level, x, y);
+    const std::vector<std::uint8_t>& t = tiles[face];
+    return !t.empty() && t[static_cast<std::size_t>((y << level) / tile) * tiles_per_side() + (x << level) / tile];
+  }
   // The level-0 texels of `face` in read tiles, one byte each (1: read), row-major.
   std::vector<std::uint8_t> texels(int face) const;
   // Level-0 texels in read tiles, over the faces in `face_mask` (0 for an inactive mask).
   double texel_count(unsigned face_mask) const;
+
+ private:
+  bool covers_tiles(int face, int level, int x, int y) const;  // covers over several tiles
 };
 
 // Colour of face `face` from its G-buffer; background samples (object == kNoId) too. `read`

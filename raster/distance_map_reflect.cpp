@@ -82,7 +82,9 @@ int map_of_sample(const GBuffer& g, const ReflectorMaps& maps, std::size_t i) {
 void search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, const glm::vec3* directions, int count,
                     const DistanceSearchOptions& options, DistanceReflectStats& st, glm::vec3* found) {
   DistanceSearchResult hits[kLobeBatch];
-  search_distance_map8(maps.cubes[m], x, directions, count, options, hits);
+  glm::vec3 from[kLobeBatch];
+  std::fill(from, from + count, x);
+  search_distance_map8(maps.cubes[m], from, directions, count, options, hits);
   for (int j = 0; j < count; ++j) {
     ++st.searches;
     st.lookups += hits[j].lookups;
@@ -201,6 +203,17 @@ DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const
     std::vector<LookupTileMarker> markers;
     for (std::size_t m = 0; m < maps.cubes.size(); ++m) markers.emplace_back(tiles[m], maps.levels[m]);
     SubLobeAxes axes(options.lobe_directions);
+    // A lookup's single searches (a mirror's, or any lobe searched along its axis alone) are
+    // gathered in sample order (their directions' places in `found` kept) and made eight at a
+    // time along runs of one map after the chunk's samples, sharing their secant steps' lanes.
+    struct Request {
+      glm::vec3 x, r;
+      int map;
+      float exponent;
+      std::size_t slot, sample;
+    };
+    std::vector<Request> requests;
+    requests.reserve(end - begin);
     for (std::size_t i = begin; i < end; ++i) {
       const int m_now = searched_map(g, g.object.pixels[i], maps, i);
       const int m_before = earlier_object ? searched_map(g, earlier_object->pixels[i], maps, i) : -1;
@@ -210,25 +223,52 @@ DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const
       const auto lookup = [&](const glm::vec3& d, float exponent) {
         return searched_lookup(n, d, exponent, axes,
                                [&](const glm::vec3* dk, int count, float e, glm::vec3* radiance) {
-          glm::vec3 along[kLobeBatch];
           if (m_before >= 0) {
-            std::copy(before, before + count, along);
+            for (int j = 0; j < count && m_now >= 0; ++j) {
+              found.push_back(before[j]);
+              markers[m].mark(before[j], e);
+            }
             before += count;
-          } else {
+          } else if (count > 1) {  // a glossy lobe's sub-lobe searches share their secant steps' lanes
+            glm::vec3 along[kLobeBatch];
+            const std::uint64_t missed_before = st.missed;
             search_counted(maps, m, x, dk, count, options, st, along);
-          }
-          for (int j = 0; j < count && m_now >= 0; ++j) {
-            found.push_back(along[j]);
-            markers[m].mark(along[j], e);
+            if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
+            for (int j = 0; j < count; ++j) {
+              found.push_back(along[j]);
+              markers[m].mark(along[j], e);
+            }
+          } else {
+            requests.push_back({x, dk[0], m, e, found.size(), i});
+            found.emplace_back(0.0f);
           }
           std::fill(radiance, radiance + count, glm::vec3(0.0f));
         });
       };
-      const std::uint64_t missed_before = st.missed;
       // Its value is not needed here: it makes the lookups (R, and T for a refractor) in the
       // order distance_map_lookup replays them.
       specular_radiance(g.surface[i], n, g.view_direction(i), lookup);
-      if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
+    }
+    for (std::size_t q = 0; q < requests.size();) {
+      const int m = requests[q].map;
+      std::size_t run = 1;
+      while (run < kLobeBatch && q + run < requests.size() && requests[q + run].map == m) ++run;
+      glm::vec3 x[kLobeBatch], r[kLobeBatch];
+      for (std::size_t j = 0; j < run; ++j) x[j] = requests[q + j].x, r[j] = requests[q + j].r;
+      DistanceSearchResult hits[kLobeBatch];
+      search_distance_map8(maps.cubes[static_cast<std::size_t>(m)], x, r, static_cast<int>(run), options, hits);
+      for (std::size_t j = 0; j < run; ++j) {
+        const Request& req = requests[q + j];
+        ++st.searches;
+        st.lookups += hits[j].lookups;
+        st.bracketed += hits[j].bracketed;
+        const bool missed = !std::isfinite(hits[j].d);
+        st.missed += missed;
+        if (fallbacks && missed) fallbacks->mark(req.sample, Fallback::search_missed);
+        found[req.slot] = glm::normalize(hits[j].direction);
+        markers[static_cast<std::size_t>(m)].mark(found[req.slot], req.exponent);
+      }
+      q += run;
     }
   });
   for (CubeTileMask& mask : tiles) settle_wide_reads(executor, mask);

@@ -58,22 +58,24 @@ struct CubeMarch {
   }
 };
 
-// refine_bracket for the searches j with bit j of `pending`, side by side: per lane the
-// scalar steps (secant_from_ratios, ratio, the bracket's update, the stop at a ratio of 1).
-void refine_brackets8(const CubeMap& map, const glm::vec3& x, const glm::vec3* r, const distance_search_detail::Bracket* b,
+// refine_bracket for the searches j with bit j of `pending` (from x[j] along r[j]), side by
+// side: per lane the scalar steps (secant_from_ratios, ratio, the bracket's update, the stop
+// at a ratio of 1).
+void refine_brackets8(const CubeMap& map, const glm::vec3* x, const glm::vec3* r, const distance_search_detail::Bracket* b,
                       unsigned pending, const DistanceSearchOptions& o, DistanceSearchResult* out) {
   // Lanes of other searches repeat the first pending one: valid inputs, results dropped.
   const int first = std::countr_zero(pending);
-  alignas(32) float in[7][8];
+  alignas(32) float in[10][8];
   for (int j = 0; j < 8; ++j) {
     const int k = (pending >> j) & 1u ? j : first;
     in[0][j] = b[k].d_l, in[1][j] = b[k].g_l, in[2][j] = b[k].d_p, in[3][j] = b[k].g_p;
     in[4][j] = r[k].x, in[5][j] = r[k].y, in[6][j] = r[k].z;
+    in[7][j] = x[k].x, in[8][j] = x[k].y, in[9][j] = x[k].z;
   }
   f32 d_l = L::load_aligned(in[0]), g_l = L::load_aligned(in[1]), d_p = L::load_aligned(in[2]),
       g_p = L::load_aligned(in[3]);
   const f32 rs[3] = {L::load_aligned(in[4]), L::load_aligned(in[5]), L::load_aligned(in[6])};
-  const f32 xs[3] = {f32(x.x), f32(x.y), f32(x.z)};
+  const f32 xs[3] = {L::load_aligned(in[7]), L::load_aligned(in[8]), L::load_aligned(in[9])};
   alignas(32) std::int32_t bits[8];
   for (int j = 0; j < 8; ++j) bits[j] = (pending >> j) & 1u ? -1 : 0;
   L::mask active = L::load_aligned(bits) != i32(0);
@@ -102,7 +104,7 @@ void refine_brackets8(const CubeMap& map, const glm::vec3& x, const glm::vec3* r
     out[j].bracketed = true;
     out[j].lookups += lookups_at[j];
     out[j].d = best_at[j];
-    out[j].direction = distance_search_detail::hit_direction(x, r[j], best_at[j]);
+    out[j].direction = distance_search_detail::hit_direction(x[j], r[j], best_at[j]);
   }
 }
 
@@ -114,23 +116,29 @@ DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_
                          x_world - map.centre, r, options);
 }
 
-void search_distance_map8(const CubeMap& map, const glm::vec3& x_world, const glm::vec3* r, int count,
+void search_distance_map8(const CubeMap& map, const glm::vec3* x_world, const glm::vec3* r, int count,
                           const DistanceSearchOptions& options, DistanceSearchResult* out) {
   using namespace distance_search_detail;
-  const glm::vec3 x = x_world - map.centre;
-  const float x_len = glm::length(x);
-  if (count < 2 || x_len == 0.0f || !(options.linear && options.linear_steps >= 2)) {
-    for (int j = 0; j < count; ++j) out[j] = search_distance_map(map, x_world, r[j], options);
+  const bool march = options.linear && options.linear_steps >= 2;
+  if (count < 2 || !march) {
+    for (int j = 0; j < count; ++j) out[j] = search_distance_map(map, x_world[j], r[j], options);
     return;
   }
   const auto towards = [&](const glm::vec3& d) { return map.distance_towards(d); };
+  glm::vec3 x[8];
   Bracket b[8];
   unsigned pending = 0;
   for (int j = 0; j < count; ++j) {
+    x[j] = x_world[j] - map.centre;
+    const float x_len = glm::length(x[j]);
+    if (x_len == 0.0f) {  // a direct lookup (search_distance)
+      out[j] = search_distance_map(map, x_world[j], r[j], options);
+      continue;
+    }
     out[j] = {};
-    b[j] = march_to_bracket(CubeMarch{map}, x, r[j], x_len, options.linear_steps, out[j].lookups);
+    b[j] = march_to_bracket(CubeMarch{map}, x[j], r[j], x_len, options.linear_steps, out[j].lookups);
     if (b[j].found) pending |= 1u << j;
-    else search_unbracketed(towards, x, r[j], options, out[j]);
+    else search_unbracketed(towards, x[j], r[j], options, out[j]);
   }
   if (pending) refine_brackets8(map, x, r, b, pending, options, out);
 }

@@ -232,11 +232,11 @@ DistanceSearchResult search_distance(const DistanceFn& distance_towards, const g
 // linear march reads eight samples at a time in lanes (each with ratio()'s bits).
 DistanceSearchResult search_distance_map(const CubeMap& map, const glm::vec3& x_world,
                                          const glm::vec3& r, const DistanceSearchOptions& options);
-// search_distance_map from one point along count (1..8) directions r[j], into out[j]: each
-// search's march as there, then the bracketed ones' secant steps side by side in lanes (a
-// step waits on the one before it; eight independent searches keep the core busy), each
+// search_distance_map from count (1..8) points x_world[j] along directions r[j], into out[j]:
+// each search's march as there, then the bracketed ones' secant steps side by side in lanes
+// (a step waits on the one before it; eight independent searches keep the core busy), each
 // lane with the scalar steps' operations in their order. The same results, bit for bit.
-void search_distance_map8(const CubeMap& map, const glm::vec3& x_world, const glm::vec3* r, int count,
+void search_distance_map8(const CubeMap& map, const glm::vec3* x_world, const glm::vec3* r, int count,
                           const DistanceSearchOptions& options, DistanceSearchResult* out);
 
 }  // namespace speculum::raster

@@ -228,7 +228,9 @@ TEST(DistanceMapSearch, EightSearchesInLanesGiveTheBitsOfEachAlone) {
       const int count = 1 + int(i / 8) % 8;
       for (const glm::vec3 origin : {x, f.map.centre}) {
         DistanceSearchResult lanes[8];
-        search_distance_map8(f.map, origin, &dirs[i], count, o, lanes);
+        glm::vec3 origins[8];
+        std::fill(origins, origins + 8, origin);
+        search_distance_map8(f.map, origins, &dirs[i], count, o, lanes);
         for (int j = 0; j < count; ++j) {
           const DistanceSearchResult alone = search_distance_map(f.map, origin, dirs[i + j], o);
           ASSERT_EQ(std::bit_cast<std::uint32_t>(lanes[j].d), std::bit_cast<std::uint32_t>(alone.d)) << oi << " " << i << " " << j;
