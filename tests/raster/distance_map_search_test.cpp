@@ -205,10 +205,11 @@ TEST(DistanceMapSearch, MarchInLanesGivesTheBitsOfTheScalarMarch) {
   EXPECT_GT(bracketed, compared / 3);
 }
 
-// Eight searches from one point with their secant steps side by side in lanes: each result
-// (d, direction, bracket, lookups) has the bits of the search alone, for every count of
-// directions, with secant steps on and off, with and without the linear march and the
-// parallax steps, from the map's centre and elsewhere, on a map with empty texels.
+// Eight searches with their secant steps side by side in lanes: each result (d, direction,
+// bracket, lookups) has the bits of the search alone, for every count of directions, with
+// secant steps on and off, with and without the linear march and the parallax steps, from one
+// point (the map's centre, or elsewhere) and from a point of its own per search (some at the
+// centre), on a map with empty texels.
 TEST(DistanceMapSearch, EightSearchesInLanesGiveTheBitsOfEachAlone) {
   RoomFixture f;
   for (int k = 0; k < 40; ++k) f.map.distance[k % kCubeFaces].pixels[(k * 997) % f.map.distance[0].pixels.size()] = kInf;
@@ -226,13 +227,17 @@ TEST(DistanceMapSearch, EightSearchesInLanesGiveTheBitsOfEachAlone) {
       const float reach = 0.1f + 3.0f * float(i % 7) / 6.0f;
       const glm::vec3 x = f.map.centre + reach * dirs[(i * 31 + 7) % dirs.size()];
       const int count = 1 + int(i / 8) % 8;
-      for (const glm::vec3 origin : {x, f.map.centre}) {
+      for (int from = 0; from < 3; ++from) {
         DistanceSearchResult lanes[8];
         glm::vec3 origins[8];
-        std::fill(origins, origins + 8, origin);
+        for (int j = 0; j < 8; ++j)
+          origins[j] = from == 0 ? x
+                       : from == 1 ? f.map.centre
+                       : j % 3 == 1 ? f.map.centre
+                                    : f.map.centre + (0.2f + 0.4f * float(j)) * dirs[(i * 17 + 5 * j + 3) % dirs.size()];
         search_distance_map8(f.map, origins, &dirs[i], count, o, lanes);
         for (int j = 0; j < count; ++j) {
-          const DistanceSearchResult alone = search_distance_map(f.map, origin, dirs[i + j], o);
+          const DistanceSearchResult alone = search_distance_map(f.map, origins[j], dirs[i + j], o);
           ASSERT_EQ(std::bit_cast<std::uint32_t>(lanes[j].d), std::bit_cast<std::uint32_t>(alone.d)) << oi << " " << i << " " << j;
           ASSERT_EQ(lanes[j].direction, alone.direction) << oi << " " << i << " " << j;
           ASSERT_EQ(lanes[j].bracketed, alone.bracketed) << oi << " " << i << " " << j;
