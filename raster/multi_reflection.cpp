@@ -241,7 +241,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
   ReflectorMaps maps;
   maps.map_of_object = distances.map_of_object;
   for (std::size_t m = 0; m < count; ++m) {
-    const std::array<ImageRGBA, kCubeFaces> colour = shade_cube_faces(
+    std::array<ImageRGBA, kCubeFaces> colour = shade_cube_faces(
         executor, scene, distances.cubes[m], kept_face_options(distances, m, depth_range, any_round[m]),
         [&](const GBuffer& g, const Camera& cam, int face, const std::vector<std::uint8_t>* texels) {
           direct[m][face] = direct_light(executor, scene, g, cam, shadows, env, texels);
@@ -251,7 +251,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
         &scratch);
     maps.maps.push_back(environment_from_faces(executor, colour, false, distances.levels[m],
                                                distances.faces[m] & read[1][m].faces(), &read[1][m]));
-    maps.cubes.emplace_back().colour = colour;
+    maps.cubes.emplace_back().colour = std::move(colour);
   }
   // Rounds 2 ..: the direct light plus what round k's searches find in round k − 1's maps.
   // A round's map differs from the round before's only where its searches found other colour,
@@ -283,7 +283,9 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
       const PrefilterReuse reuse =
           prefilter_reuse(executor, cube.colour, faces, &read[k][m], maps.maps[m], faces_before[m], &read[k - 1][m],
                           distances.levels[m]);
-      next.maps.push_back(environment_from_faces(executor, cube.colour, false, distances.levels[m], faces, &read[k][m], &reuse));
+      // The last round's faces are the result's colour too; the others' only level 0.
+      std::array<ImageRGBA, kCubeFaces> level0 = k == rounds ? cube.colour : std::move(cube.colour);
+      next.maps.push_back(environment_from_faces(executor, std::move(level0), false, distances.levels[m], faces, &read[k][m], &reuse));
       faces_before[m] = faces;
     }
     maps = std::move(next);
