@@ -158,13 +158,13 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
   const CubeDepthRange depth_range = scene_cube_depth_range(scene);
   CubeMapScratch scratch;
   // Each face's specular texels (the reflectors it shows), compacted, with their texel indices:
-  // resolved only where the visible material can be specular (specular, or textured: a texture
-  // may make it so at some texels).
+  // resolved only where the visible material can be specular (specular, or with a texture that
+  // may make it so at some texels: is_specular reads the roughness and the transmission alone,
+  // which only the metallic-roughness and transmission textures change).
   std::vector<std::uint8_t> may_be_specular(scene.materials.size(), 0);
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& mat = scene.materials[i];
-    may_be_specular[i] = is_specular(surface_params(mat)) || mat.base_color_texture.valid() ||
-                         mat.metallic_roughness_texture.valid() || mat.emissive_texture.valid() ||
+    may_be_specular[i] = is_specular(surface_params(mat)) || mat.metallic_roughness_texture.valid() ||
                          mat.transmission_texture.valid();
   }
   std::vector<MapFaceLayers> layers(count);

@@ -133,13 +133,34 @@ TEST(MultiReflection, SameBytesForOneAndTwoThreads) {
   EXPECT_TRUE(same_bytes(render_display(s, "multi-reflection", two_rounds, 1), render_display(s, "multi-reflection", two_rounds, 2)));
 }
 
+// living-room with its base-colour-textured materials given a metallic-roughness texture
+// that makes every other texel a mirror: reflectors that only a texture makes specular.
+Scene textured_mirror_room() {
+  Scene s = load_scene("living-room");
+  ImageRGBA mr(2, 2);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 2; ++x) mr.at(x, y) = glm::vec4(0.0f, (x + y) % 2 ? 1.0f : 0.01f, 1.0f, 1.0f);
+  const int texture = static_cast<int>(s.textures.size());
+  s.textures.push_back(mr);
+  int textured = 0;
+  for (Material& m : s.materials)
+    if (m.base_color_texture.valid()) {
+      m.metallic_roughness_texture = m.base_color_texture;
+      m.metallic_roughness_texture.texture = texture;
+      m.metallic = 1.0f;
+      ++textured;
+    }
+  EXPECT_GT(textured, 0);
+  return s;
+}
+
 // The rounds shaded only where the next round (or the camera) reads them give the camera's
 // specular layer the bytes of rounds shaded whole, for one to three rounds, with fewer
-// texels shaded and fewer searches made.
+// texels shaded and fewer searches made; reflectors made specular by a texture alone too.
 TEST(MultiReflection, RoundsShadedWhereReadGiveTheBytesOfWholeRounds) {
   par::Executor ex(2);
-  for (const char* name : {"living-room", "sphere-in-room"}) {
-    const Scene s = name == std::string("sphere-in-room") ? two_mirror_room() : load_scene(name);
+  for (const std::string name : {"living-room", "sphere-in-room", "textured mirrors"}) {
+    const Scene s = name == "sphere-in-room" ? two_mirror_room() : name == "textured mirrors" ? textured_mirror_room() : load_scene(name);
     const Camera cam = s.cameras.front();
     const ShadowMaps shadows = render_shadow_maps(ex, s, 128);
     const EnvironmentMap env = build_environment(ex, s.environment);
@@ -149,7 +170,7 @@ TEST(MultiReflection, RoundsShadedWhereReadGiveTheBytesOfWholeRounds) {
         render_reflector_maps(ex, s, shadows, env, 32, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false, false));
     const DistanceSearches camera = distance_map_search(ex, g, distances, search);
     for (int rounds = 1; rounds <= 3; ++rounds) {
-      SCOPED_TRACE(std::string(name) + ", rounds " + std::to_string(rounds));
+      SCOPED_TRACE(name + ", rounds " + std::to_string(rounds));
       DistanceReflectStats whole_stats, read_stats;
       const ReflectorMaps whole = render_multi_reflection_maps(ex, s, shadows, env, 32, &g, rounds, search, &whole_stats);
       const ReflectorMaps where_read =
