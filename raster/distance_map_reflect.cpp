@@ -329,7 +329,7 @@ ImageRGBA distance_map_lookup(par::Executor& executor, const GBuffer& g, const E
     std::vector<glm::vec3> colour(map_of.size());
     for (std::size_t q = 0; q < map_of.size();) {
       std::size_t run = 1;
-      while (run < 8 && q + run < map_of.size() && map_of[q + run] == map_of[q]) ++run;
+      while (run < kLobeBatch && q + run < map_of.size() && map_of[q + run] == map_of[q]) ++run;
       maps.maps[static_cast<std::size_t>(map_of[q])].radiance8(&found[q], &exponent_of[q], static_cast<int>(run), &colour[q]);
       q += run;
     }

@@ -437,7 +437,7 @@ namespace {
 // Whether a level ≥ 1 texel over tile `i` of face f is prefiltered under a face mask and tiles
 // (null: all).
 bool prefiltered_over(unsigned faces, const CubeTileMask* tiles, int f, std::size_t i) {
-  return ((faces >> f) & 1u) && (!tiles || !tiles->active() || tiles->tiles[f][i]);
+  return ((faces >> f) & 1u) && (!tiles || !tiles->active() || (i < tiles->tiles[f].size() && tiles->tiles[f][i]));
 }
 
 }  // namespace
