@@ -783,10 +783,13 @@ CausticMaps CausticMapPass::operator()(par::NodeContext& c, const CausticPhotons
 ReflectorMaps shade_caustic_reflector_maps(par::Executor& executor, const Scene& scene,
                                            const std::vector<ShadowMap>& shadows, const EnvironmentMap& env,
                                            const ReflectorMaps& distances, const DistanceSearches& searches,
+                                           const std::vector<CubeTileMask>* refraction_reads,
                                            const CausticMaps& caustics, float tolerance) {
   std::vector<CubeTileMask> tiles = searches.tiles;
-  for (std::size_t m = 0; m < tiles.size() && m < distances.refracts.size(); ++m)
-    if (distances.refracts[m]) tiles[m].mark_all();
+  if (refraction_reads) merge_reads(tiles, *refraction_reads);
+  else
+    for (std::size_t m = 0; m < tiles.size() && m < distances.refracts.size(); ++m)
+      if (distances.refracts[m]) tiles[m].mark_all();
   return shade_reflector_maps(executor, scene, shadows, env, distances, std::move(tiles),
                               [&](const GBuffer& face, const ImageRGBA& direct) {
                                 return gather_caustics(executor, face, caustics, direct, tolerance);
@@ -796,9 +799,10 @@ ReflectorMaps shade_caustic_reflector_maps(par::Executor& executor, const Scene&
 ReflectorMaps CausticReflectorColourPass::operator()(par::NodeContext& c, const ShadowMaps& shadows,
                                                      const EnvironmentMap& environment, const ReflectorMaps& distances,
                                                      const DistanceSearches& searches,
+                                                     const std::vector<CubeTileMask>& refraction_reads,
                                                      const CausticMaps& caustics) const {
-  ReflectorMaps maps =
-      shade_caustic_reflector_maps(c.executor(), *scene, shadows, environment, distances, searches, caustics, tolerance);
+  ReflectorMaps maps = shade_caustic_reflector_maps(c.executor(), *scene, shadows, environment, distances, searches,
+                                                    &refraction_reads, caustics, tolerance);
   count_maps(c, maps);
   return maps;
 }

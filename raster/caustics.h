@@ -173,26 +173,28 @@ struct CausticMapPass {
 
 // The caustics technique's lit maps: the colour of `distances` (rendered with
 // MapSizing::keep_visibility) with the caustics gathered on the faces, shaded only on the
-// tiles `searches` read — a refractor's map whole, since paths through it read it anywhere.
+// tiles `searches` read and those `refraction_reads` marks (mark_refraction_reads: where the
+// refraction pass's paths read the refractors' maps); null: a refractor's map whole.
 ReflectorMaps shade_caustic_reflector_maps(par::Executor& executor, const Scene& scene,
                                            const std::vector<ShadowMap>& shadows, const EnvironmentMap& env,
                                            const ReflectorMaps& distances, const DistanceSearches& searches,
+                                           const std::vector<CubeTileMask>* refraction_reads,
                                            const CausticMaps& caustics, float tolerance);
 
-// Pass "caustic_reflector_maps" after the camera's searches: the same maps' colour, shaded only
-// where the searches read it (shade_reflector_maps with the caustics on the faces); a
-// refractor's map whole, since paths through it (the refraction pass) read it anywhere.
+// Pass "caustic_reflector_maps" after the camera's searches and the refraction pass's reads:
+// the same maps' colour, shaded only where those read it (shade_reflector_maps with the
+// caustics on the faces).
 struct CausticReflectorColourPass {
   static constexpr const char* description =
       "Per specular object the colour of its cube map, its faces' direct light completed by the "
-      "caustic maps, shaded only where the camera's searches read it (refractors' whole): caustics "
+      "caustic maps, shaded only where the camera's searches and refracted paths read it: caustics "
       "seen in reflections and through refractors (SURVEY §6.3.3).";
   const Scene* scene = nullptr;
   float tolerance = 0.05f;
-  void parameters(par::Params& p) const { p.set("tiles", "read by the searches; refractors' all"); }
+  void parameters(par::Params& p) const { p.set("tiles", "read by the searches and the refracted paths"); }
   ReflectorMaps operator()(par::NodeContext& c, const ShadowMaps& shadows, const EnvironmentMap& environment,
                            const ReflectorMaps& distances, const DistanceSearches& searches,
-                           const CausticMaps& caustics) const;
+                           const std::vector<CubeTileMask>& refraction_reads, const CausticMaps& caustics) const;
 };
 
 // Pass "caustic_gather".

@@ -7,6 +7,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "raster/refraction_path.h"
+#include "raster/specular_radiance.h"
 
 namespace speculum::raster {
 
@@ -113,7 +114,8 @@ bool two_face_exit(const RefractionInputs& in, const GBuffer& g, std::size_t i, 
 // The refractor's specular radiance at P1: transmission × (f_entry·L(R1) + (1 − f_entry)·
 // base colour·L_through), L_through arriving through the exit (split again by f_exit unless
 // the exit reflects totally) or, when the path has no exit, along T1 from P1.
-glm::vec3 refractor_radiance(const RefractorEnvironment& environment, const SurfaceParams& s,
+template <class Environment>
+glm::vec3 refractor_radiance(const Environment& environment, const SurfaceParams& s,
                              std::uint32_t object, const glm::vec3& p1, const RefractionPath& path,
                              bool exits) {
   glm::vec3 through;
@@ -130,7 +132,79 @@ glm::vec3 refractor_radiance(const RefractorEnvironment& environment, const Surf
   return s.transmission * (path.f_entry * mirror + (1.0f - path.f_entry) * s.base_color * through);
 }
 
+// Refractor sample i's path through its refractor: entered at P1, and left where the method
+// finds the exit (two-face or impostor), or not.
+struct SamplePath {
+  glm::vec3 p1;
+  RefractionPath path;
+  bool exits = false;
+  RefractionOutcome outcome = RefractionOutcome::Refracted;
+};
+SamplePath trace_sample_path(const RefractionInputs& in, const RefractionOptions& options, std::size_t i,
+                             ChunkCounts& c) {
+  const GBuffer& g = *in.front;
+  const RefractionMethod method = options.method;
+  const bool two_face = method == RefractionMethod::TwoFace && in.back && in.vertex_thickness &&
+                        in.front_vis && in.mesh;
+  const bool impostor = method == RefractionMethod::DistanceImpostor && in.impostors;
+  const SurfaceParams& s = g.surface[i];
+  const std::uint32_t object = g.object.pixels[i];
+  SamplePath out;
+  out.p1 = g.position.pixels[i];
+  const glm::vec3 view = g.view_direction(i), v = -view;
+  glm::vec3 n1 = g.normal.pixels[i];
+  // Seen from inside (the camera in the refractor): swap the roles; single interface.
+  const bool entering = glm::dot(n1, view) >= 0.0f;
+  if (!entering) n1 = -n1;
+  const float ior = entering ? s.ior : 1.0f / s.ior;
+  out.path = enter_refractor(out.p1, v, n1, ior);
+  if (entering && out.path.f_entry < 1.0f) {
+    glm::vec3 p2, n2;
+    if (two_face) {
+      out.exits = two_face_exit(in, g, i, s.ior, object, out.p1, n1, out.path, p2, n2, c);
+    } else if (impostor) {
+      const CubeMap* cube = in.impostors->for_object(object);
+      out.exits = cube && find_impostor_exit(*cube, out.p1, out.path.inside, options.exit_search, p2, n2);
+    }
+    if (out.exits) {
+      leave_refractor(out.path, p2, n2, s.ior);
+      if (out.path.total_internal) out.outcome = RefractionOutcome::TotalInternal;
+    } else if (method != RefractionMethod::SingleInterface) {
+      out.outcome = RefractionOutcome::NoExit;
+    }
+  }
+  return out;
+}
+
+// RefractorEnvironment's colour reads marked instead of made: the same searches, each found
+// direction's bilinear taps of level 0 (what CubeMap::colour_towards reads) marked in its map.
+struct MarkedEnvironment {
+  const RefractionInputs& in;
+  const DistanceSearchOptions& search;
+  std::vector<LookupTileMarker>& markers;
+  glm::vec3 operator()(std::uint32_t object, const glm::vec3& p, const glm::vec3& d) const {
+    const int k = in.maps && object < in.maps->map_of_object.size() ? in.maps->map_of_object[object] : -1;
+    if (k < 0) return glm::vec3(0.0f);
+    const DistanceSearchResult r = search_distance_map(in.maps->cubes[static_cast<std::size_t>(k)], p, d, search);
+    markers[static_cast<std::size_t>(k)].mark(r.direction, kSharpLookupExponent);
+    return glm::vec3(0.0f);
+  }
+};
+
 }  // namespace
+
+void mark_refraction_reads(const RefractionInputs& in, const RefractionOptions& options, std::vector<CubeTileMask>& tiles) {
+  const GBuffer& g = *in.front;
+  std::vector<LookupTileMarker> markers;
+  for (std::size_t m = 0; m < tiles.size(); ++m) markers.emplace_back(tiles[m], in.maps->levels[m]);
+  const MarkedEnvironment environment{in, options.environment_search, markers};
+  ChunkCounts c;
+  for (std::size_t i = 0; i < g.object.size(); ++i) {
+    if (!g.covered(i) || !g.surface[i].is_refractor()) continue;
+    const SamplePath sp = trace_sample_path(in, options, i, c);
+    refractor_radiance(environment, g.surface[i], g.object.pixels[i], sp.p1, sp.path, sp.exits);
+  }
+}
 
 RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& in,
                               const RefractionOptions& options, const ImageRGBA& specular) {
@@ -140,11 +214,6 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
   out.outcome = Buffer2D<std::uint8_t>(g.width, g.height, 0);
   out.exit_point = Buffer2D<glm::vec3>(g.width, g.height, glm::vec3(0.0f));
   out.exit_direction = Buffer2D<glm::vec3>(g.width, g.height, glm::vec3(0.0f));
-  const RefractionMethod method = options.method;
-  const bool two_face = method == RefractionMethod::TwoFace && in.back && in.vertex_thickness &&
-                        in.front_vis && in.mesh;
-  const bool impostor = method == RefractionMethod::DistanceImpostor && in.impostors;
-
   const RefractorEnvironment environment{in, options.environment_search};
 
   constexpr std::size_t kChunk = 4096;
@@ -154,40 +223,14 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
                         [&](std::size_t begin, std::size_t end) {
     ChunkCounts& c = counts[begin / kChunk];
     for (std::size_t i = begin; i < end; ++i) {
-      if (!g.covered(i)) continue;
-      const SurfaceParams& s = g.surface[i];
-      if (!s.is_refractor()) continue;
-      const std::uint32_t object = g.object.pixels[i];
-      const glm::vec3 p1 = g.position.pixels[i], view = g.view_direction(i), v = -view;
-      glm::vec3 n1 = g.normal.pixels[i];
-      // Seen from inside (the camera in the refractor): swap the roles; single interface.
-      const bool entering = glm::dot(n1, view) >= 0.0f;
-      if (!entering) n1 = -n1;
-      const float ior = entering ? s.ior : 1.0f / s.ior;
-      RefractionPath path = enter_refractor(p1, v, n1, ior);
-      RefractionOutcome outcome = RefractionOutcome::Refracted;
-      bool exits = false;
-      if (entering && path.f_entry < 1.0f) {
-        glm::vec3 p2, n2;
-        if (two_face) {
-          exits = two_face_exit(in, g, i, s.ior, object, p1, n1, path, p2, n2, c);
-        } else if (impostor) {
-          const CubeMap* cube = in.impostors->for_object(object);
-          exits = cube && find_impostor_exit(*cube, p1, path.inside, options.exit_search, p2, n2);
-        }
-        if (exits) {
-          leave_refractor(path, p2, n2, s.ior);
-          if (path.total_internal) outcome = RefractionOutcome::TotalInternal;
-        } else if (method != RefractionMethod::SingleInterface) {
-          outcome = RefractionOutcome::NoExit;
-        }
-      }
-      const glm::vec3 radiance = refractor_radiance(environment, s, object, p1, path, exits);
+      if (!g.covered(i) || !g.surface[i].is_refractor()) continue;
+      SamplePath sp = trace_sample_path(in, options, i, c);
+      const glm::vec3 radiance = refractor_radiance(environment, g.surface[i], g.object.pixels[i], sp.p1, sp.path, sp.exits);
       out.specular.pixels[i] = glm::vec4(radiance, 1.0f);
-      out.outcome.pixels[i] = static_cast<std::uint8_t>(outcome);
-      out.exit_point.pixels[i] = exits ? path.exit_point : p1;
-      out.exit_direction.pixels[i] = exits ? path.exit_direction : path.inside;
-      c.count(outcome);
+      out.outcome.pixels[i] = static_cast<std::uint8_t>(sp.outcome);
+      out.exit_point.pixels[i] = sp.exits ? sp.path.exit_point : sp.p1;
+      out.exit_direction.pixels[i] = sp.exits ? sp.path.exit_direction : sp.path.inside;
+      c.count(sp.outcome);
     }
   });
   for (const ChunkCounts& c : counts) {
@@ -201,6 +244,25 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
 
 GBuffer RefractorBackFacesPass::operator()(par::NodeContext& c) const {
   return render_refractor_back_faces(c.executor(), *scene, camera, width, height);
+}
+
+std::vector<CubeTileMask> RefractionReadsPass::operator()(par::NodeContext&, const GBuffer& gbuffer,
+                                                          const VisibilityBuffer& visibility, const ReflectorMaps& maps,
+                                                          const GBuffer* back, const VertexThickness* thickness,
+                                                          const RefractorImpostors* impostors) const {
+  RefractionInputs in;
+  in.front = &gbuffer;
+  in.front_vis = &visibility;
+  in.mesh = &scene->mesh;
+  in.camera = camera;
+  in.maps = &maps;
+  in.back = back;
+  in.vertex_thickness = thickness;
+  in.impostors = impostors;
+  std::vector<CubeTileMask> tiles;
+  for (std::size_t m = 0; m < maps.cubes.size(); ++m) tiles.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
+  mark_refraction_reads(in, options, tiles);
+  return tiles;
 }
 
 ImageRGBA RefractionPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,

@@ -69,6 +69,12 @@ struct RefractionLayer {
 RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& in,
                               const RefractionOptions& options, const ImageRGBA& specular);
 
+// The tiles of the refractors' maps whose colour refract_layer reads, marked into `tiles`
+// (per map of in.maps, from tile_mask_for_reads; in.maps needs only its distances): the same
+// paths and searches, each search's colour read marked (its level-0 bilinear taps) instead of
+// made. Shading a refractor's map on those tiles alone gives refract_layer the same bytes.
+void mark_refraction_reads(const RefractionInputs& in, const RefractionOptions& options, std::vector<CubeTileMask>& tiles);
+
 using VertexThickness = std::vector<float>;  // d_N per mesh vertex (two-face method)
 
 // Pass "back_faces": render_refractor_back_faces at the camera's sample grid.
@@ -81,6 +87,21 @@ struct RefractorBackFacesPass {
   int width = 0, height = 0;
   void parameters(par::Params& p) const { p.set("width", width).set("height", height); }
   GBuffer operator()(par::NodeContext& c) const;
+};
+
+// Pass "refraction_reads": mark_refraction_reads on the maps' distances, so that the maps'
+// colour is shaded where the refraction pass will read it.
+struct RefractionReadsPass {
+  static constexpr const char* description =
+      "The refracted paths of the refraction pass traced ahead in the maps' distances alone: "
+      "the tiles of the refractors' maps whose colour they will read (SURVEY §4.4).";
+  const Scene* scene = nullptr;
+  Camera camera;
+  RefractionOptions options;
+  void parameters(par::Params& p) const { p.set("method", static_cast<int>(options.method)); }
+  std::vector<CubeTileMask> operator()(par::NodeContext& c, const GBuffer& gbuffer, const VisibilityBuffer& visibility,
+                                       const ReflectorMaps& maps, const GBuffer* back, const VertexThickness* thickness,
+                                       const RefractorImpostors* impostors) const;
 };
 
 // Pass "refraction": the refractor samples of the specular layer replaced by refract_layer's.

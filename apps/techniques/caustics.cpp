@@ -49,16 +49,18 @@ FrameOutputs add_caustics_passes(par::Graph& g, const Scene* scene, const FrameS
   const float tolerance = static_cast<float>(f.param("tolerance"));
   auto lit = g.add("caustic_gather", CausticGatherPass{tolerance}, s.gbuffer, caustic_maps, s.direct);
   // What reflections and refractions look up: the maps' colour with the caustics on it, where
-  // the camera's searches read it (refractors' maps whole: the refraction pass reads them).
-  auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, maps);
-  auto lit_maps = g.add("caustic_reflector_maps", CausticReflectorColourPass{scene, tolerance}, s.shadow_maps,
-                        s.environment, maps, searches, caustic_maps);
-  auto reflected = g.add("distance_map_reflect", DistanceMapLookupPass{search}, s.gbuffer, s.environment, lit_maps,
-                         searches);
+  // the camera's searches and the refraction pass's paths (traced ahead in the distances) read it.
   RefractionOptions ro;
   ro.method = RefractionMethod::DistanceImpostor;
   ro.environment_search = search;
   ro.exit_search = search;
+  auto searches = g.add("distance_map_search", DistanceMapSearchPass{search}, s.gbuffer, maps);
+  auto refraction_reads = g.add("refraction_reads", RefractionReadsPass{scene, f.camera, ro}, s.gbuffer, s.visibility,
+                                maps, par::Resource<GBuffer>{}, par::Resource<VertexThickness>{}, impostors);
+  auto lit_maps = g.add("caustic_reflector_maps", CausticReflectorColourPass{scene, tolerance}, s.shadow_maps,
+                        s.environment, maps, searches, refraction_reads, caustic_maps);
+  auto reflected = g.add("distance_map_reflect", DistanceMapLookupPass{search}, s.gbuffer, s.environment, lit_maps,
+                         searches);
   auto specular = g.add("refraction", RefractionPass{scene, f.camera, ro}, s.gbuffer, s.visibility, lit_maps,
                         s.environment, reflected, par::Resource<GBuffer>{}, par::Resource<VertexThickness>{},
                         impostors);

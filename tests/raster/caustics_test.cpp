@@ -21,6 +21,8 @@
 #include "parallel/executor.h"
 #include "raster/distance_map_reflect.h"
 #include "raster/environment.h"
+#include "raster/refraction.h"
+#include "trace/refractor_thickness.h"
 #include "raster/shadow_map.h"
 #include "trace/bvh.h"
 #include "trace/light_tracer.h"
@@ -678,7 +680,7 @@ TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
       render_reflector_maps(ex, s, shadows, env, 64, &g, ReflectorSelection::all, {}, nullptr, searched_distance_maps(false, false));
   const DistanceSearchOptions search;
   const DistanceSearches found = distance_map_search(ex, g, distances, search);
-  const ReflectorMaps lit = shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, caustics, 0.05f);
+  const ReflectorMaps lit = shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, nullptr, caustics, 0.05f);
   EXPECT_LT(rendered_texels(lit), rendered_texels(whole));
   const ImageRGBA expected = distance_map_reflect(ex, g, env, whole, search);
   const ImageRGBA got = distance_map_lookup(ex, g, env, lit, found, search);
@@ -695,6 +697,44 @@ TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
     }
   }
   EXPECT_EQ(refractor_maps, 1);  // the glass ball
+  // With the refraction pass's reads marked ahead (mark_refraction_reads on the distances), the
+  // refractor's map keeps only those tiles, and the refraction layer has the bytes it has on
+  // the whole maps, for the three exit methods; fails if one of a path's reads is not marked.
+  const RefractorImpostors impostors = render_refractor_impostors(ex, s, 128);
+  const GBuffer back = render_refractor_back_faces(ex, s, cam, 128, 96);
+  const VisibilityBuffer vis = render_visibility(ex, s, cam, 128, 96);
+  const std::vector<float> thickness = trace::refractor_vertex_thickness(s, ex);
+  for (const RefractionMethod method :
+       {RefractionMethod::SingleInterface, RefractionMethod::TwoFace, RefractionMethod::DistanceImpostor}) {
+    SCOPED_TRACE(static_cast<int>(method));
+    RefractionInputs in;
+    in.front = &g;
+    in.front_vis = &vis;
+    in.mesh = &s.mesh;
+    in.camera = cam;
+    in.maps = &distances;
+    in.env = &env;
+    in.back = &back;
+    in.vertex_thickness = &thickness;
+    in.impostors = &impostors;
+    RefractionOptions o;
+    o.method = method;
+    std::vector<CubeTileMask> reads;
+    for (std::size_t m = 0; m < distances.cubes.size(); ++m)
+      reads.push_back(tile_mask_for_reads(distances.cubes[m].size, distances.levels[m]));
+    mark_refraction_reads(in, o, reads);
+    const ReflectorMaps read_only =
+        shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, &reads, caustics, 0.05f);
+    EXPECT_LT(rendered_texels(read_only), rendered_texels(lit));
+    const ImageRGBA none(g.width, g.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    in.maps = &whole;
+    const RefractionLayer expected_layer = refract_layer(ex, in, o, none);
+    in.maps = &read_only;
+    const RefractionLayer got_layer = refract_layer(ex, in, o, none);
+    EXPECT_GT(expected_layer.refracted, 30u);
+    EXPECT_EQ(0, std::memcmp(expected_layer.specular.pixels.data(), got_layer.specular.pixels.data(),
+                             expected_layer.specular.size() * sizeof(glm::vec4)));
+  }
 }
 
 }  // namespace
