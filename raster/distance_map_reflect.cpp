@@ -77,21 +77,30 @@ int map_of_sample(const GBuffer& g, const ReflectorMaps& maps, std::size_t i) {
   return object < maps.map_of_object.size() ? maps.map_of_object[object] : -1;
 }
 
-// The searches from x along directions[0..count) in map m, counted in `st`: into found[j]
-// the direction search j reads its colour along.
-void search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, const glm::vec3* directions, int count,
-                    const DistanceSearchOptions& options, DistanceReflectStats& st, glm::vec3* found) {
+// The searches from points[j] along directions[j], j < count ≤ kLobeBatch, in map m, counted
+// in `st`: into found[j] the direction search j reads its colour along. Returns bit j set for
+// each search that missed.
+unsigned search_counted(const ReflectorMaps& maps, int m, const glm::vec3* points, const glm::vec3* directions,
+                        int count, const DistanceSearchOptions& options, DistanceReflectStats& st, glm::vec3* found) {
   DistanceSearchResult hits[kLobeBatch];
-  glm::vec3 from[kLobeBatch];
-  std::fill(from, from + count, x);
-  search_distance_map8(maps.cubes[m], from, directions, count, options, hits);
+  search_distance_map8(maps.cubes[static_cast<std::size_t>(m)], points, directions, count, options, hits);
+  unsigned missed = 0;
   for (int j = 0; j < count; ++j) {
     ++st.searches;
     st.lookups += hits[j].lookups;
     st.bracketed += hits[j].bracketed;
-    st.missed += !std::isfinite(hits[j].d);
+    if (!std::isfinite(hits[j].d)) ++st.missed, missed |= 1u << j;
     found[j] = glm::normalize(hits[j].direction);
   }
+  return missed;
+}
+
+// search_counted from one point x along every direction.
+unsigned search_counted(const ReflectorMaps& maps, int m, const glm::vec3& x, const glm::vec3* directions, int count,
+                        const DistanceSearchOptions& options, DistanceReflectStats& st, glm::vec3* found) {
+  glm::vec3 points[kLobeBatch];
+  std::fill(points, points + count, x);
+  return search_counted(maps, m, points, directions, count, options, st, found);
 }
 
 // The colour the searches found along directions[0..count), read through lobes of exponent
@@ -191,9 +200,7 @@ DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const
   out.found.resize(par::Executor::chunk_count(n, kChunk));
   if (earlier_object && (earlier_object->size() != n || earlier->found.size() != out.found.size()))
     throw std::logic_error("distance_map_search_reusing: the earlier searches are of another G-buffer's size");
-  if (!mark_into)
-    for (std::size_t m = 0; m < maps.cubes.size(); ++m)
-      out.tiles.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
+  if (!mark_into) out.tiles = tile_masks_for_reads(maps);
   std::vector<CubeTileMask>& tiles = mark_into ? *mark_into : out.tiles;
   std::vector<DistanceReflectStats> per_chunk(out.found.size());
   executor.parallel_for("distance_map_search.search", n, kChunk, [&](std::size_t begin, std::size_t end) {
@@ -231,9 +238,8 @@ DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const
             before += count;
           } else if (count > 1) {  // a glossy lobe's sub-lobe searches share their secant steps' lanes
             glm::vec3 along[kLobeBatch];
-            const std::uint64_t missed_before = st.missed;
-            search_counted(maps, m, x, dk, count, options, st, along);
-            if (fallbacks && st.missed > missed_before) fallbacks->mark(i, Fallback::search_missed);
+            if (search_counted(maps, m, x, dk, count, options, st, along) && fallbacks)
+              fallbacks->mark(i, Fallback::search_missed);
             for (int j = 0; j < count; ++j) {
               found.push_back(along[j]);
               markers[m].mark(along[j], e);
@@ -253,20 +259,14 @@ DistanceSearches search_samples(par::Executor& executor, const GBuffer& g, const
       const int m = requests[q].map;
       std::size_t run = 1;
       while (run < kLobeBatch && q + run < requests.size() && requests[q + run].map == m) ++run;
-      glm::vec3 x[kLobeBatch], r[kLobeBatch];
+      glm::vec3 x[kLobeBatch], r[kLobeBatch], along[kLobeBatch];
       for (std::size_t j = 0; j < run; ++j) x[j] = requests[q + j].x, r[j] = requests[q + j].r;
-      DistanceSearchResult hits[kLobeBatch];
-      search_distance_map8(maps.cubes[static_cast<std::size_t>(m)], x, r, static_cast<int>(run), options, hits);
+      const unsigned missed = search_counted(maps, m, x, r, static_cast<int>(run), options, st, along);
       for (std::size_t j = 0; j < run; ++j) {
         const Request& req = requests[q + j];
-        ++st.searches;
-        st.lookups += hits[j].lookups;
-        st.bracketed += hits[j].bracketed;
-        const bool missed = !std::isfinite(hits[j].d);
-        st.missed += missed;
-        if (fallbacks && missed) fallbacks->mark(req.sample, Fallback::search_missed);
-        found[req.slot] = glm::normalize(hits[j].direction);
-        markers[static_cast<std::size_t>(m)].mark(found[req.slot], req.exponent);
+        if (fallbacks && ((missed >> j) & 1u)) fallbacks->mark(req.sample, Fallback::search_missed);
+        found[req.slot] = along[j];
+        markers[static_cast<std::size_t>(m)].mark(along[j], req.exponent);
       }
       q += run;
     }

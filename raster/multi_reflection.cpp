@@ -201,8 +201,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
       static_cast<std::size_t>(rounds) + 1, std::vector<std::array<FaceSearches, kCubeFaces>>(count));
   DistanceReflectStats st;
   for (int k = rounds; k >= 2; --k) {
-    for (std::size_t m = 0; m < count; ++m)
-      read[k - 1].push_back(tile_mask_for_reads(distances.cubes[m].size, distances.levels[m]));
+    read[k - 1] = tile_masks_for_reads(distances);
     for (std::size_t m = 0; m < count; ++m)
       for (int f = 0; f < kCubeFaces; ++f) {
         GBuffer& texels = layers[m].specular[f];
@@ -210,13 +209,11 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
         if (texel.empty() || !((distances.faces[m] >> f) & 1u)) continue;
         FaceSearches& s = searched[k][m][f];
         s.object = texels.object;
-        const CubeTileMask& on = read[k][m];  // its level-0 tiles, read directly (CubeTileMask::covers)
-        const std::uint32_t size = static_cast<std::uint32_t>(std::max(on.size, 1)), tile = static_cast<std::uint32_t>(on.tile);
-        const std::uint32_t n = static_cast<std::uint32_t>(on.tiles_per_side());
+        const std::uint32_t size = static_cast<std::uint32_t>(distances.cubes[m].size);
         bool any = false;
         for (std::size_t j = 0; j < texel.size(); ++j) {
-          const std::uint32_t x = texel[j] % size, y = texel[j] / size;
-          if (!on.active() || (!on.tiles[f].empty() && on.tiles[f][(y / tile) * n + x / tile])) any = true;
+          const int x = static_cast<int>(texel[j] % size), y = static_cast<int>(texel[j] / size);
+          if (read[k][m].covers(f, 0, x, y)) any = true;
           else s.object.pixels[j] = kNoId;
         }
         if (!any) {

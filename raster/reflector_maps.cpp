@@ -289,6 +289,13 @@ float square_radius(int size, int span) {
   return widest;
 }
 
+// The direction of the centre of tile (tx, ty) of face f (a partial last tile's own centre).
+glm::vec3 tile_centre(const CubeTileMask& mask, int f, int tx, int ty) {
+  const float x0 = float(tx * mask.tile), y0 = float(ty * mask.tile);
+  const float x1 = float(std::min(mask.size, (tx + 1) * mask.tile)), y1 = float(std::min(mask.size, (ty + 1) * mask.tile));
+  return cube_direction(f, {0.5f * (x0 + x1), 0.5f * (y0 + y1)}, mask.size);
+}
+
 // A reflector map face's colour (MapFaceLayers: `kept`, may be null, receives its layers).
 CubeFaceShader reflector_face_shader(par::Executor& executor, const Scene& scene, const std::vector<ShadowMap>& shadows,
                                      const EnvironmentMap& env, const FaceLight& add_light, MapFaceLayers* kept) {
@@ -361,6 +368,12 @@ CubeTileMask tile_mask_for_reads(int size, int level_count) {
   return mask;
 }
 
+std::vector<CubeTileMask> tile_masks_for_reads(const ReflectorMaps& maps) {
+  std::vector<CubeTileMask> masks;
+  for (std::size_t m = 0; m < maps.cubes.size(); ++m) masks.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
+  return masks;
+}
+
 LookupTileMarker::LookupTileMarker(CubeTileMask& mask, int level_count) : mask_(mask), level_count_(level_count) {
   for (std::array<int, 4>& r : last_marked_) r = {0, 0, -1, -1};
 }
@@ -417,9 +430,7 @@ void settle_wide_reads(par::Executor& executor, CubeTileMask& mask) {
       std::uint8_t& tile = mask.tiles[f][i];
       if (tile) continue;
       const int tx = static_cast<int>(i % n), ty = static_cast<int>(i / n);
-      const float x0 = float(tx * mask.tile), y0 = float(ty * mask.tile);
-      const float x1 = float(std::min(mask.size, (tx + 1) * mask.tile)), y1 = float(std::min(mask.size, (ty + 1) * mask.tile));
-      const glm::vec3 centre = cube_direction(f, {0.5f * (x0 + x1), 0.5f * (y0 + y1)}, mask.size);
+      const glm::vec3 centre = tile_centre(mask, f, tx, ty);
       for (const Cell& c : recorded)
         if (glm::dot(c.centre, centre) >= c.cos_within) {
           tile = 1;
@@ -495,9 +506,7 @@ PrefilterReuse prefilter_reuse(par::Executor& executor, const std::array<ImageRG
   for (int f = 0; f < kCubeFaces; ++f)
     for (int ty = 0; ty < n; ++ty)
       for (int tx = 0; tx < n; ++tx) {
-        const float x0 = float(tx * tile), y0 = float(ty * tile);
-        const float x1 = float(std::min(size, (tx + 1) * tile)), y1 = float(std::min(size, (ty + 1) * tile));
-        centre[f].push_back(cube_direction(f, {0.5f * (x0 + x1), 0.5f * (y0 + y1)}, size));
+        centre[f].push_back(tile_centre(changed, f, tx, ty));
       }
   const std::size_t all_tiles = static_cast<std::size_t>(kCubeFaces) * n * n;
   reuse.changed.resize(static_cast<std::size_t>(levels));

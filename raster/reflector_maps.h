@@ -136,6 +136,8 @@ CubeTileMask tiles_read(par::Executor& executor, const GBuffer& camera_view, con
 // An empty mask for the reads of a map of side `size` (a power of two) with `level_count`
 // levels: one-texel tiles when level 0 alone is read (bilinear taps), else kTile.
 CubeTileMask tile_mask_for_reads(int size, int level_count);
+// tile_mask_for_reads for every map of `maps`, in map order (no tile marked).
+std::vector<CubeTileMask> tile_masks_for_reads(const ReflectorMaps& maps);
 
 // Marks in a mask (from tile_mask_for_reads) what lookups EnvironmentMap::radiance(d, n) on
 // the map read: the bilinear taps of a lookup that reads level 0 alone, else every texel

@@ -246,22 +246,35 @@ GBuffer RefractorBackFacesPass::operator()(par::NodeContext& c) const {
   return render_refractor_back_faces(c.executor(), *scene, camera, width, height);
 }
 
+namespace {
+
+// The refraction passes' inputs from their nodes' (environment may be null: marking needs none).
+RefractionInputs pass_inputs(const Scene& scene, const Camera& camera, const GBuffer& gbuffer,
+                             const VisibilityBuffer& visibility, const ReflectorMaps& maps,
+                             const EnvironmentMap* environment, const GBuffer* back, const VertexThickness* thickness,
+                             const RefractorImpostors* impostors) {
+  RefractionInputs in;
+  in.front = &gbuffer;
+  in.front_vis = &visibility;
+  in.mesh = &scene.mesh;
+  in.camera = camera;
+  in.maps = &maps;
+  in.env = environment;
+  in.back = back;
+  in.vertex_thickness = thickness;
+  in.impostors = impostors;
+  return in;
+}
+
+}  // namespace
+
 std::vector<CubeTileMask> RefractionReadsPass::operator()(par::NodeContext&, const GBuffer& gbuffer,
                                                           const VisibilityBuffer& visibility, const ReflectorMaps& maps,
                                                           const GBuffer* back, const VertexThickness* thickness,
                                                           const RefractorImpostors* impostors) const {
-  RefractionInputs in;
-  in.front = &gbuffer;
-  in.front_vis = &visibility;
-  in.mesh = &scene->mesh;
-  in.camera = camera;
-  in.maps = &maps;
-  in.back = back;
-  in.vertex_thickness = thickness;
-  in.impostors = impostors;
-  std::vector<CubeTileMask> tiles;
-  for (std::size_t m = 0; m < maps.cubes.size(); ++m) tiles.push_back(tile_mask_for_reads(maps.cubes[m].size, maps.levels[m]));
-  mark_refraction_reads(in, options, tiles);
+  std::vector<CubeTileMask> tiles = tile_masks_for_reads(maps);
+  mark_refraction_reads(pass_inputs(*scene, camera, gbuffer, visibility, maps, nullptr, back, thickness, impostors),
+                        options, tiles);
   return tiles;
 }
 
@@ -270,16 +283,8 @@ ImageRGBA RefractionPass::operator()(par::NodeContext& c, const GBuffer& gbuffer
                                     const EnvironmentMap& environment, const ImageRGBA& specular,
                                     const GBuffer* back, const VertexThickness* thickness,
                                     const RefractorImpostors* impostors) const {
-  RefractionInputs in;
-  in.front = &gbuffer;
-  in.front_vis = &visibility;
-  in.mesh = &scene->mesh;
-  in.camera = camera;
-  in.maps = &maps;
-  in.env = &environment;
-  in.back = back;
-  in.vertex_thickness = thickness;
-  in.impostors = impostors;
+  const RefractionInputs in =
+      pass_inputs(*scene, camera, gbuffer, visibility, maps, &environment, back, thickness, impostors);
   RefractionLayer layer = refract_layer(c.executor(), in, options, specular);
   c.count("refracted", layer.refracted);
   c.count("total_internal", layer.total_internal);

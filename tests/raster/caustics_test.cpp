@@ -719,9 +719,7 @@ TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
     in.impostors = &impostors;
     RefractionOptions o;
     o.method = method;
-    std::vector<CubeTileMask> reads;
-    for (std::size_t m = 0; m < distances.cubes.size(); ++m)
-      reads.push_back(tile_mask_for_reads(distances.cubes[m].size, distances.levels[m]));
+    std::vector<CubeTileMask> reads = tile_masks_for_reads(distances);
     mark_refraction_reads(in, o, reads);
     const ReflectorMaps read_only =
         shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, &reads, caustics, 0.05f);

@@ -291,8 +291,9 @@ TEST(ReflectorMaps, SearchesReusedFromOtherSamplesOfTheGBufferAreTheSame) {
     ASSERT_EQ(reused.found.size(), direct.found.size());
     for (std::size_t c = 0; c < direct.found.size(); ++c) {
       ASSERT_EQ(reused.found[c].size(), direct.found[c].size());
-      if (!direct.found[c].empty())
+      if (!direct.found[c].empty()) {
         EXPECT_EQ(std::memcmp(reused.found[c].data(), direct.found[c].data(), direct.found[c].size() * sizeof(glm::vec3)), 0);
+      }
     }
     ASSERT_EQ(reused.tiles.size(), direct.tiles.size());
     for (std::size_t m = 0; m < direct.tiles.size(); ++m)
