@@ -83,27 +83,103 @@ void deposit(MapTarget& t, int face, int x, int y, const glm::vec3& flux, float 
   t.incident[face].at(x, y) += weight * wi;
 }
 
-// A photon's flux spread by a tent kernel of `radius` texels about its continuous pixel
-// position c (cube_coord of its direction from the map's centre), the weights normalized over
-// the texels of its face (so they sum to one).
-void splat(MapTarget& t, const CubeCoord& c, const glm::vec3& flux, float dist, const glm::vec3& wi, int radius) {
-  const CubeMap& m = t.m;
-  const int cx = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
-  const int cy = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
-  if (radius <= 0) {
-    deposit(t, c.face, cx, cy, flux, 1.0f, dist, wi);
+// A tent kernel of `radius` texels about continuous pixel position c, clipped to the face:
+// the texels it covers, weighted max(0, 1 − |texel centre − c| / (radius + ½)).
+struct SplatKernel {
+  static constexpr int kColumns = 24;  // 2 kMaxSplatRadius + 1, rounded up to lanes of 8
+  int x0, x1, y0, y1;                  // inclusive
+  float reach;
+  SplatKernel(const CubeCoord& c, int radius, int size) {
+    const int cx = std::clamp(static_cast<int>(c.pixel.x), 0, size - 1);
+    const int cy = std::clamp(static_cast<int>(c.pixel.y), 0, size - 1);
+    x0 = std::max(0, cx - radius);
+    x1 = std::min(size - 1, cx + radius);
+    y0 = std::max(0, cy - radius);
+    y1 = std::min(size - 1, cy + radius);
+    reach = static_cast<float>(radius) + 0.5f;
+  }
+  // Row y's weights, columns x0..x1, into w[0, x1 − x0]: eight columns at once in lanes.
+  void row_weights(const CubeCoord& c, int y, float (&w)[kColumns]) const {
+    using L = par::Lanes<8>;
+    const float dy = static_cast<float>(y) + 0.5f - c.pixel.y;
+    const L::f32 dy2(dy * dy), zero(0.0f);
+    for (int i = 0; i <= x1 - x0; i += 8) {
+      const L::f32 dx = L::to_float(L::iota(x0 + i)) + 0.5f - c.pixel.x;
+      L::store(L::max(zero, 1.0f - L::sqrt(dx * dx + dy2) / reach), w + i);
+    }
+  }
+};
+
+// A photon as the splat filter stores it: the texel position of its direction from the map's
+// centre, its distance, kernel radius and the sum of its kernel's weights.
+struct PhotonSplat {
+  CubeCoord c;
+  float dist = 0.0f;
+  int radius = 0;
+  float total = 1.0f;
+  const PhotonImage* image = nullptr;
+  std::uint32_t texel = 0;
+};
+
+// The kernel weights' sums of `count` (1..8) splats of radius > 0 on size² faces: each lane
+// adds one kernel's weights in row-major order (a serial sum per splat: eight side by side
+// keep the adder busy), with the operations of SplatKernel::row_weights.
+void splat_totals8(PhotonSplat* const* sp, int count, int size) {
+  using L = par::Lanes<8>;
+  alignas(32) std::int32_t x0[8] = {}, x1[8] = {}, y0[8] = {}, n[8] = {};
+  alignas(32) float px[8] = {}, py[8] = {}, reach[8] = {}, total[8];
+  int steps = 0;
+  for (int j = 0; j < count; ++j) {
+    const SplatKernel k(sp[j]->c, sp[j]->radius, size);
+    x0[j] = k.x0, x1[j] = k.x1, y0[j] = k.y0, reach[j] = k.reach;
+    n[j] = (k.x1 - k.x0 + 1) * (k.y1 - k.y0 + 1);
+    px[j] = sp[j]->c.pixel.x, py[j] = sp[j]->c.pixel.y;
+    steps = std::max(steps, n[j]);
+  }
+  const L::i32 first_x = L::load_aligned(x0), last_x = L::load_aligned(x1), texels = L::load_aligned(n);
+  const L::f32 cx = L::load_aligned(px), cy = L::load_aligned(py), r = L::load_aligned(reach), zero(0.0f);
+  L::i32 x = first_x, y = L::load_aligned(y0);
+  L::f32 sum(0.0f);
+  for (int k = 0; k < steps; ++k) {
+    const L::f32 dx = L::to_float(x) + 0.5f - cx, dy = L::to_float(y) + 0.5f - cy;
+    const L::f32 w = L::max(zero, 1.0f - L::sqrt(dx * dx + dy * dy) / r);
+    sum = L::select(L::i32(k) < texels, sum + w, sum);
+    x = x + 1;
+    const L::mask wrap = x > last_x;
+    y = L::select(wrap, y + 1, y);
+    x = L::select(wrap, first_x, x);
+  }
+  L::store_aligned(sum, total);
+  for (int j = 0; j < count; ++j) sp[j]->total = total[j];
+}
+
+// Adds a photon's flux to the texel under c alone.
+void deposit_nearest(MapTarget& t, const CubeCoord& c, const glm::vec3& flux, float dist, const glm::vec3& wi) {
+  const int size = t.m.size;
+  deposit(t, c.face, std::clamp(static_cast<int>(c.pixel.x), 0, size - 1),
+          std::clamp(static_cast<int>(c.pixel.y), 0, size - 1), flux, 1.0f, dist, wi);
+}
+
+// Photon sp's flux spread by its tent kernel, the weights normalized over the texels of its
+// face (so they sum to one), deposited in rows [row_begin, row_end) only: a face stored in
+// bands of rows gets the sums of one pass.
+void splat_rows(MapTarget& t, const PhotonSplat& sp, int row_begin, int row_end) {
+  const glm::vec3& flux = sp.image->flux[sp.texel];
+  const glm::vec3& wi = sp.image->wi[sp.texel];
+  if (sp.radius <= 0) {
+    const int cy = std::clamp(static_cast<int>(sp.c.pixel.y), 0, t.m.size - 1);
+    if (cy >= row_begin && cy < row_end) deposit_nearest(t, sp.c, flux, sp.dist, wi);
     return;
   }
-  const float reach = static_cast<float>(radius) + 0.5f;
-  float total = 0.0f;
-  for (int pass = 0; pass < 2; ++pass)
-    for (int y = std::max(0, cy - radius); y <= std::min(m.size - 1, cy + radius); ++y)
-      for (int x = std::max(0, cx - radius); x <= std::min(m.size - 1, cx + radius); ++x) {
-        const float dx = static_cast<float>(x) + 0.5f - c.pixel.x, dy = static_cast<float>(y) + 0.5f - c.pixel.y;
-        const float w = std::max(0.0f, 1.0f - std::sqrt(dx * dx + dy * dy) / reach);
-        if (pass == 0) total += w;
-        else if (w > 0.0f) deposit(t, c.face, x, y, flux * (w / total), w / total, dist, wi);
-      }
+  const SplatKernel k(sp.c, sp.radius, t.m.size);
+  alignas(32) float w[SplatKernel::kColumns];
+  for (int y = std::max(k.y0, row_begin); y <= std::min(k.y1, row_end - 1); ++y) {
+    k.row_weights(sp.c, y, w);
+    for (int x = k.x0; x <= k.x1; ++x) {
+      const float share = w[x - k.x0];
+      if (share > 0.0f) deposit(t, sp.c.face, x, y, flux * (share / sp.total), share / sp.total, sp.dist, wi);
+    }
+  }
 }
 
 float edge(glm::vec2 a, glm::vec2 b, glm::vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
@@ -497,47 +573,59 @@ glm::dvec3 caustic_map_flux(const CubeMap& map) {
   return sum;
 }
 
-// Stores the photons of image `img` into its map (target), in the order of its texels. A
-// splat lands on the face of its photon's direction alone: with the splat filter and
-// `only_face` ≥ 0 only the splats onto that face are made (faces stored side by side get the
-// sums of one pass). Caustic triangles are stored on every face (`only_face` −1).
-void store_photon_image(const PhotonImage& img, MapTarget& target, const CausticMapOptions& opt,
-                        std::vector<TexelShare>& scratch, int only_face = -1) {
+// The splats of image `img`'s photons into map m, in the order of its texels, with their
+// kernels' totals.
+void photon_splats(const PhotonImage& img, const CubeMap& m, const CausticMapOptions& opt,
+                   std::vector<PhotonSplat>& out) {
+  const int res = img.res;
+  auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
+  for (int y = 0; y < res; ++y)
+    for (int x = 0; x < res; ++x) {
+      const std::size_t i = idx(x, y);
+      if (!img.valid[i]) continue;
+      PhotonSplat sp;
+      const glm::vec3 d = img.hit[i] - m.centre;
+      sp.c = cube_coord(d, m.size);
+      sp.dist = glm::length(d);
+      sp.radius = opt.splat_radius;
+      if (opt.adaptive) {
+        // The photon's reach: the farthest of its photon-image neighbours on the same
+        // receiver (distances within 20 %), in caustic-map texels, so sparse photons
+        // leave no holes and dense ones stay sharp.
+        float spacing = 0.0f;
+        const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+        for (int k = 0; k < 4; ++k) {
+          if (nx[k] < 0 || ny[k] < 0 || nx[k] >= res || ny[k] >= res) continue;
+          const std::size_t j = idx(nx[k], ny[k]);
+          if (!img.valid[j]) continue;
+          const glm::vec3 dj = img.hit[j] - m.centre;
+          const float lj = glm::length(dj);
+          if (std::max(lj, sp.dist) > 1.2f * std::min(lj, sp.dist)) continue;
+          glm::vec2 pj;
+          if (face_pixel(dj, sp.c.face, m.size, pj)) spacing = std::max(spacing, glm::length(pj - sp.c.pixel));
+        }
+        sp.radius = std::max(sp.radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
+      }
+      sp.image = &img;
+      sp.texel = static_cast<std::uint32_t>(i);
+      out.push_back(sp);
+    }
+  PhotonSplat* wide[8];
+  int count = 0;
+  for (PhotonSplat& sp : out) {
+    if (sp.radius <= 0) continue;
+    wide[count++] = &sp;
+    if (count == 8) splat_totals8(wide, count, m.size), count = 0;
+  }
+  if (count > 0) splat_totals8(wide, count, m.size);
+}
+
+// Stores the caustic triangles of image `img` into its map (target), in the order of its
+// texels, on every face.
+void store_caustic_triangles(const PhotonImage& img, MapTarget& target, std::vector<TexelShare>& scratch) {
   CubeMap& m = target.m;
   const int res = img.res;
   auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
-  if (opt.filter == CausticFilter::Splat) {
-    for (int y = 0; y < res; ++y)
-      for (int x = 0; x < res; ++x) {
-        const std::size_t i = idx(x, y);
-        if (!img.valid[i]) continue;
-        const glm::vec3 d = img.hit[i] - m.centre;
-        const CubeCoord c = cube_coord(d, m.size);
-        if (only_face >= 0 && c.face != only_face) continue;
-        const float dist = glm::length(d);
-        int radius = opt.splat_radius;
-        if (opt.adaptive) {
-          // The photon's reach: the farthest of its photon-image neighbours on the same
-          // receiver (distances within 20 %), in caustic-map texels, so sparse photons
-          // leave no holes and dense ones stay sharp.
-          float spacing = 0.0f;
-          const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-          for (int k = 0; k < 4; ++k) {
-            if (nx[k] < 0 || ny[k] < 0 || nx[k] >= res || ny[k] >= res) continue;
-            const std::size_t j = idx(nx[k], ny[k]);
-            if (!img.valid[j]) continue;
-            const glm::vec3 dj = img.hit[j] - m.centre;
-            const float lj = glm::length(dj);
-            if (std::max(lj, dist) > 1.2f * std::min(lj, dist)) continue;
-            glm::vec2 pj;
-            if (face_pixel(dj, c.face, m.size, pj)) spacing = std::max(spacing, glm::length(pj - c.pixel));
-          }
-          radius = std::max(radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
-        }
-        splat(target, c, img.flux[i], dist, img.wi[i], radius);
-      }
-    return;
-  }
   // Caustic triangles (§6.3.2): a cell of four neighbouring photons whose receiver
   // distances agree within 20 % (one receiver surface) makes two triangles, drawn on the
   // face of the cell's mean direction. Each photon's flux is shared equally by the cells it
@@ -563,7 +651,7 @@ void store_photon_image(const PhotonImage& img, MapTarget& target, const Caustic
       for (std::size_t k : c) ++corner_of[k];
     }
   for (std::size_t i = 0; i < img.valid.size(); ++i)
-    if (img.valid[i] && corner_of[i] == 0) splat(target, cube_coord(img.hit[i] - m.centre, m.size), img.flux[i], dists[i], img.wi[i], 0);
+    if (img.valid[i] && corner_of[i] == 0) deposit_nearest(target, cube_coord(img.hit[i] - m.centre, m.size), img.flux[i], dists[i], img.wi[i]);
   for (int y = 0; y < cells; ++y)
     for (int x = 0; x < cells; ++x) {
       if (!cell_ok[static_cast<std::size_t>(y) * cells + x]) continue;
@@ -583,8 +671,8 @@ void store_photon_image(const PhotonImage& img, MapTarget& target, const Caustic
       for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, face, m.size, p[k]);
       if (!projected) {  // a cell wider than a face's half space: its corners as points
         for (int k = 0; k < 4; ++k)
-          splat(target, cube_coord(img.hit[c[k]] - m.centre, m.size), img.flux[c[k]] / static_cast<float>(corner_of[c[k]]),
-                dists[c[k]], img.wi[c[k]], 0);
+          deposit_nearest(target, cube_coord(img.hit[c[k]] - m.centre, m.size),
+                          img.flux[c[k]] / static_cast<float>(corner_of[c[k]]), dists[c[k]], img.wi[c[k]]);
         continue;
       }
       const glm::vec2 t0[3] = {p[0], p[1], p[2]}, t1[3] = {p[0], p[2], p[3]};
@@ -593,10 +681,11 @@ void store_photon_image(const PhotonImage& img, MapTarget& target, const Caustic
     }
 }
 
-// Face f's flux-weighted mean distances (+inf where nothing landed) and unit incident
-// directions; the weights' sums are done with.
-void finish_face(CubeMap& m, CubeDirections& incident, int f) {
-  for (std::size_t i = 0; i < m.distance[f].pixels.size(); ++i) {
+// Rows [row_begin, row_end) of face f: flux-weighted mean distances (+inf where nothing
+// landed) and unit incident directions; the weights' sums are done with.
+void finish_rows(CubeMap& m, CubeDirections& incident, int f, int row_begin, int row_end) {
+  const std::size_t w = static_cast<std::size_t>(m.size);
+  for (std::size_t i = static_cast<std::size_t>(row_begin) * w; i < static_cast<std::size_t>(row_end) * w; ++i) {
     glm::vec4& c = m.colour[f].pixels[i];
     float& d = m.distance[f].pixels[i];
     glm::vec3& wi = incident[f].pixels[i];
@@ -605,6 +694,8 @@ void finish_face(CubeMap& m, CubeDirections& incident, int f) {
     c.w = 1.0f;
   }
 }
+
+void finish_face(CubeMap& m, CubeDirections& incident, int f) { finish_rows(m, incident, f, 0, m.size); }
 
 CausticMaps build_caustic_maps(par::Executor& executor, const Scene& scene, const CausticPhotons& photons,
                                const CausticMapOptions& opt) {
@@ -644,21 +735,52 @@ CausticMaps build_caustic_maps(par::Executor& executor, const Scene& scene, cons
     }
     images_of[map_index[key]].push_back(&img);
   }
-  // The maps side by side (splats: each face of each map); in each the photons land in the
-  // order of its images and their texels (a serial blend per map or face: the same sums for
-  // any thread count).
-  const bool per_face = opt.filter == CausticFilter::Splat;
-  const std::size_t parts = per_face ? kCubeFaces : 1;
-  executor.parallel_for("caustic_map.store", out.cubes.size() * parts, 1, [&](std::size_t begin, std::size_t end) {
-    std::vector<TexelShare> scratch;
+  if (opt.filter == CausticFilter::Triangles) {
+    // The maps side by side; in each the photons land in the order of its images and their
+    // texels (a serial blend per map: the same sums for any thread count).
+    executor.parallel_for("caustic_map.store", out.cubes.size(), 1, [&](std::size_t begin, std::size_t end) {
+      std::vector<TexelShare> scratch;
+      for (std::size_t k = begin; k < end; ++k) {
+        MapTarget target{out.cubes[k], out.incident[k]};
+        for (const PhotonImage* img : images_of[k]) store_caustic_triangles(*img, target, scratch);
+        blur(out.cubes[k], out.incident[k]);
+        for (int f = 0; f < kCubeFaces; ++f) finish_face(out.cubes[k], out.incident[k], f);
+      }
+    });
+    return out;
+  }
+  // Splats: each image's splats found side by side, then listed per face in the order of the
+  // map's images and their texels. A splat lands on its own face alone, so the faces, and
+  // bands of rows within them, are stored side by side, each texel's photons blended in
+  // that order (the same sums for any thread count).
+  std::vector<std::pair<std::size_t, const PhotonImage*>> jobs;
+  for (std::size_t k = 0; k < images_of.size(); ++k)
+    for (const PhotonImage* img : images_of[k]) jobs.emplace_back(k, img);
+  std::vector<std::vector<PhotonSplat>> splats(jobs.size());
+  executor.parallel_for("caustic_map.splats", jobs.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t j = begin; j < end; ++j) photon_splats(*jobs[j].second, out.cubes[jobs[j].first], opt, splats[j]);
+  });
+  std::vector<std::vector<PhotonSplat>> on_face(out.cubes.size() * kCubeFaces);
+  for (std::size_t j = 0; j < jobs.size(); ++j)
+    for (const PhotonSplat& sp : splats[j]) on_face[jobs[j].first * kCubeFaces + static_cast<std::size_t>(sp.c.face)].push_back(sp);
+  const int band_rows = 16;
+  const std::size_t bands = static_cast<std::size_t>((opt.size + band_rows - 1) / band_rows);
+  executor.parallel_for("caustic_map.store", on_face.size() * bands, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t task = begin; task < end; ++task) {
-      const std::size_t k = task / parts;
-      const int face = per_face ? static_cast<int>(task % parts) : -1;
+      const std::size_t face_index = task / bands;
+      const std::size_t k = face_index / kCubeFaces;
+      const int face = static_cast<int>(face_index % kCubeFaces);
+      const int row_begin = static_cast<int>(task % bands) * band_rows;
+      const int row_end = std::min(opt.size, row_begin + band_rows);
       MapTarget target{out.cubes[k], out.incident[k]};
-      for (const PhotonImage* img : images_of[k]) store_photon_image(*img, target, opt, scratch, face);
-      if (!per_face) blur(out.cubes[k], out.incident[k]);
-      for (int f = 0; f < kCubeFaces; ++f)
-        if (face < 0 || f == face) finish_face(out.cubes[k], out.incident[k], f);
+      for (const PhotonSplat& sp : on_face[face_index]) {
+        const float cy = sp.c.pixel.y;
+        if (cy + static_cast<float>(sp.radius) + 1.0f < static_cast<float>(row_begin) ||
+            cy - static_cast<float>(sp.radius) - 1.0f >= static_cast<float>(row_end))
+          continue;
+        splat_rows(target, sp, row_begin, row_end);
+      }
+      finish_rows(out.cubes[k], out.incident[k], face, row_begin, row_end);
     }
   });
   return out;
