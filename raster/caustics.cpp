@@ -610,14 +610,17 @@ void photon_splats(const PhotonImage& img, const CubeMap& m, const CausticMapOpt
       sp.texel = static_cast<std::uint32_t>(i);
       out.push_back(sp);
     }
-  PhotonSplat* wide[8];
-  int count = 0;
-  for (PhotonSplat& sp : out) {
-    if (sp.radius <= 0) continue;
-    wide[count++] = &sp;
-    if (count == 8) splat_totals8(wide, count, m.size), count = 0;
+  // Eight splats of one radius at a time (their kernels as long, but at the face's edges).
+  for (int radius = 1; radius <= kMaxSplatRadius; ++radius) {
+    PhotonSplat* wide[8];
+    int count = 0;
+    for (PhotonSplat& sp : out) {
+      if (sp.radius != radius) continue;
+      wide[count++] = &sp;
+      if (count == 8) splat_totals8(wide, count, m.size), count = 0;
+    }
+    if (count > 0) splat_totals8(wide, count, m.size);
   }
-  if (count > 0) splat_totals8(wide, count, m.size);
 }
 
 // Stores the caustic triangles of image `img` into its map (target), in the order of its
@@ -700,6 +703,8 @@ void finish_face(CubeMap& m, CubeDirections& incident, int f) { finish_rows(m, i
 CausticMaps build_caustic_maps(par::Executor& executor, const Scene& scene, const CausticPhotons& photons,
                                const CausticMapOptions& opt) {
   if (opt.size < 1 || opt.size > 4096) throw InputError("caustic_map", "size out of range (1..4096)");
+  if (opt.splat_radius < 0 || opt.splat_radius > kMaxSplatRadius)
+    throw InputError("caustic_map", "splat_radius out of range (0..8)");
   CausticMaps out;
   out.map_of_object.assign(scene.objects.size(), -1);
   // One map per generator (cube storage), or per generator and light (light storage), in the

@@ -113,7 +113,7 @@ struct CausticMapOptions {
   int size = 128;                // cube face side
   CausticFilter filter = CausticFilter::Splat;
   CausticStorage storage = CausticStorage::Cube;
-  int splat_radius = 1;          // texels (0: the nearest texel only)
+  int splat_radius = 1;          // texels, 0..8 (0: the nearest texel only)
   bool adaptive = true;          // splat: radius raised to the spacing of neighbouring photons
 };
 
