@@ -43,6 +43,28 @@ template <int W>
   irradiance = select(reached, Vec3Lanes<W>(light.color) * e, none);
 }
 
+// brdf_params_for_punctual_light of surfaces s[0, count) as lanes (lanes past count repeat
+// s[0]); `mirror` marks the lanes whose surface is_mirror_lobe() (shade_light_lanes' mask).
+template <int W>
+inline BrdfParamsLanes<W> punctual_brdf_params_lanes(const SurfaceParams* const* s, int count,
+                                                     typename par::Lanes<W>::mask& mirror) {
+  using L = par::Lanes<W>;
+  alignas(64) float params[8][W];
+  for (int j = 0; j < W; ++j) {
+    const SurfaceParams& sj = *s[j < count ? j : 0];
+    const BrdfParams b = brdf_params_for_punctual_light(sj);
+    const float fields[8] = {b.base_color.x, b.base_color.y, b.base_color.z, b.metallic, b.alpha, b.dielectric_f0,
+                             b.transmission, sj.is_mirror_lobe() ? 1.0f : 0.0f};
+    for (int k = 0; k < 8; ++k) params[k][j] = fields[k];
+  }
+  BrdfParamsLanes<W> p;
+  p.base_color = {L::load(params[0]), L::load(params[1]), L::load(params[2])};
+  p.metallic = L::load(params[3]), p.alpha = L::load(params[4]);
+  p.dielectric_f0 = L::load(params[5]), p.transmission = L::load(params[6]);
+  mirror = L::load(params[7]) > typename L::f32(0.0f);
+  return p;
+}
+
 // shade_light(s, view, n, v, {l, irradiance}) per lane for lanes whose N·L > 0 (the others:
 // 0); `mirror` marks the lanes whose surface is_mirror_lobe() (no highlight).
 template <int W>

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/optics.h"
 #include "core/shading.h"
+#include "core/shading_lanes.h"
 #include "parallel/lanes.h"
 #include "raster/cube_coord_lanes.h"
 #include "raster/refraction_path.h"
@@ -793,28 +794,52 @@ CausticMaps build_caustic_maps(par::Executor& executor, const Scene& scene, cons
 
 namespace {
 
-// The caustic light a receiver gets from one map's texel c, seen at distance `dist` along
-// d = p − centre with |N·d|/dist = cos_alpha: irradiance Φ |cosα| / (Ω d²) from the texel's
-// mean photon direction, shaded (`view`: the receiver's BRDF terms, made on first use).
-// Nothing when that direction is below the surface.
-glm::vec3 texel_caustic(const CausticMaps& maps, std::size_t k, const CubeCoord& c, float dist, float cos_alpha,
-                        const SurfaceParams& s, const glm::vec3& nrm, const glm::vec3& v, std::optional<BrdfAtView>& view) {
+// Eight receivers' caustic light from one map's texels: the bilinear flux Φ of the texel
+// under each lane's coordinate, the nearest texel's mean photon direction wi and solid angle
+// Ω, for the lanes in `lit`.
+struct CausticTexels8 {
+  Vec3Lanes<8> flux, wi;
+  par::Lanes<8>::f32 solid_angle;
+};
+
+CausticTexels8 caustic_texels8(const CausticMaps& maps, std::size_t k, const CubeCoordLanes& cc,
+                               const par::Lanes<8>::mask& lit) {
+  using L = par::Lanes<8>;
   const CubeMap& m = maps.cubes[k];
-  const int x = std::clamp(static_cast<int>(c.pixel.x), 0, m.size - 1);
-  const int y = std::clamp(static_cast<int>(c.pixel.y), 0, m.size - 1);
-  const glm::vec3 flux = glm::vec3(m.colour_at(c));
-  const glm::vec3 wi = maps.incident[k][c.face].at(x, y);
-  // The texel's flux lands on the receiver area Ω d² / |cosα| it subtends (α between the
-  // normal and the line from the centre): irradiance Φ |cosα| / (Ω d²), arriving from wi.
-  // shade_light returns f (N·L) E, so it is given E / (N·wi).
-  const float cos_in = glm::dot(nrm, wi);
-  if (cos_in <= 1e-4f) return glm::vec3(0.0f);
-  LightSample ls;
-  ls.direction = wi;
-  ls.distance = dist;
-  ls.irradiance = flux * (cos_alpha / (cube_texel_solid_angle(x, y, m.size) * dist * dist * cos_in));
-  if (!view) view = brdf_at_view(brdf_params_for_punctual_light(s), nrm, v);
-  return shade_light(s, *view, nrm, v, ls);
+  const float last = static_cast<float>(m.size - 1);
+  alignas(32) float tap[4][3][8] = {}, tx[8] = {}, ty[8] = {}, wi[3][8] = {}, u[8] = {}, v[8] = {};
+  for (int j = 0; j < 8; ++j) {
+    if (!lit[j]) continue;
+    // CubeMap::colour_at's taps and weights.
+    const ImageRGBA& img = m.colour[cc.face[j]];
+    const float fx = std::clamp(cc.x[j] - 0.5f, 0.0f, last), fy = std::clamp(cc.y[j] - 0.5f, 0.0f, last);
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = std::min(x0 + 1, m.size - 1), y1 = std::min(y0 + 1, m.size - 1);
+    tx[j] = fx - static_cast<float>(x0), ty[j] = fy - static_cast<float>(y0);
+    const glm::vec4* corner[4] = {&img.at(x0, y0), &img.at(x1, y0), &img.at(x0, y1), &img.at(x1, y1)};
+    for (int t = 0; t < 4; ++t)
+      for (int c = 0; c < 3; ++c) tap[t][c][j] = (*corner[t])[c];
+    const int x = std::clamp(static_cast<int>(cc.x[j]), 0, m.size - 1);
+    const int y = std::clamp(static_cast<int>(cc.y[j]), 0, m.size - 1);
+    const glm::vec3& w = maps.incident[k][cc.face[j]].at(x, y);
+    wi[0][j] = w.x, wi[1][j] = w.y, wi[2][j] = w.z;
+    u[j] = static_cast<float>(x), v[j] = static_cast<float>(y);
+  }
+  CausticTexels8 out;
+  const L::f32 wx = L::load_aligned(tx), wy = L::load_aligned(ty);
+  const L::f32 one_x = 1.0f - wx, one_y = 1.0f - wy;
+  L::f32 flux[3];
+  for (int c = 0; c < 3; ++c)
+    flux[c] = (L::load_aligned(tap[0][c]) * one_x + L::load_aligned(tap[1][c]) * wx) * one_y +
+              (L::load_aligned(tap[2][c]) * one_x + L::load_aligned(tap[3][c]) * wx) * wy;
+  out.flux = {flux[0], flux[1], flux[2]};
+  out.wi = {L::load_aligned(wi[0]), L::load_aligned(wi[1]), L::load_aligned(wi[2])};
+  // cube_texel_solid_angle(x, y, size).
+  const float size = static_cast<float>(m.size);
+  const L::f32 su = 2.0f * (L::load_aligned(u) + 0.5f) / size - 1.0f, sv = 2.0f * (L::load_aligned(v) + 0.5f) / size - 1.0f;
+  const L::f32 q = 1.0f + su * su + sv * sv;
+  out.solid_angle = (2.0f / size) * (2.0f / size) / (q * L::sqrt(q));
+  return out;
 }
 
 }  // namespace
@@ -827,29 +852,34 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
   const std::size_t n = static_cast<std::size_t>(g.width) * g.height;
   using L = par::Lanes<8>;
   using f32 = L::f32;
+  using V = Vec3Lanes<8>;
   ex.parallel_for("caustic_gather", n, 1024, [&](std::size_t b, std::size_t e) {
-    // The chunk's receivers (covered, not refractors), map by map: eight receivers' distance
-    // tests at once in lanes (each lane with the scalar operations in their order), the
-    // texels that light one shaded one at a time; each receiver's sum in map order.
+    // The chunk's receivers (covered, not refractors), eight at a time in lanes, each lane
+    // with the scalar operations in their order: map by map the distance tests, then the
+    // lit receivers' texels shaded; each receiver's sum in map order.
     std::vector<std::uint32_t> at;
     for (std::size_t i = b; i < e; ++i)
       if (g.covered(i) && !g.surface[i].is_refractor()) at.push_back(static_cast<std::uint32_t>(i));
-    std::vector<glm::vec3> sum(at.size(), glm::vec3(0.0f));
-    std::vector<std::optional<BrdfAtView>> view(at.size());
-    for (std::size_t k = 0; k < maps.cubes.size(); ++k) {
-      const CubeMap& m = maps.cubes[k];
-      const float texel = 2.0f / static_cast<float>(m.size);
-      for (std::size_t first = 0; first < at.size(); first += 8) {
-        const int count = static_cast<int>(std::min<std::size_t>(8, at.size() - first));
-        alignas(32) float p[3][8] = {}, nr[3][8] = {};
+    for (std::size_t first = 0; first < at.size(); first += 8) {
+      const int count = static_cast<int>(std::min<std::size_t>(8, at.size() - first));
+      glm::vec3 p[8], nr[8], view_dir[8];
+      const SurfaceParams* surface[8];
+      for (int j = 0; j < count; ++j) {
+        const std::size_t i = at[first + j];
+        p[j] = g.position.pixels[i], nr[j] = g.normal.pixels[i], view_dir[j] = g.view_direction(i);
+        surface[j] = &g.surface[i];
+      }
+      const V pv = V::load(p, count), nv = V::load(nr, count), vv = V::load(view_dir, count);
+      // The receivers' BRDF terms at their viewer (brdf_at_view), made when a map lights one.
+      std::optional<BrdfAtViewLanes<8>> view;
+      L::mask mirror(false);
+      V sum(f32(0.0f), f32(0.0f), f32(0.0f));
+      for (std::size_t k = 0; k < maps.cubes.size(); ++k) {
+        const CubeMap& m = maps.cubes[k];
+        const float texel = 2.0f / static_cast<float>(m.size);
         alignas(32) std::int32_t mine[8] = {};
-        for (int j = 0; j < count; ++j) {
-          const std::size_t i = at[first + j];
-          for (int c = 0; c < 3; ++c) p[c][j] = g.position.pixels[i][c], nr[c][j] = g.normal.pixels[i][c];
-          mine[j] = g.object.pixels[i] == maps.objects[k];  // a generator is not its own receiver
-        }
-        f32 d[3];
-        for (int c = 0; c < 3; ++c) d[c] = L::load_aligned(p[c]) - f32(m.centre[c]);
+        for (int j = 0; j < count; ++j) mine[j] = g.object.pixels[at[first + j]] == maps.objects[k];  // a generator is not its own receiver
+        const f32 d[3] = {pv.x - f32(m.centre.x), pv.y - f32(m.centre.y), pv.z - f32(m.centre.z)};
         const f32 dist = L::sqrt((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]);
         const L::mask tested = L::first_n(count) && (L::load_aligned(mine) == 0) && (dist > 0.0f);
         if (L::none(tested)) continue;
@@ -865,8 +895,7 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
         // changes its distance by about d (2/size) tanα, so grazing receivers are allowed
         // that much more (tanα capped at 16, beyond which no texel resolves the surface).
         // std::min/max's operand order kept, so NaNs fall as they would.
-        const f32 cos_view =
-            L::abs((L::load_aligned(nr[0]) * d[0] + L::load_aligned(nr[1]) * d[1]) + L::load_aligned(nr[2]) * d[2]) / dist;
+        const f32 cos_view = L::abs((nv.x * d[0] + nv.y * d[1]) + nv.z * d[2]) / dist;
         const f32 sin2 = 1.0f - cos_view * cos_view;
         const f32 sin_view = L::sqrt(L::select(f32(0.0f) < sin2, sin2, f32(0.0f)));
         const f32 ratio = sin_view / L::select(cos_view < 1e-3f, f32(1e-3f), cos_view);
@@ -874,16 +903,23 @@ ImageRGBA gather_caustics(par::Executor& ex, const GBuffer& g, const CausticMaps
         const f32 slack = tolerance * stored + 2.0f * dist * tan_view * texel;
         const L::mask lit = tested && (L::abs(stored) < std::numeric_limits<float>::infinity()) &&
                             !(L::abs(dist - stored) > slack);
-        for (int j = 0; j < count; ++j) {
-          if (!lit[j]) continue;
-          const std::size_t i = at[first + j];
-          const CubeCoord c{cc.face[j], {cc.x[j], cc.y[j]}};
-          sum[first + j] += texel_caustic(maps, k, c, dist[j], cos_view[j], g.surface[i], g.normal.pixels[i],
-                                          g.view_direction(i), view[first + j]);
-        }
+        if (L::none(lit)) continue;
+        // The texel's flux lands on the receiver area Ω d² / |cosα| it subtends (α between
+        // the normal and the line from the centre): irradiance Φ |cosα| / (Ω d²), arriving
+        // from the texel's mean photon direction wi, none when that is below the surface.
+        // shade_light returns f (N·L) E, so it is given E / (N·wi).
+        const CausticTexels8 t = caustic_texels8(maps, k, cc, lit);
+        const f32 cos_in = dot(nv, t.wi);
+        const L::mask received = lit && !(cos_in <= 1e-4f);
+        if (L::none(received)) continue;
+        const V irradiance = t.flux * (cos_view / (t.solid_angle * dist * dist * cos_in));
+        if (!view) view = brdf_at_view_lanes(punctual_brdf_params_lanes<8>(surface, count, mirror), nv, vv);
+        sum = select(received, sum + shade_light_lanes(*view, mirror, nv, vv, t.wi, irradiance), sum);
       }
+      glm::vec3 light[8];
+      sum.store(light, count);
+      for (int j = 0; j < count; ++j) out.pixels[at[first + j]] += glm::vec4(light[j], 0.0f);
     }
-    for (std::size_t r = 0; r < at.size(); ++r) out.pixels[at[r]] += glm::vec4(sum[r], 0.0f);
   });
   return out;
 }

@@ -76,28 +76,18 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
   using L = par::Lanes<8>;
   using V = Vec3Lanes<8>;
   // The points' material parameters as lanes.
-  alignas(32) float params[11][8];
-  for (int j = 0; j < 8; ++j) {
-    const SurfaceParams& sj = *s[j < count ? j : 0];
-    const BrdfParams b = brdf_params_for_punctual_light(sj);
-    const float fields[11] = {sj.emissive.x, sj.emissive.y, sj.emissive.z, b.base_color.x, b.base_color.y,
-                              b.base_color.z, b.metallic, b.alpha, b.dielectric_f0, b.transmission,
-                              sj.is_mirror_lobe() ? 1.0f : 0.0f};
-    for (int k = 0; k < 11; ++k) params[k][j] = fields[k];
-  }
+  L::mask mirror;
+  const BrdfParamsLanes<8> brdf = punctual_brdf_params_lanes<8>(s, count, mirror);
+  glm::vec3 emissive[8];
+  for (int j = 0; j < count; ++j) emissive[j] = s[j]->emissive;
   const L::f32 zero(0.0f);
-  BrdfParamsLanes<8> brdf;
-  brdf.base_color = {L::load(params[3]), L::load(params[4]), L::load(params[5])};
-  brdf.metallic = L::load(params[6]), brdf.alpha = L::load(params[7]);
-  brdf.dielectric_f0 = L::load(params[8]), brdf.transmission = L::load(params[9]);
-  const L::mask mirror = L::load(params[10]) > zero;
 
   const V pv = V::load(p, count), vv = V::load(v, count), raw_n = V::load(n_in, count);
   const V nv = select(dot(raw_n, vv) < zero, -raw_n, raw_n);  // facing_viewer
   glm::vec3 n[8];
   nv.store(n, count);
   const BrdfAtViewLanes<8> view = brdf_at_view_lanes(brdf, nv, vv);
-  V radiance(L::load(params[0]), L::load(params[1]), L::load(params[2]));
+  V radiance = V::load(emissive, count);
   for (std::size_t k = 0; k < lights_.size(); ++k) {
     V l, irradiance;
     lights_[k].sample(pv, l, irradiance);
