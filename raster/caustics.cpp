@@ -48,17 +48,35 @@ Sphere bounding_sphere(const Scene& scene, const Object& obj) {
   return {b.center(), std::sqrt(r2) * 1.01f + 1e-6f};
 }
 
-// Continuous pixel coordinates of direction d projected on the plane of `face`, unclamped
-// (beyond [0, size] off the face): so caustic triangles and photon spacings that straddle a
-// face edge are measured in one face's texels. False when d points away from the face.
-bool face_pixel(const glm::vec3& d, int face, int size, glm::vec2& out) {
+// A face's plane in a size² cube: its centre direction f and the offsets r, u to the centres
+// of its right and top edges.
+struct FacePlane {
+  glm::vec3 f, r, u;
+  FacePlane() = default;
+  FacePlane(int face, int size) {
+    const float s = static_cast<float>(size);
+    f = cube_direction(face, {0.5f * s, 0.5f * s}, size);
+    r = cube_direction(face, {s, 0.5f * s}, size) * std::sqrt(2.0f) - f;
+    u = cube_direction(face, {0.5f * s, 0.0f}, size) * std::sqrt(2.0f) - f;
+  }
+};
+
+// The six faces' planes of a size² cube.
+std::array<FacePlane, kCubeFaces> face_planes(int size) {
+  std::array<FacePlane, kCubeFaces> planes;
+  for (int face = 0; face < kCubeFaces; ++face) planes[face] = FacePlane(face, size);
+  return planes;
+}
+
+// Continuous pixel coordinates of direction d projected on `plane` (a face of a size² cube),
+// unclamped (beyond [0, size] off the face): so caustic triangles and photon spacings that
+// straddle a face edge are measured in one face's texels. False when d points away from the
+// face.
+bool face_pixel(const glm::vec3& d, const FacePlane& plane, int size, glm::vec2& out) {
   const float s = static_cast<float>(size);
-  const glm::vec3 f = cube_direction(face, {0.5f * s, 0.5f * s}, size);
-  const glm::vec3 r = cube_direction(face, {s, 0.5f * s}, size) * std::sqrt(2.0f) - f;
-  const glm::vec3 u = cube_direction(face, {0.5f * s, 0.0f}, size) * std::sqrt(2.0f) - f;
-  const float depth = glm::dot(d, f);
+  const float depth = glm::dot(d, plane.f);
   if (depth <= 0.0f) return false;
-  out = {(glm::dot(d, r) / depth + 1.0f) * 0.5f * s, (1.0f - glm::dot(d, u) / depth) * 0.5f * s};
+  out = {(glm::dot(d, plane.r) / depth + 1.0f) * 0.5f * s, (1.0f - glm::dot(d, plane.u) / depth) * 0.5f * s};
   return true;
 }
 
@@ -99,14 +117,17 @@ struct SplatKernel {
     y1 = std::min(size - 1, cy + radius);
     reach = static_cast<float>(radius) + 0.5f;
   }
-  // Row y's weights, columns x0..x1, into w[0, x1 − x0]: eight columns at once in lanes.
-  void row_weights(const CubeCoord& c, int y, float (&w)[kColumns]) const {
+  // Row y's weights, columns x0..x1, into w[0, x1 − x0], and each over `total` into share:
+  // eight columns at once in lanes.
+  void row_weights(const CubeCoord& c, int y, float total, float (&w)[kColumns], float (&share)[kColumns]) const {
     using L = par::Lanes<8>;
     const float dy = static_cast<float>(y) + 0.5f - c.pixel.y;
     const L::f32 dy2(dy * dy), zero(0.0f);
     for (int i = 0; i <= x1 - x0; i += 8) {
       const L::f32 dx = L::to_float(L::iota(x0 + i)) + 0.5f - c.pixel.x;
-      L::store(L::max(zero, 1.0f - L::sqrt(dx * dx + dy2) / reach), w + i);
+      const L::f32 weight = L::max(zero, 1.0f - L::sqrt(dx * dx + dy2) / reach);
+      L::store(weight, w + i);
+      L::store(weight / total, share + i);
     }
   }
 };
@@ -173,13 +194,11 @@ void splat_rows(MapTarget& t, const PhotonSplat& sp, int row_begin, int row_end)
     return;
   }
   const SplatKernel k(sp.c, sp.radius, t.m.size);
-  alignas(32) float w[SplatKernel::kColumns];
+  alignas(32) float w[SplatKernel::kColumns], share[SplatKernel::kColumns];
   for (int y = std::max(k.y0, row_begin); y <= std::min(k.y1, row_end - 1); ++y) {
-    k.row_weights(sp.c, y, w);
-    for (int x = k.x0; x <= k.x1; ++x) {
-      const float share = w[x - k.x0];
-      if (share > 0.0f) deposit(t, sp.c.face, x, y, flux * (share / sp.total), share / sp.total, sp.dist, wi);
-    }
+    k.row_weights(sp.c, y, sp.total, w, share);
+    for (int x = k.x0; x <= k.x1; ++x)
+      if (w[x - k.x0] > 0.0f) deposit(t, sp.c.face, x, y, flux * share[x - k.x0], share[x - k.x0], sp.dist, wi);
   }
 }
 
@@ -579,6 +598,7 @@ glm::dvec3 caustic_map_flux(const CubeMap& map) {
 void photon_splats(const PhotonImage& img, const CubeMap& m, const CausticMapOptions& opt,
                    std::vector<PhotonSplat>& out) {
   const int res = img.res;
+  const std::array<FacePlane, kCubeFaces> planes = face_planes(m.size);
   auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
   for (int y = 0; y < res; ++y)
     for (int x = 0; x < res; ++x) {
@@ -603,7 +623,7 @@ void photon_splats(const PhotonImage& img, const CubeMap& m, const CausticMapOpt
           const float lj = glm::length(dj);
           if (std::max(lj, sp.dist) > 1.2f * std::min(lj, sp.dist)) continue;
           glm::vec2 pj;
-          if (face_pixel(dj, sp.c.face, m.size, pj)) spacing = std::max(spacing, glm::length(pj - sp.c.pixel));
+          if (face_pixel(dj, planes[sp.c.face], m.size, pj)) spacing = std::max(spacing, glm::length(pj - sp.c.pixel));
         }
         sp.radius = std::max(sp.radius, std::min(kMaxSplatRadius, static_cast<int>(std::ceil(spacing))));
       }
@@ -630,6 +650,7 @@ void store_caustic_triangles(const PhotonImage& img, MapTarget& target, std::vec
   CubeMap& m = target.m;
   const int res = img.res;
   auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * res + x; };
+  const std::array<FacePlane, kCubeFaces> planes = face_planes(m.size);
   // Caustic triangles (§6.3.2): a cell of four neighbouring photons whose receiver
   // distances agree within 20 % (one receiver surface) makes two triangles, drawn on the
   // face of the cell's mean direction. Each photon's flux is shared equally by the cells it
@@ -672,7 +693,7 @@ void store_caustic_triangles(const PhotonImage& img, MapTarget& target, std::vec
       }
       const int face = cube_coord(mean_dir, m.size).face;
       bool projected = true;
-      for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, face, m.size, p[k]);
+      for (int k = 0; k < 4; ++k) projected = projected && face_pixel(img.hit[c[k]] - m.centre, planes[face], m.size, p[k]);
       if (!projected) {  // a cell wider than a face's half space: its corners as points
         for (int k = 0; k < 4; ++k)
           deposit_nearest(target, cube_coord(img.hit[c[k]] - m.centre, m.size),
