@@ -801,3 +801,86 @@ TEST(Caustics, GatherGivesEachReceiverTheBitsOfAScalarOracle) {
 
 }  // namespace
 }  // namespace speculum::raster
+
+namespace speculum::raster {
+namespace {
+
+// The splat store (photons listed per face, faces stored in bands of rows side by side, the
+// kernels' sums in lanes) against every photon splatted alone in image and texel order with
+// the scalar operations: each texel's flux, weight, distance and direction, bit for bit, for
+// the nearest texel and kernels up to the widest (splats cut at the faces' edges).
+TEST(Caustics, SplatStoreGivesTheBitsOfPhotonsSplattedOneByOne) {
+  const Scene s = load_scene("glass-sphere:size=8000");
+  par::Executor ex(3);
+  const PhotonRun r = shoot(ex, s, 96);
+  ASSERT_GT(r.photons.stored, 1000u);
+  for (int radius : {0, 1, 3, 8}) {
+    CausticMapOptions o;
+    o.size = 40;  // not a multiple of the 16-row bands
+    o.splat_radius = radius;
+    o.adaptive = false;
+    const CausticMaps got = build_caustic_maps(ex, s, r.photons, o);
+    ASSERT_EQ(got.cubes.size(), 1u);
+    const glm::vec3 centre = got.cubes[0].centre;
+    const int n = o.size;
+    std::array<std::vector<glm::vec4>, kCubeFaces> colour;
+    std::array<std::vector<float>, kCubeFaces> distance;
+    std::array<std::vector<glm::vec3>, kCubeFaces> incident;
+    for (int f = 0; f < kCubeFaces; ++f) {
+      colour[f].assign(static_cast<std::size_t>(n) * n, glm::vec4(0.0f));
+      distance[f].assign(colour[f].size(), 0.0f);
+      incident[f].assign(colour[f].size(), glm::vec3(0.0f));
+    }
+    for (const PhotonImage& img : r.photons.images)
+      for (std::size_t i = 0; i < img.valid.size(); ++i) {
+        if (!img.valid[i]) continue;
+        const glm::vec3 d = img.hit[i] - centre;
+        const CubeCoord c = cube_coord(d, n);
+        const float dist = glm::length(d);
+        const int cx = std::clamp(static_cast<int>(c.pixel.x), 0, n - 1);
+        const int cy = std::clamp(static_cast<int>(c.pixel.y), 0, n - 1);
+        const auto add = [&](int x, int y, float share) {
+          const std::size_t t = static_cast<std::size_t>(y) * n + x;
+          colour[c.face][t] += glm::vec4(img.flux[i] * share, share);
+          distance[c.face][t] += share * dist;
+          incident[c.face][t] += share * img.wi[i];
+        };
+        if (radius == 0) {
+          add(cx, cy, 1.0f);
+          continue;
+        }
+        const float reach = static_cast<float>(radius) + 0.5f;
+        const auto weight = [&](int x, int y) {
+          const float dx = static_cast<float>(x) + 0.5f - c.pixel.x, dy = static_cast<float>(y) + 0.5f - c.pixel.y;
+          return std::max(0.0f, 1.0f - std::sqrt(dx * dx + dy * dy) / reach);
+        };
+        const int x0 = std::max(0, cx - radius), x1 = std::min(n - 1, cx + radius);
+        const int y0 = std::max(0, cy - radius), y1 = std::min(n - 1, cy + radius);
+        float total = 0.0f;
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x) total += weight(x, y);
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x)
+            if (weight(x, y) > 0.0f) add(x, y, weight(x, y) / total);
+      }
+    std::size_t lit = 0, mismatched = 0;
+    for (int f = 0; f < kCubeFaces; ++f)
+      for (std::size_t t = 0; t < colour[f].size(); ++t) {
+        glm::vec4 c = colour[f][t];
+        const float want_d = c.w > 0.0f ? distance[f][t] / c.w : std::numeric_limits<float>::infinity();
+        glm::vec3 wi = incident[f][t];
+        wi = glm::dot(wi, wi) > 0.0f ? glm::normalize(wi) : glm::vec3(0.0f);
+        lit += c.w > 0.0f;
+        c.w = 1.0f;
+        const bool same = std::memcmp(&c, &got.cubes[0].colour[f].pixels[t], sizeof(c)) == 0 &&
+                          std::memcmp(&want_d, &got.cubes[0].distance[f].pixels[t], sizeof(float)) == 0 &&
+                          std::memcmp(&wi, &got.incident[0][f].pixels[t], sizeof(wi)) == 0;
+        if (!same && ++mismatched <= 3) ADD_FAILURE() << "radius " << radius << " face " << f << " texel " << t;
+      }
+    EXPECT_EQ(mismatched, 0u) << "radius " << radius;
+    EXPECT_GT(lit, 100u) << "radius " << radius;
+  }
+}
+
+}  // namespace
+}  // namespace speculum::raster
