@@ -18,6 +18,7 @@
 #include "parallel/lanes.h"
 #include "raster/cube_coord_lanes.h"
 #include "raster/refraction_path.h"
+#include "raster/transpose8.h"
 #include "raster/visibility.h"
 
 namespace speculum::raster {
@@ -828,8 +829,11 @@ CausticTexels8 caustic_texels8(const CausticMaps& maps, std::size_t k, const Cub
   using L = par::Lanes<8>;
   const CubeMap& m = maps.cubes[k];
   const float last = static_cast<float>(m.size - 1);
-  alignas(32) float tap[4][3][8] = {}, tx[8] = {}, ty[8] = {}, wi[3][8] = {}, u[8] = {}, v[8] = {};
+  static const glm::vec4 none(0.0f);  // the taps of lanes not lit
+  alignas(32) float tap[4][3][8], tx[8] = {}, ty[8] = {}, wi[3][8] = {}, u[8] = {}, v[8] = {};
+  const float* corner[4][8];
   for (int j = 0; j < 8; ++j) {
+    for (int t = 0; t < 4; ++t) corner[t][j] = &none.x;
     if (!lit[j]) continue;
     // CubeMap::colour_at's taps and weights.
     const ImageRGBA& img = m.colour[cc.face[j]];
@@ -837,15 +841,15 @@ CausticTexels8 caustic_texels8(const CausticMaps& maps, std::size_t k, const Cub
     const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
     const int x1 = std::min(x0 + 1, m.size - 1), y1 = std::min(y0 + 1, m.size - 1);
     tx[j] = fx - static_cast<float>(x0), ty[j] = fy - static_cast<float>(y0);
-    const glm::vec4* corner[4] = {&img.at(x0, y0), &img.at(x1, y0), &img.at(x0, y1), &img.at(x1, y1)};
-    for (int t = 0; t < 4; ++t)
-      for (int c = 0; c < 3; ++c) tap[t][c][j] = (*corner[t])[c];
+    corner[0][j] = &img.at(x0, y0).x, corner[1][j] = &img.at(x1, y0).x;
+    corner[2][j] = &img.at(x0, y1).x, corner[3][j] = &img.at(x1, y1).x;
     const int x = std::clamp(static_cast<int>(cc.x[j]), 0, m.size - 1);
     const int y = std::clamp(static_cast<int>(cc.y[j]), 0, m.size - 1);
     const glm::vec3& w = maps.incident[k][cc.face[j]].at(x, y);
     wi[0][j] = w.x, wi[1][j] = w.y, wi[2][j] = w.z;
     u[j] = static_cast<float>(x), v[j] = static_cast<float>(y);
   }
+  for (int t = 0; t < 4; ++t) detail::rgb_of_rgba8(corner[t], tap[t]);
   CausticTexels8 out;
   const L::f32 wx = L::load_aligned(tx), wy = L::load_aligned(ty);
   const L::f32 one_x = 1.0f - wx, one_y = 1.0f - wy;

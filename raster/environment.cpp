@@ -4,8 +4,6 @@
 // number of lookups whatever its lobe width.
 #include "raster/environment.h"
 
-#include <immintrin.h>
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -16,6 +14,7 @@
 #include "core/shading.h"
 #include "parallel/lanes.h"
 #include "raster/cube_coord_lanes.h"
+#include "raster/transpose8.h"
 
 namespace speculum::raster {
 namespace {
@@ -100,21 +99,12 @@ struct LevelFaces {
   const i32 row0 = y0 * side, row1 = y1 * side;
   const i32 taps[4] = {(row0 + x0) * 4, (row0 + x1) * 4, (row1 + x0) * 4, (row1 + x1) * 4};
   const float* const* pixels = level.pixels;
-  // Each lane's tap texel loaded as one RGBA row, lanes j and j + 4 in the two halves of a
-  // register, and the rows transposed into channels within the halves: the values one load
-  // per channel would give. Whole registers are stored (a 256-bit load of two 128-bit
-  // stores would wait for them to reach the cache).
+  // Each lane's tap texel loaded as one RGBA row and transposed into channels.
   alignas(32) float channel[4][3][8];  // [tap][channel][lane]
   for (int q = 0; q < 4; ++q) {
-    __m256 r[4];
-    for (int j = 0; j < 4; ++j)
-      r[j] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(pixels[fi[j]] + taps[q][j])),
-                                  _mm_loadu_ps(pixels[fi[j + 4]] + taps[q][j + 4]), 1);
-    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-    const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-    _mm256_store_ps(channel[q][0], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
-    _mm256_store_ps(channel[q][1], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
-    _mm256_store_ps(channel[q][2], _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+    const float* texel[8];
+    for (int j = 0; j < 8; ++j) texel[j] = pixels[fi[j]] + taps[q][j];
+    detail::rgb_of_rgba8(texel, channel[q]);
   }
   for (int c = 0; c < 3; ++c) {
     const auto tap = [&](int q) { return L::load_aligned(channel[q][c]); };

@@ -1,5 +1,6 @@
 // The 8×8 transpose of 32-bit lanes in AVX2: eight records of eight dwords to eight lanes of
-// each field and back (triangle setup assembles its records with it).
+// each field and back (triangle setup assembles its records with it); eight RGBA texels'
+// colour channels as lanes (texel lookups in lanes).
 #pragma once
 
 #include <immintrin.h>
@@ -27,6 +28,22 @@ inline void transpose8(const __m256i (&in)[8], __m256i (&out)[8]) {
   for (int k = 0; k < 8; ++k) f[k] = _mm256_castsi256_ps(in[k]);
   transpose8(f, g);
   for (int k = 0; k < 8; ++k) out[k] = _mm256_castps_si256(g[k]);
+}
+
+// The red, green and blue of eight RGBA texels (texel[j]: lane j's four floats) into
+// rgb[c][j] (32-byte aligned): each texel one 128-bit load, lanes j and j + 4 in the two
+// halves of a register, the rows transposed into channels within the halves: the values one
+// load per channel would give. Whole registers are stored (a 256-bit load of two 128-bit
+// stores would wait for them to reach the cache).
+inline void rgb_of_rgba8(const float* const (&texel)[8], float (&rgb)[3][8]) {
+  __m256 r[4];
+  for (int j = 0; j < 4; ++j)
+    r[j] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(texel[j])), _mm_loadu_ps(texel[j + 4]), 1);
+  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+  _mm256_store_ps(rgb[0], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+  _mm256_store_ps(rgb[1], _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+  _mm256_store_ps(rgb[2], _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
 }
 
 }  // namespace speculum::raster::detail
