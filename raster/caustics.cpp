@@ -412,6 +412,13 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         std::vector<std::uint8_t> hops(n, 0);   // of which into other generators
         const CubeMap* impostor = impostors ? impostors->for_object(object) : nullptr;
         ex.parallel_for("caustic_photons", n, 256, [&](std::size_t b, std::size_t e) {
+          // Each texel's photon up to its receiver, then the receivers (their first searches
+          // side by side), in texel order.
+          struct Pending {
+            std::uint32_t i;
+            glm::vec3 x, r, flux;
+          };
+          std::vector<Pending> pending;
           for (std::size_t i = b; i < e; ++i) {
             if (gb.object.pixels[i] != object) continue;
             const SurfaceParams& s = gb.surface[i];
@@ -485,6 +492,20 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               }
               if (lost) continue;
             }
+            pending.push_back({static_cast<std::uint32_t>(i), x, r, flux});
+          }
+          // The receivers' first searches, in the generator's distance map, eight at a time
+          // (search_distance_map8: each the bits of the search alone).
+          std::vector<DistanceSearchResult> receiver(pending.size());
+          for (std::size_t first = 0; first < pending.size(); first += 8) {
+            const int count = static_cast<int>(std::min<std::size_t>(8, pending.size() - first));
+            glm::vec3 xs[8], rs[8];
+            for (int j = 0; j < count; ++j) xs[j] = pending[first + j].x, rs[j] = pending[first + j].r;
+            search_distance_map8(env, xs, rs, count, opt.receiver_search, &receiver[first]);
+          }
+          for (std::size_t q = 0; q < pending.size(); ++q) {
+            const std::size_t i = pending[q].i;
+            glm::vec3 x = pending[q].x, r = pending[q].r, flux = pending[q].flux;
             // The receiver, searched in the generator's distance map. Where it lies on another
             // generator (on that generator's impostor surface, within 3 %), the photon goes on
             // through it (reflected off a mirror, or refracted in and out of a refractor: its
@@ -494,8 +515,9 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
             std::uint32_t current = object;
             glm::vec3 hit(0.0f);
             bool lost = false;
-            for (;;) {
-              const DistanceSearchResult found = search_distance_map(*search_map, x, r, opt.receiver_search);
+            for (bool first = true;; first = false) {
+              const DistanceSearchResult found =
+                  first ? receiver[q] : search_distance_map(*search_map, x, r, opt.receiver_search);
               const float stored = std::isfinite(found.d) ? search_map->distance_towards(found.direction) : kInf;
               if (!std::isfinite(stored)) {
                 state[i] = 3;
