@@ -306,6 +306,30 @@ std::vector<std::uint32_t> caustic_generator_objects(const Scene& scene) {
   return out;
 }
 
+namespace {
+
+// A photon on its way: texel i of its photon image, at x going along r, carrying flux.
+struct PhotonStep {
+  std::uint32_t i;
+  glm::vec3 x, r, flux;
+};
+
+// search_distance_map from each step's x along its r, eight at a time (search_distance_map8:
+// each the bits of the search alone).
+std::vector<DistanceSearchResult> first_searches(const CubeMap& map, const std::vector<PhotonStep>& steps,
+                                                 const DistanceSearchOptions& options) {
+  std::vector<DistanceSearchResult> found(steps.size());
+  for (std::size_t first = 0; first < steps.size(); first += 8) {
+    const int count = static_cast<int>(std::min<std::size_t>(8, steps.size() - first));
+    glm::vec3 x[8], r[8];
+    for (int j = 0; j < count; ++j) x[j] = steps[first + j].x, r[j] = steps[first + j].r;
+    search_distance_map8(map, x, r, count, options, &found[first]);
+  }
+  return found;
+}
+
+}  // namespace
+
 CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const ReflectorMaps& maps,
                                    const RefractorImpostors* impostors, const CausticPhotonOptions& opt) {
   if (opt.photon_res < 1 || opt.photon_res > 4096)
@@ -412,13 +436,9 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
         std::vector<std::uint8_t> hops(n, 0);   // of which into other generators
         const CubeMap* impostor = impostors ? impostors->for_object(object) : nullptr;
         ex.parallel_for("caustic_photons", n, 256, [&](std::size_t b, std::size_t e) {
-          // Each texel's photon up to its receiver, then the receivers (their first searches
-          // side by side), in texel order.
-          struct Pending {
-            std::uint32_t i;
-            glm::vec3 x, r, flux;
-          };
-          std::vector<Pending> pending;
+          // Each texel's photon up to a mirror's self-searches or its receiver, then those
+          // searches, the first of each photon side by side with others' (in texel order).
+          std::vector<PhotonStep> pending, mirrored;
           for (std::size_t i = b; i < e; ++i) {
             if (gb.object.pixels[i] != object) continue;
             const SurfaceParams& s = gb.surface[i];
@@ -461,48 +481,53 @@ CausticPhotons trace_photon_images(par::Executor& ex, const Scene& scene, const 
               flux *= specular_reflectance(s, -glm::dot(n1, v));
               x = p1;
               r = reflect(v, n1);
-              // A concave mirror (a ring, a bowl) meets itself again: the ray searched in the
-              // mirror's own distance impostor. A crossing is the next reflection when it is
-              // bracketed, lies on the stored surface (within 2 %: a bracket from an empty
-              // direction into one behind the surface is none), beyond a twentieth of the
-              // mirror's radius, and before the receiver the environment search brackets;
-              // up to `chain` of them. A photon still meeting the mirror after those is
-              // dropped (its receiver would be behind the mirror: a light leak).
-              bool lost = false;
-              while (impostor) {
-                const DistanceSearchResult self = search_distance_map(*impostor, x, r, opt.exit_search);
-                if (!self.bracketed || !(self.d > 0.05f * sphere.radius)) break;
-                const glm::vec3 on = x + r * self.d - impostor->centre;
-                const float surface = impostor->distance_towards(on);
-                if (!(std::fabs(glm::length(on) - surface) <= 0.02f * surface)) break;
-                const DistanceSearchResult before = search_distance_map(env, x, r, opt.receiver_search);
-                if (before.bracketed && before.d < self.d) break;
-                if (chain[i] == opt.chain) {
-                  state[i] = 4;
-                  lost = true;
-                  break;
-                }
-                ++chain[i];
-                x += r * self.d;
-                glm::vec3 nm(impostor->colour_towards(self.direction));
-                nm = glm::dot(nm, nm) > 0.0f ? glm::normalize(nm) : glm::normalize(x - impostor->centre);
-                if (glm::dot(nm, r) > 0.0f) nm = -nm;
-                flux *= specular_reflectance(s, -glm::dot(nm, r));
-                r = glm::normalize(reflect(r, nm));
+              if (impostor) {  // its self-searches below, the first side by side with others'
+                mirrored.push_back({static_cast<std::uint32_t>(i), x, r, flux});
+                continue;
               }
-              if (lost) continue;
             }
             pending.push_back({static_cast<std::uint32_t>(i), x, r, flux});
           }
-          // The receivers' first searches, in the generator's distance map, eight at a time
-          // (search_distance_map8: each the bits of the search alone).
-          std::vector<DistanceSearchResult> receiver(pending.size());
-          for (std::size_t first = 0; first < pending.size(); first += 8) {
-            const int count = static_cast<int>(std::min<std::size_t>(8, pending.size() - first));
-            glm::vec3 xs[8], rs[8];
-            for (int j = 0; j < count; ++j) xs[j] = pending[first + j].x, rs[j] = pending[first + j].r;
-            search_distance_map8(env, xs, rs, count, opt.receiver_search, &receiver[first]);
+          // A concave mirror (a ring, a bowl) meets itself again: the ray searched in the
+          // mirror's own distance impostor. A crossing is the next reflection when it is
+          // bracketed, lies on the stored surface (within 2 %: a bracket from an empty
+          // direction into one behind the surface is none), beyond a twentieth of the
+          // mirror's radius, and before the receiver the environment search brackets;
+          // up to `chain` of them. A photon still meeting the mirror after those is
+          // dropped (its receiver would be behind the mirror: a light leak).
+          const std::vector<DistanceSearchResult> self_first =
+              impostor ? first_searches(*impostor, mirrored, opt.exit_search) : std::vector<DistanceSearchResult>{};
+          for (std::size_t q = 0; q < mirrored.size(); ++q) {
+            const std::size_t i = mirrored[q].i;
+            const SurfaceParams& s = gb.surface[i];
+            glm::vec3 x = mirrored[q].x, r = mirrored[q].r, flux = mirrored[q].flux;
+            bool lost = false;
+            for (bool first = true;; first = false) {
+              const DistanceSearchResult self = first ? self_first[q] : search_distance_map(*impostor, x, r, opt.exit_search);
+              if (!self.bracketed || !(self.d > 0.05f * sphere.radius)) break;
+              const glm::vec3 on = x + r * self.d - impostor->centre;
+              const float surface = impostor->distance_towards(on);
+              if (!(std::fabs(glm::length(on) - surface) <= 0.02f * surface)) break;
+              const DistanceSearchResult before = search_distance_map(env, x, r, opt.receiver_search);
+              if (before.bracketed && before.d < self.d) break;
+              if (chain[i] == opt.chain) {
+                state[i] = 4;
+                lost = true;
+                break;
+              }
+              ++chain[i];
+              x += r * self.d;
+              glm::vec3 nm(impostor->colour_towards(self.direction));
+              nm = glm::dot(nm, nm) > 0.0f ? glm::normalize(nm) : glm::normalize(x - impostor->centre);
+              if (glm::dot(nm, r) > 0.0f) nm = -nm;
+              flux *= specular_reflectance(s, -glm::dot(nm, r));
+              r = glm::normalize(reflect(r, nm));
+            }
+            if (lost) continue;
+            pending.push_back({static_cast<std::uint32_t>(i), x, r, flux});
           }
+          // The receivers, their first searches in the generator's distance map side by side.
+          const std::vector<DistanceSearchResult> receiver = first_searches(env, pending, opt.receiver_search);
           for (std::size_t q = 0; q < pending.size(); ++q) {
             const std::size_t i = pending[q].i;
             glm::vec3 x = pending[q].x, r = pending[q].r, flux = pending[q].flux;
