@@ -94,13 +94,19 @@ struct MapTarget {
   CubeDirections& incident;
 };
 
-// Adds `flux` carried by a photon at distance `dist` from direction `wi` to texel (x, y).
-void deposit(MapTarget& t, int face, int x, int y, const glm::vec3& flux, float weight, float dist,
+// Adds `share` of a photon's flux, arriving from distance `dist` along direction `wi`, to a
+// texel's sums: flux and weight, weighted distance, weighted direction.
+void add_share(glm::vec4& colour, float& distance, glm::vec3& incident, const glm::vec3& flux, float share,
+               float dist, const glm::vec3& wi) {
+  colour += glm::vec4(flux * share, share);
+  distance += share * dist;
+  incident += share * wi;
+}
+
+// add_share at texel (x, y) of `face`.
+void deposit(MapTarget& t, int face, int x, int y, const glm::vec3& flux, float share, float dist,
              const glm::vec3& wi) {
-  glm::vec4& c = t.m.colour[face].at(x, y);
-  c += glm::vec4(flux, weight);
-  t.m.distance[face].at(x, y) += weight * dist;
-  t.incident[face].at(x, y) += weight * wi;
+  add_share(t.m.colour[face].at(x, y), t.m.distance[face].at(x, y), t.incident[face].at(x, y), flux, share, dist, wi);
 }
 
 // A tent kernel of `radius` texels about continuous pixel position c, clipped to the face:
@@ -198,8 +204,12 @@ void splat_rows(MapTarget& t, const PhotonSplat& sp, int row_begin, int row_end)
   alignas(32) float w[SplatKernel::kColumns], share[SplatKernel::kColumns];
   for (int y = std::max(k.y0, row_begin); y <= std::min(k.y1, row_end - 1); ++y) {
     k.row_weights(sp.c, y, sp.total, w, share);
-    for (int x = k.x0; x <= k.x1; ++x)
-      if (w[x - k.x0] > 0.0f) deposit(t, sp.c.face, x, y, flux * share[x - k.x0], share[x - k.x0], sp.dist, wi);
+    // add_share along the row, the three planes' row pointers found once.
+    glm::vec4* colour = &t.m.colour[sp.c.face].at(k.x0, y);
+    float* distance = &t.m.distance[sp.c.face].at(k.x0, y);
+    glm::vec3* incident = &t.incident[sp.c.face].at(k.x0, y);
+    for (int i = 0; i <= k.x1 - k.x0; ++i)
+      if (w[i] > 0.0f) add_share(colour[i], distance[i], incident[i], flux, share[i], sp.dist, wi);
   }
 }
 
@@ -258,7 +268,7 @@ void raster_triangle(MapTarget& t, int face, const glm::vec2 (&p)[3], const glm:
     scratch.assign(1, {std::clamp(static_cast<int>(g.x), 0, m.size - 1), std::clamp(static_cast<int>(g.y), 0, m.size - 1), 1.0f});
     total = 1.0f;
   }
-  for (const TexelShare& e : scratch) deposit(t, face, e.x, e.y, flux * (e.w / total), e.w / total, dist, wi);
+  for (const TexelShare& e : scratch) deposit(t, face, e.x, e.y, flux, e.w / total, dist, wi);
 }
 
 // A normalized 3×3 tent blur inside each face: every texel's flux goes to its in-face
