@@ -735,12 +735,6 @@ TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
   }
 }
 
-}  // namespace
-}  // namespace speculum::raster
-
-namespace speculum::raster {
-namespace {
-
 // The gather's lanes against each receiver gathered alone with the scalar operations: per
 // map in order, the distance test (tolerance plus the grazing slack), then Φ |cosα| / (Ω d²)
 // from the bilinear flux and the nearest texel's direction through shade_light. Every
@@ -798,12 +792,6 @@ TEST(Caustics, GatherGivesEachReceiverTheBitsOfAScalarOracle) {
   EXPECT_EQ(mismatched, 0u);
   EXPECT_GT(lit, 10000u);  // receivers lit by some map
 }
-
-}  // namespace
-}  // namespace speculum::raster
-
-namespace speculum::raster {
-namespace {
 
 // The splat store (photons listed per face, faces stored in bands of rows side by side, the
 // kernels' sums in lanes) against every photon splatted alone in image and texel order with
