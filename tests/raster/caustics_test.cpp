@@ -2,7 +2,8 @@
 // any splat radius or filter, a parallel slab under a directional light gives uniform
 // irradiance E (1 − F0)², an occluder between the generator and the receiver removes the
 // caustic (the distance check), the error against the light-traced reference falls as
-// photon_res grows, and the frame is the same for any thread count and lane width.
+// photon_res grows, the frame is the same for any thread count and lane width, and the
+// splat store and the gather's lanes give the bits of their scalar oracles.
 #include "raster/caustics.h"
 
 #include <algorithm>
