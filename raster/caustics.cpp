@@ -16,9 +16,9 @@
 #include "core/shading.h"
 #include "core/shading_lanes.h"
 #include "parallel/lanes.h"
+#include "raster/cube_bilinear_lanes.h"
 #include "raster/cube_coord_lanes.h"
 #include "raster/refraction_path.h"
-#include "raster/transpose8.h"
 #include "raster/visibility.h"
 
 namespace speculum::raster {
@@ -873,9 +873,9 @@ CausticMaps build_caustic_maps(par::Executor& executor, const Scene& scene, cons
 
 namespace {
 
-// Eight receivers' caustic light from one map's texels: the bilinear flux Φ of the texel
-// under each lane's coordinate, the nearest texel's mean photon direction wi and solid angle
-// Ω, for the lanes in `lit`.
+// Eight receivers' caustic light from one map's texels: the bilinear flux Φ at each lane's
+// coordinate (CubeMap::colour_at), the nearest texel's mean photon direction wi and solid
+// angle Ω, for the lanes in `lit`.
 struct CausticTexels8 {
   Vec3Lanes<8> flux, wi;
   par::Lanes<8>::f32 solid_angle;
@@ -884,42 +884,31 @@ struct CausticTexels8 {
 CausticTexels8 caustic_texels8(const CausticMaps& maps, std::size_t k, const CubeCoordLanes& cc,
                                const par::Lanes<8>::mask& lit) {
   using L = par::Lanes<8>;
+  using f32 = L::f32;
+  using i32 = L::i32;
   const CubeMap& m = maps.cubes[k];
-  const float last = static_cast<float>(m.size - 1);
-  static const glm::vec4 none(0.0f);  // the taps of lanes not lit
-  alignas(32) float tap[4][3][8], tx[8] = {}, ty[8] = {}, wi[3][8] = {}, u[8] = {}, v[8] = {};
-  const float* corner[4][8];
-  for (int j = 0; j < 8; ++j) {
-    for (int t = 0; t < 4; ++t) corner[t][j] = &none.x;
-    if (!lit[j]) continue;
-    // CubeMap::colour_at's taps and weights.
-    const ImageRGBA& img = m.colour[cc.face[j]];
-    const float fx = std::clamp(cc.x[j] - 0.5f, 0.0f, last), fy = std::clamp(cc.y[j] - 0.5f, 0.0f, last);
-    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-    const int x1 = std::min(x0 + 1, m.size - 1), y1 = std::min(y0 + 1, m.size - 1);
-    tx[j] = fx - static_cast<float>(x0), ty[j] = fy - static_cast<float>(y0);
-    corner[0][j] = &img.at(x0, y0).x, corner[1][j] = &img.at(x1, y0).x;
-    corner[2][j] = &img.at(x0, y1).x, corner[3][j] = &img.at(x1, y1).x;
-    const int x = std::clamp(static_cast<int>(cc.x[j]), 0, m.size - 1);
-    const int y = std::clamp(static_cast<int>(cc.y[j]), 0, m.size - 1);
-    const glm::vec3& w = maps.incident[k][cc.face[j]].at(x, y);
-    wi[0][j] = w.x, wi[1][j] = w.y, wi[2][j] = w.z;
-    u[j] = static_cast<float>(x), v[j] = static_cast<float>(y);
-  }
-  for (int t = 0; t < 4; ++t) detail::rgb_of_rgba8(corner[t], tap[t]);
+  // Lanes not lit read texel (0, 0) of face 0: valid coordinates, results dropped.
+  const CubeCoordLanes at{L::select(lit, cc.face, i32(0)), L::select(lit, cc.x, f32(0.0f)),
+                          L::select(lit, cc.y, f32(0.0f))};
   CausticTexels8 out;
-  const L::f32 wx = L::load_aligned(tx), wy = L::load_aligned(ty);
-  const L::f32 one_x = 1.0f - wx, one_y = 1.0f - wy;
-  L::f32 flux[3];
-  for (int c = 0; c < 3; ++c)
-    flux[c] = (L::load_aligned(tap[0][c]) * one_x + L::load_aligned(tap[1][c]) * wx) * one_y +
-              (L::load_aligned(tap[2][c]) * one_x + L::load_aligned(tap[3][c]) * wx) * wy;
+  f32 flux[3];
+  bilinear_rgb8(RgbaFaces(m.colour), at, flux);
   out.flux = {flux[0], flux[1], flux[2]};
+  // The nearest texel (distance_at's).
+  const i32 last(m.size - 1), zero(0);
+  const i32 x = L::clamp(L::to_int(at.x), zero, last), y = L::clamp(L::to_int(at.y), zero, last);
+  alignas(32) std::int32_t face[8], px[8], py[8];
+  L::store_aligned(at.face, face), L::store_aligned(x, px), L::store_aligned(y, py);
+  alignas(32) float wi[3][8];
+  for (int j = 0; j < 8; ++j) {
+    const glm::vec3& w = maps.incident[k][face[j]].at(px[j], py[j]);
+    wi[0][j] = w.x, wi[1][j] = w.y, wi[2][j] = w.z;
+  }
   out.wi = {L::load_aligned(wi[0]), L::load_aligned(wi[1]), L::load_aligned(wi[2])};
   // cube_texel_solid_angle(x, y, size).
   const float size = static_cast<float>(m.size);
-  const L::f32 su = 2.0f * (L::load_aligned(u) + 0.5f) / size - 1.0f, sv = 2.0f * (L::load_aligned(v) + 0.5f) / size - 1.0f;
-  const L::f32 q = 1.0f + su * su + sv * sv;
+  const f32 su = 2.0f * (L::to_float(x) + 0.5f) / size - 1.0f, sv = 2.0f * (L::to_float(y) + 0.5f) / size - 1.0f;
+  const f32 q = 1.0f + su * su + sv * sv;
   out.solid_angle = (2.0f / size) * (2.0f / size) / (q * L::sqrt(q));
   return out;
 }

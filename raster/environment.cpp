@@ -13,8 +13,8 @@
 #include "core/sampling.h"
 #include "core/shading.h"
 #include "parallel/lanes.h"
+#include "raster/cube_bilinear_lanes.h"
 #include "raster/cube_coord_lanes.h"
-#include "raster/transpose8.h"
 
 namespace speculum::raster {
 namespace {
@@ -68,48 +68,12 @@ glm::vec3 prefilter_texel(const std::array<ImageRGBA, kCubeFaces>& previous, int
   return sum;
 }
 
-// One level's six faces as lookup_level8 reads them: its side and each face's first float.
-struct LevelFaces {
-  int side;
-  const float* pixels[kCubeFaces];
-  explicit LevelFaces(const std::array<ImageRGBA, kCubeFaces>& level) : side(level[0].width) {
-    for (int f = 0; f < kCubeFaces; ++f) pixels[f] = &level[f].pixels[0].x;
-  }
-};
-
 // lookup_level for eight directions at once (d: lanes of x, y, z): per lane the operations
-// of lookup_level in its order (cube_coord8 is cube_coord per lane; then bilinear_face's
-// clamp, taps and weights), so every lane has the bits of the scalar call. out: r, g, b.
-[[gnu::always_inline]] inline void lookup_level8(const LevelFaces& level, const par::Lanes<8>::f32 (&d)[3],
+// of lookup_level in its order (cube_coord8 is cube_coord per lane; bilinear_rgb8 is
+// bilinear_face per lane), so every lane has the bits of the scalar call. out: r, g, b.
+[[gnu::always_inline]] inline void lookup_level8(const RgbaFaces& level, const par::Lanes<8>::f32 (&d)[3],
                                                  par::Lanes<8>::f32 (&out)[3]) {
-  using L = par::Lanes<8>;
-  using f32 = L::f32;
-  using i32 = L::i32;
-  const int side = level.side;
-  const float last = static_cast<float>(side - 1);
-  const CubeCoordLanes cc = cube_coord8(d, side);
-  const i32& fi = cc.face;
-  const f32 &px = cc.x, &py = cc.y;
-  // bilinear_face
-  const f32 fx = L::clamp(px - 0.5f, f32(0.0f), f32(last)), fy = L::clamp(py - 0.5f, f32(0.0f), f32(last));
-  const i32 x0 = L::to_int(fx), y0 = L::to_int(fy);
-  const i32 x1 = L::min(x0 + 1, i32(side - 1)), y1 = L::min(y0 + 1, i32(side - 1));
-  const f32 tx = fx - L::to_float(x0), ty = fy - L::to_float(y0);
-  const f32 wx = 1.0f - tx, wy = 1.0f - ty;
-  const i32 row0 = y0 * side, row1 = y1 * side;
-  const i32 taps[4] = {(row0 + x0) * 4, (row0 + x1) * 4, (row1 + x0) * 4, (row1 + x1) * 4};
-  const float* const* pixels = level.pixels;
-  // Each lane's tap texel loaded as one RGBA row and transposed into channels.
-  alignas(32) float channel[4][3][8];  // [tap][channel][lane]
-  for (int q = 0; q < 4; ++q) {
-    const float* texel[8];
-    for (int j = 0; j < 8; ++j) texel[j] = pixels[fi[j]] + taps[q][j];
-    detail::rgb_of_rgba8(texel, channel[q]);
-  }
-  for (int c = 0; c < 3; ++c) {
-    const auto tap = [&](int q) { return L::load_aligned(channel[q][c]); };
-    out[c] = (tap(0) * wx + tap(1) * tx) * wy + (tap(2) * wx + tap(3) * tx) * ty;
-  }
+  bilinear_rgb8(level, cube_coord8(d, level.side), out);
 }
 
 // Eight texels of one face at once, lane j = texel first + j: per lane the operations of
@@ -128,7 +92,7 @@ void prefilter_texels8(const std::array<ImageRGBA, kCubeFaces>& previous, int fa
   }
   f32 tv[3], bv[3], nv[3];
   for (int c = 0; c < 3; ++c) tv[c] = L::load(t[c]), bv[c] = L::load(b[c]), nv[c] = L::load(n[c]);
-  const LevelFaces faces(previous);
+  const RgbaFaces faces(previous);
   f32 sum[3] = {f32(0.0f), f32(0.0f), f32(0.0f)};
   for (int k = 0; k < count; ++k) {
     f32 d[3], texel[3];
@@ -344,12 +308,12 @@ void EnvironmentMap::radiance8(const glm::vec3* d, const float* phong_exponent, 
     f32 dv[3];
     for (int c = 0; c < 3; ++c) dv[c] = L::load_aligned(dir[c]);
     f32 a[3];
-    lookup_level8(LevelFaces(levels[l0]), dv, a);
+    lookup_level8(RgbaFaces(levels[l0]), dv, a);
     const f32 t = L::load_aligned(from_l0);
     const L::mask blend = t > 0.0f;
     if (L::any(blend)) {
       f32 b[3];
-      lookup_level8(LevelFaces(levels[std::min(l0 + 1, last)]), dv, b);
+      lookup_level8(RgbaFaces(levels[std::min(l0 + 1, last)]), dv, b);
       for (int c = 0; c < 3; ++c) a[c] = L::select(blend, a[c] * (1.0f - t) + b[c] * t, a[c]);
     }
     for (int j = first; j < count; ++j)
