@@ -16,12 +16,20 @@ using L = par::Lanes<8>;
 using f32 = L::f32;
 using i32 = L::i32;
 
+// A cube's six distance faces: each face's first texel.
+struct DistanceFaces {
+  const float* pixels[kCubeFaces];
+  explicit DistanceFaces(const CubeMap& map) {
+    for (int f = 0; f < kCubeFaces; ++f) pixels[f] = map.distance[f].pixels.data();
+  }
+};
+
 // ratio() for eight points l = x + r d at once (x and r per lane), each lane with its
 // operations in their order (l, |l|, cube_coord, the nearest texel's distance, |l| / stored
 // or 0 where the map is empty), so the same bits; lanes outside `wanted` read nothing. The
 // lanes that read the map (what ratio() counts) in `reads`.
-[[gnu::always_inline]] inline f32 ratio8(const CubeMap& map, const f32 (&x)[3], const f32 (&r)[3], const f32& d,
-                                         const L::mask& wanted, L::mask& reads) {
+[[gnu::always_inline]] inline f32 ratio8(const CubeMap& map, const DistanceFaces& faces, const f32 (&x)[3],
+                                         const f32 (&r)[3], const f32& d, const L::mask& wanted, L::mask& reads) {
   const f32 l[3] = {x[0] + r[0] * d, x[1] + r[1] * d, x[2] + r[2] * d};
   const f32 len = L::sqrt((l[0] * l[0] + l[1] * l[1]) + l[2] * l[2]);
   reads = !(len <= 0.0f) && wanted;
@@ -32,10 +40,10 @@ using i32 = L::i32;
   const f32 at_x = L::select(reads, c.x, f32(0.0f)), at_y = L::select(reads, c.y, f32(0.0f));
   const i32 tx = L::clamp(L::to_int(at_x), zero, last), ty = L::clamp(L::to_int(at_y), zero, last);
   const i32 face = L::select(reads, c.face, zero);
-  alignas(32) std::int32_t fx[8], px[8], py[8];
-  L::store_aligned(face, fx), L::store_aligned(tx, px), L::store_aligned(ty, py);
+  alignas(32) std::int32_t fx[8], texel[8];
+  L::store_aligned(face, fx), L::store_aligned(ty * i32(map.size) + tx, texel);
   alignas(32) float stored_at[8];
-  for (int j = 0; j < 8; ++j) stored_at[j] = map.distance[fx[j]].at(px[j], py[j]);
+  for (int j = 0; j < 8; ++j) stored_at[j] = faces.pixels[fx[j]][texel[j]];
   const f32 stored = L::load_aligned(stored_at);
   const f32 g = L::select(L::abs(stored) == std::numeric_limits<float>::infinity(), f32(0.0f), len / stored);
   return L::select(reads, g, f32(0.0f));
@@ -45,16 +53,36 @@ using i32 = L::i32;
 // march's parameter and of ratio() in their order, so the same bits.
 struct CubeMarch {
   const CubeMap& map;
+  DistanceFaces faces;
+  explicit CubeMarch(const CubeMap& m) : map(m), faces(m) {}
   void operator()(const glm::vec3& x, const glm::vec3& r, float x_len, int n, int first, MarchBatch& b) const {
     const i32 k = L::iota(first);
     const f32 t = L::to_float(k) / float(n);
     const f32 d = L::select(k == 0, f32(0.0f), x_len * t / (1.0f - t));
     const f32 xs[3] = {f32(x.x), f32(x.y), f32(x.z)}, rs[3] = {f32(r.x), f32(r.y), f32(r.z)};
     L::mask reads;
-    const f32 g = ratio8(map, xs, rs, d, L::mask(k < n), reads);
+    const f32 g = ratio8(map, faces, xs, rs, d, L::mask(k < n), reads);
     L::store(g, b.g);
     L::store(d, b.d);
     L::store(L::select(reads, i32(1), i32(0)), b.counted);
+  }
+  // The same batch of two marches (a and b) at once: two independent chains of work side by
+  // side, each with its own operations.
+  void pair(const glm::vec3& xa, const glm::vec3& ra, float xa_len, const glm::vec3& xb, const glm::vec3& rb,
+            float xb_len, int n, int first, MarchBatch& a, MarchBatch& b) const {
+    const i32 k = L::iota(first);
+    const f32 t = L::to_float(k) / float(n);
+    const f32 da = L::select(k == 0, f32(0.0f), xa_len * t / (1.0f - t));
+    const f32 db = L::select(k == 0, f32(0.0f), xb_len * t / (1.0f - t));
+    const f32 xas[3] = {f32(xa.x), f32(xa.y), f32(xa.z)}, ras[3] = {f32(ra.x), f32(ra.y), f32(ra.z)};
+    const f32 xbs[3] = {f32(xb.x), f32(xb.y), f32(xb.z)}, rbs[3] = {f32(rb.x), f32(rb.y), f32(rb.z)};
+    L::mask reads_a, reads_b;
+    const f32 ga = ratio8(map, faces, xas, ras, da, L::mask(k < n), reads_a);
+    const f32 gb = ratio8(map, faces, xbs, rbs, db, L::mask(k < n), reads_b);
+    L::store(ga, a.g), L::store(gb, b.g);
+    L::store(da, a.d), L::store(db, b.d);
+    L::store(L::select(reads_a, i32(1), i32(0)), a.counted);
+    L::store(L::select(reads_b, i32(1), i32(0)), b.counted);
   }
 };
 
@@ -79,6 +107,7 @@ void refine_brackets8(const CubeMap& map, const glm::vec3* x, const glm::vec3* r
   alignas(32) std::int32_t bits[8];
   for (int j = 0; j < 8; ++j) bits[j] = (pending >> j) & 1u ? -1 : 0;
   L::mask active = L::load_aligned(bits) != i32(0);
+  const DistanceFaces faces(map);
   f32 best = d_p;
   i32 lookups(0);
   const f32 inf(std::numeric_limits<float>::infinity());
@@ -89,7 +118,7 @@ void refine_brackets8(const CubeMap& map, const glm::vec3* x, const glm::vec3* r
     const f32 d_new = L::select(degenerate, d_l, d_l + (d_p - d_l) * (1.0f - g_l) / denom);
     best = L::select(active, d_new, best);
     L::mask reads;
-    const f32 g_new = ratio8(map, xs, rs, d_new, active, reads);
+    const f32 g_new = ratio8(map, faces, xs, rs, d_new, active, reads);
     lookups = lookups + L::select(reads, i32(1), i32(0));
     const L::mask under = active && g_new < 1.0f, over = active && !(g_new < 1.0f);
     d_l = L::select(under, d_new, d_l), g_l = L::select(under, g_new, g_l);
@@ -126,19 +155,48 @@ void search_distance_map8(const CubeMap& map, const glm::vec3* x_world, const gl
   }
   const auto towards = [&](const glm::vec3& d) { return map.distance_towards(d); };
   glm::vec3 x[8];
+  float x_len[8];
   Bracket b[8];
-  unsigned pending = 0;
+  MarchState state[8];
+  unsigned marching = 0;
   for (int j = 0; j < count; ++j) {
     x[j] = x_world[j] - map.centre;
-    const float x_len = glm::length(x[j]);
-    if (x_len == 0.0f) {  // a direct lookup (search_distance)
+    x_len[j] = glm::length(x[j]);
+    if (x_len[j] == 0.0f) {  // a direct lookup (search_distance)
       out[j] = search_distance_map(map, x_world[j], r[j], options);
       continue;
     }
     out[j] = {};
-    b[j] = march_to_bracket(CubeMarch{map}, x[j], r[j], x_len, options.linear_steps, out[j].lookups);
+    marching |= 1u << j;
+  }
+  // The marches batch by batch: each batch of every search still marching is computed before
+  // any is scanned (independent work side by side, no branch on a scan between them), each
+  // search's batches and scans in its own order, so the same results as march_to_bracket.
+  const int n = options.linear_steps;
+  MarchBatch batch[8];
+  const CubeMarch marcher(map);
+  for (int first = 0; first < n && marching; first += kMarchBatch) {
+    for (unsigned m = marching; m;) {
+      const int j = std::countr_zero(m);
+      m &= m - 1;
+      if (!m) {
+        marcher(x[j], r[j], x_len[j], n, first, batch[j]);
+        break;
+      }
+      const int i = std::countr_zero(m);
+      m &= m - 1;
+      marcher.pair(x[j], r[j], x_len[j], x[i], r[i], x_len[i], n, first, batch[j], batch[i]);
+    }
+    for (unsigned m = marching; m; m &= m - 1) {
+      const int j = std::countr_zero(m);
+      scan_batch(batch[j], first, n, state[j], out[j].lookups, b[j]);
+      if (state[j].ended) marching &= ~(1u << j);
+    }
+  }
+  unsigned pending = 0;
+  for (int j = 0; j < count; ++j) {
     if (b[j].found) pending |= 1u << j;
-    else search_unbracketed(towards, x[j], r[j], options, out[j]);
+    else if (x_len[j] != 0.0f) search_unbracketed(towards, x[j], r[j], options, out[j]);
   }
   if (pending) refine_brackets8(map, x, r, b, pending, options, out);
 }

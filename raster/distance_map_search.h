@@ -118,26 +118,46 @@ struct Bracket {
   float d_p = 0.0f, g_p = 0.0f;  // overshoot
 };
 
+// Where a linear march stands between batches: the last sample scanned (d, ratio), and
+// whether the march has ended (a bracket found, or every sample scanned).
+struct MarchState {
+  float d_prev = 0.0f, g_prev = 0.0f;
+  bool ended = false;
+};
+
+// Scans batch `b` (samples first .. min(first + kMarchBatch, n) of a march of n) after `st`
+// for the first undershoot → overshoot pair; adds to `lookups` those of the samples up to
+// it. Ends the march at a bracket (returned in `out`) or at the last sample.
+inline void scan_batch(const MarchBatch& b, int first, int n, MarchState& st, int& lookups, Bracket& out) {
+  for (int k = first; k < std::min(first + kMarchBatch, n); ++k) {
+    const int j = k - first;
+    lookups += b.counted[j];
+    const float d = b.d[j], g = b.g[j];
+    if (k > 0 && st.g_prev < 1.0f && g >= 1.0f) {
+      out = {true, st.d_prev, st.g_prev, d, g};
+      st.ended = true;
+      return;
+    }
+    st.d_prev = d;
+    st.g_prev = g;
+  }
+  st.ended = first + kMarchBatch >= n;
+}
+
 // The linear march of n steps (§4.1.2) from x (|x| = x_len > 0) along r, `march` giving its
 // ratios a batch at a time (any batch is computed before it is scanned); adds to `lookups`
 // those of the samples up to the bracket.
 template <class March>
 Bracket march_to_bracket(const March& march, const glm::vec3& x, const glm::vec3& r, float x_len, int n,
                          int& lookups) {
-  float d_prev = 0.0f, g_prev = 0.0f;
+  MarchState st;
+  Bracket out;
   MarchBatch b;
-  for (int first = 0; first < n; first += kMarchBatch) {
+  for (int first = 0; first < n && !st.ended; first += kMarchBatch) {
     march(x, r, x_len, n, first, b);
-    for (int k = first; k < std::min(first + kMarchBatch, n); ++k) {
-      const int j = k - first;
-      lookups += b.counted[j];
-      const float d = b.d[j], g = b.g[j];
-      if (k > 0 && g_prev < 1.0f && g >= 1.0f) return {true, d_prev, g_prev, d, g};
-      d_prev = d;
-      g_prev = g;
-    }
+    scan_batch(b, first, n, st, lookups, out);
   }
-  return {};
+  return out;
 }
 
 // `secant_steps` regula-falsi steps inside the bracket (none: the overshooting sample).

@@ -1,8 +1,10 @@
 // Shading benchmarks: the per-sample kernels every feed-forward frame runs, on the
 // living-room scene at 640×480 from its main camera — the direct light of the camera's
 // G-buffer (three lights with filtered shadow maps, SH ambient, rough lobes' environment
-// lookups), and the glossy prefiltering cascade of one 256² reflector map (six random faces).
-// 1 and 2 threads. Counters: Msamples_s (shaded samples or prefiltered texels per second).
+// lookups), the glossy prefiltering cascade of one 256² reflector map (six random faces), and
+// the camera's distance-map searches (the distance-map technique's maps of every reflector).
+// 1 and 2 threads. Counters: Msamples_s (shaded samples or prefiltered texels per second),
+// Msearches_s.
 #include <benchmark/benchmark.h>
 
 #include <array>
@@ -10,8 +12,10 @@
 
 #include "core/procedural_scenes.h"
 #include "raster/direct_light.h"
+#include "raster/distance_map_reflect.h"
 #include "raster/environment.h"
 #include "raster/gbuffer.h"
+#include "raster/reflector_maps.h"
 #include "raster/shadow_map.h"
 #include "raster/visibility.h"
 
@@ -88,5 +92,21 @@ void BM_PrefilterCascade(benchmark::State& state) {
   state.counters["Msamples_s"] = benchmark::Counter(texels * double(state.iterations()) / 1e6, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_PrefilterCascade)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_DistanceMapSearch(benchmark::State& state) {
+  const LivingRoomView& v = living_room();
+  static const ReflectorMaps distances =
+      render_reflector_maps(executor(2), v.scene, {}, {}, 256, &v.gbuffer, ReflectorSelection::all, {}, nullptr,
+                            searched_distance_maps(true, true));
+  par::Executor& ex = executor(static_cast<int>(state.range(0)));
+  std::uint64_t searches = 0;
+  for (auto _ : state) {
+    const DistanceSearches found = distance_map_search(ex, v.gbuffer, distances, DistanceSearchOptions{}, nullptr);
+    searches += found.stats.searches;
+    benchmark::DoNotOptimize(found.found.data());
+  }
+  state.counters["Msearches_s"] = benchmark::Counter(double(searches) / 1e6, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DistanceMapSearch)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -4,9 +4,11 @@
 #include "raster/cube_map.h"
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -14,11 +16,46 @@
 #include "core/camera_rays.h"
 #include "core/sampling.h"
 #include "core/shading.h"
+#include "raster/cube_coord_lanes.h"
 #include "raster/environment.h"
 #include "raster_test_scenes.h"
 
 namespace speculum::raster {
 namespace {
+
+// cube_coord8 against cube_coord, bit for bit: directions on every face, along the axes, on
+// the edges and corners between faces (the ties of the largest component), with signed zeros,
+// and random ones, eight at a time in every arrangement of lanes.
+TEST(CubeCoordLanes, EightCoordinatesHaveTheBitsOfOneAtATime) {
+  std::vector<glm::vec3> dirs;
+  const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 0.3f, -0.7f};
+  for (const float x : values)
+    for (const float y : values)
+      for (const float z : values)
+        if (x != 0.0f || y != 0.0f || z != 0.0f) dirs.emplace_back(x, y, z);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> n(0.0f, 1.0f);
+  for (int k = 0; k < 4000; ++k) dirs.emplace_back(n(rng), n(rng), n(rng));
+  for (const int size : {1, 7, 256}) {
+    for (std::size_t i = 0; i + 8 <= dirs.size(); i += 3) {
+      using L = par::Lanes<8>;
+      alignas(32) float in[3][8];
+      for (int j = 0; j < 8; ++j)
+        for (int c = 0; c < 3; ++c) in[c][j] = dirs[i + j][c];
+      const L::f32 d[3] = {L::load_aligned(in[0]), L::load_aligned(in[1]), L::load_aligned(in[2])};
+      const CubeCoordLanes lanes = cube_coord8(d, size);
+      alignas(32) std::int32_t face[8];
+      alignas(32) float x[8], y[8];
+      L::store_aligned(lanes.face, face), L::store_aligned(lanes.x, x), L::store_aligned(lanes.y, y);
+      for (int j = 0; j < 8; ++j) {
+        const CubeCoord one = cube_coord(dirs[i + j], size);
+        ASSERT_EQ(face[j], one.face) << i + j;
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(x[j]), std::bit_cast<std::uint32_t>(one.pixel.x)) << i + j;
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(y[j]), std::bit_cast<std::uint32_t>(one.pixel.y)) << i + j;
+      }
+    }
+  }
+}
 
 TEST(CubeMapFaces, DirectionAndCoordinateRoundTrip) {
   const int size = 32;
