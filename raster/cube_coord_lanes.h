@@ -20,30 +20,28 @@ struct CubeCoordLanes {
 
 namespace detail {
 
-// kCubeFaceAxes as cube_coord8 reads it: each face's axis signs in lanes 0..5 of a register,
-// and the axes each pair of faces 2k, 2k + 1 shares (both look along axis k, the axis
-// cube_coord picks them by).
-struct CubeFaceLanes {
-  __m256 forward_sign, right_sign, up_sign;
-  int forward[3], right[3], up[3];
-  CubeFaceLanes() {
+// The axes of cube_coord's faces (kCubeFaceAxes): faces 2k and 2k + 1 look along axis k; a
+// face's right axis is z on the x faces and x on the others, its up axis z on the y faces and
+// y on the others. Checked against the table once; each face's signs in lanes 0..5 of a
+// register.
+constexpr int kRightAxis[3] = {2, 0, 0}, kUpAxis[3] = {1, 2, 1};
+struct CubeFaceSigns {
+  __m256 forward, right, up;
+  CubeFaceSigns() {
     alignas(32) float signs[3][8] = {};
     for (int f = 0; f < kCubeFaces; ++f) {
       const CubeFaceAxes& a = kCubeFaceAxes[f];
+      if (a.forward != f / 2 || a.right != kRightAxis[f / 2] || a.up != kUpAxis[f / 2])
+        throw std::logic_error("cube_coord8: the cube faces' axes are not the ones it was written for");
       signs[0][f] = a.forward_sign, signs[1][f] = a.right_sign, signs[2][f] = a.up_sign;
-      const CubeFaceAxes& pair = kCubeFaceAxes[f & ~1];
-      if (a.forward != f / 2 || a.right != pair.right || a.up != pair.up)
-        throw std::logic_error("cube faces 2k and 2k+1 must look along axis k and share their right and up axes");
     }
-    forward_sign = _mm256_load_ps(signs[0]), right_sign = _mm256_load_ps(signs[1]), up_sign = _mm256_load_ps(signs[2]);
-    for (int k = 0; k < 3; ++k)
-      forward[k] = kCubeFaceAxes[2 * k].forward, right[k] = kCubeFaceAxes[2 * k].right, up[k] = kCubeFaceAxes[2 * k].up;
+    forward = _mm256_load_ps(signs[0]), right = _mm256_load_ps(signs[1]), up = _mm256_load_ps(signs[2]);
   }
 };
 
-inline const CubeFaceLanes& cube_face_lanes() {
-  static const CubeFaceLanes lanes;
-  return lanes;
+inline const CubeFaceSigns& cube_face_signs() {
+  static const CubeFaceSigns signs;
+  return signs;
 }
 
 }  // namespace detail
@@ -58,15 +56,14 @@ inline const CubeFaceLanes& cube_face_lanes() {
   const f32 major = L::select(is_x, d[0], L::select(is_y, d[1], d[2]));
   i32 face = L::select(is_x, i32(0), L::select(is_y, i32(2), i32(4)));
   face = L::select(!(major >= 0.0f), face + 1, face);
-  // Each lane's face's signed components: the component its pair of faces reads, times the
-  // face's sign (cube_coord's product: a.forward_sign * d[a.forward] and so on).
-  const detail::CubeFaceLanes& axes = detail::cube_face_lanes();
-  const auto along = [&](const int (&axis)[3], __m256 sign) {
-    const f32 component = L::select(is_x, d[axis[0]], L::select(is_y, d[axis[1]], d[axis[2]]));
-    return f32(_mm256_permutevar8x32_ps(sign, static_cast<__m256i>(face))) * component;
-  };
-  const f32 depth = along(axes.forward, axes.forward_sign);
-  const f32 along_right = along(axes.right, axes.right_sign), along_up = along(axes.up, axes.up_sign);
+  // Each lane's face's signed components (cube_coord's a.forward_sign * d[a.forward] and so
+  // on): the face's sign times the component its axis names.
+  const detail::CubeFaceSigns& signs = detail::cube_face_signs();
+  const auto sign = [&](__m256 of_face) { return f32(_mm256_permutevar8x32_ps(of_face, static_cast<__m256i>(face))); };
+  static_assert(detail::kRightAxis[1] == 0 && detail::kRightAxis[2] == 0 && detail::kUpAxis[0] == detail::kUpAxis[2]);
+  const f32 depth = sign(signs.forward) * major;
+  const f32 along_right = sign(signs.right) * L::select(is_x, d[detail::kRightAxis[0]], d[0]);
+  const f32 along_up = sign(signs.up) * L::select(is_y, d[detail::kUpAxis[1]], d[detail::kUpAxis[0]]);
   const float s = static_cast<float>(size);
   return {face, L::clamp((along_right / depth + 1.0f) * 0.5f * s, f32(0.0f), f32(s)),
           L::clamp((1.0f - along_up / depth) * 0.5f * s, f32(0.0f), f32(s))};
