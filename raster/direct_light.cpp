@@ -98,18 +98,9 @@ void SurfaceShader::shade8(const SurfaceParams* const* s, const glm::vec3* p, co
     // The points this light reaches, in point order, and their shadow tests in one call.
     alignas(32) float lit[8] = {};
     if (k < shadows_->size()) {
-      glm::vec3 all_l[8], lit_p[8], lit_n[8], lit_l[8];
-      l.store(all_l, 8);
-      int lane[8], reached_count = 0;
-      for (int j = 0; j < count; ++j)
-        if (reached[j]) {
-          lane[reached_count] = j;
-          lit_p[reached_count] = p[j], lit_n[reached_count] = n[j], lit_l[reached_count] = all_l[j];
-          ++reached_count;
-        }
-      float packed[8];
-      (*shadows_)[k].visibility8(lit_p, lit_n, lit_l, reached_count, packed);
-      for (int t = 0; t < reached_count; ++t) lit[lane[t]] = packed[t];
+      unsigned lanes = 0;
+      for (int j = 0; j < count; ++j) lanes |= reached[j] ? 1u << j : 0u;
+      (*shadows_)[k].visibility_lanes(pv, nv, l, lanes, lit);
     } else {
       for (int j = 0; j < count; ++j) lit[j] = reached[j] ? 1.0f : 0.0f;
     }

@@ -32,7 +32,7 @@ class SurfaceShader {
   SurfaceShader(const Scene& scene, const std::vector<ShadowMap>& shadows, const EnvironmentMap& env);
   glm::vec3 operator()(const SurfaceParams& s, const glm::vec3& p, glm::vec3 n, const glm::vec3& v) const;
   // The same for `count` (1..8) points, out[j] for s[j], p[j], n[j], v[j]: each light's
-  // shadow tests of the points it reaches in one ShadowMap::visibility8 call.
+  // shadow tests of the points it reaches in one ShadowMap::visibility_lanes call.
   void shade8(const SurfaceParams* const* s, const glm::vec3* p, const glm::vec3* n, const glm::vec3* v, int count,
               glm::vec3* out) const;
   // The samples i in [begin, end) of `g` with wanted(i): each covered one shaded (eight at a

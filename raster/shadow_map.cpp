@@ -4,7 +4,9 @@
 #include "raster/shadow_map.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <glm/geometric.hpp>
@@ -163,22 +165,36 @@ void ShadowMap::visibility8(const glm::vec3* p, const glm::vec3* n, const glm::v
   for (int j = 0; j < count; ++j) out[j] = filtered(t[j]);
 }
 
-void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const {
-  if (type == LightType::Directional) {
-    for (int j = 0; j < count; ++j) out[j] = taps(p[j], n[j], l[j]);
-    return;
+void ShadowMap::visibility_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes,
+                                 float* out) const {
+  Taps t[8];
+  taps_lanes(p, n, l, lanes, t);
+  for (unsigned m = lanes; m; m &= m - 1) {
+    const int j = std::countr_zero(m);
+    out[j] = filtered(t[j]);
   }
+}
+
+void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const {
+  using V = Vec3Lanes<8>;
+  taps_lanes(V::load(p, count), V::load(n, count), V::load(l, count), (1u << count) - 1u, out);
+}
+
+void ShadowMap::taps_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes,
+                           Taps* out) const {
   using L = par::Lanes<8>;
   using f32 = L::f32;
   using i32 = L::i32;
-  // Lanes past `count` repeat point 0: valid inputs, their results dropped.
-  alignas(32) float in[9][8];
-  for (int j = 0; j < 8; ++j) {
-    const int k = j < count ? j : 0;
-    for (int c = 0; c < 3; ++c) in[c][j] = p[k][c], in[3 + c][j] = n[k][c], in[6 + c][j] = l[k][c];
+  if (type == LightType::Directional) {
+    glm::vec3 ps[8], ns[8], ls[8];
+    p.store(ps, 8), n.store(ns, 8), l.store(ls, 8);
+    for (unsigned m = lanes; m; m &= m - 1) {
+      const int j = std::countr_zero(m);
+      out[j] = taps(ps[j], ns[j], ls[j]);
+    }
+    return;
   }
-  f32 pv[3], nv[3], lv[3];
-  for (int c = 0; c < 3; ++c) pv[c] = L::load(in[c]), nv[c] = L::load(in[3 + c]), lv[c] = L::load(in[6 + c]);
+  const f32 pv[3] = {p.x, p.y, p.z}, nv[3] = {n.x, n.y, n.z}, lv[3] = {l.x, l.y, l.z};
   // glm's dot of two vec3 is (x·x' + y·y') + z·z', and length is the root of the dot.
   const auto dot = [](const f32* a, const f32* b) { return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]; };
   const glm::vec3 eye = cube.centre;
@@ -193,12 +209,16 @@ void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l
   for (int c = 0; c < 3; ++c) d[c] = (pv[c] + nv[c] * q) - eye[c];
   const f32 dist = L::sqrt(dot(d, d));
   const CubeCoordLanes c = cube_coord8(d, cube.size);
-  const L::i32& face = c.face;
-  const f32 &px = c.x, &py = c.y;
   const f32 biased = dist - kDepthBias * footprint;
-  const i32 cx = L::min(L::to_int(px), i32(size - 1)), cy = L::min(L::to_int(py), i32(size - 1));
-  for (int j = 0; j < count; ++j)
-    out[j] = dist[j] <= 0.0f ? Taps{} : Taps{&cube.distance[face[j]], cx[j], cy[j], biased[j]};
+  const i32 cx = L::min(L::to_int(c.x), i32(size - 1)), cy = L::min(L::to_int(c.y), i32(size - 1));
+  alignas(32) float dist_at[8], biased_at[8];
+  alignas(32) std::int32_t face_at[8], cx_at[8], cy_at[8];
+  L::store_aligned(dist, dist_at), L::store_aligned(biased, biased_at);
+  L::store_aligned(c.face, face_at), L::store_aligned(cx, cx_at), L::store_aligned(cy, cy_at);
+  for (unsigned m = lanes; m; m &= m - 1) {
+    const int j = std::countr_zero(m);
+    out[j] = dist_at[j] <= 0.0f ? Taps{} : Taps{&cube.distance[face_at[j]], cx_at[j], cy_at[j], biased_at[j]};
+  }
 }
 
 ShadowMaps ShadowMapPass::operator()(par::NodeContext& c) const {

@@ -9,6 +9,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/scene.h"
+#include "core/vec3_lanes.h"
 #include "parallel/executor.h"
 #include "parallel/graph_node.h"
 #include "raster/cube_map.h"
@@ -34,6 +35,10 @@ struct ShadowMap {
   float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
   // The same for `count` (1..8) points at once, out[j] for p[j], n[j], l[j].
   void visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const;
+  // The same for the points of eight in lanes whose bit is set in `lanes`, into out[j] (the
+  // others' left as they were): what a kernel holding its points in lanes asks.
+  void visibility_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes,
+                        float* out) const;
 
   // Where visibility reads: the texel its 3×3 taps are centred on and the biased distance
   // they are compared with (img null: no tap, the point is lit).
@@ -47,6 +52,8 @@ struct ShadowMap {
   // arithmetic in lanes, with per lane the operations of taps in its order (the same bits);
   // a directional map's run one by one.
   void taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const;
+  // taps8 for the lanes whose bit is set in `lanes`, into out[j].
+  void taps_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes, Taps* out) const;
   // The fraction of the taps at least `biased` away.
   float filtered(const Taps& t) const;
 };
