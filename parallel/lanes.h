@@ -113,10 +113,15 @@ struct Lanes {
   static auto load_partial(const T* p, int count, T fill = T{}) {
     return simd<T>([&](auto i) { return int(i) < count ? p[i] : fill; });
   }
-  // base[index[lane]] for every lane (gather is free on the GPU model).
+  // base[index[lane]] for every lane (gather is free on the GPU model). The lanes go through
+  // memory: the generator constructor was left a call per gather.
   template <class T, class Index>
-  static auto gather(const T* base, const simd<Index>& index) {
-    return simd<T>([&](auto i) { return base[index[i]]; });
+  [[gnu::always_inline]] static auto gather(const T* base, const simd<Index>& index) {
+    alignas(64) Index at[W];
+    alignas(64) T out[W];
+    index.copy_to(at, stdx::element_aligned);
+    for (int i = 0; i < W; ++i) out[i] = base[at[i]];
+    return simd<T>(out, stdx::element_aligned);
   }
   // Gathers only active lanes (inactive indices may be out of range); others get `fill`.
   template <class T, class Index, class M>
