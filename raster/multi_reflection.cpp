@@ -1,7 +1,9 @@
 // Inter-object multiple reflections by rounds of cube-map re-rendering: see multi_reflection.h.
 #include "raster/multi_reflection.h"
 
+#include <algorithm>
 #include <utility>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -25,6 +27,23 @@ class ObjectsSwapped {
   GBuffer& g_;
   IdBuffer& object_;
 };
+
+// composite(direct, specular) of a specular image black (0, 0, 0, 1) but at texels
+// texel[j], where it holds seen[j]: the same sums, without that image.
+ImageRGBA composite_at(par::Executor& executor, const ImageRGBA& direct, const std::vector<std::uint32_t>& texel,
+                       const ImageRGBA& seen) {
+  ImageRGBA out(direct.width, direct.height);
+  executor.parallel_for("composite.add", out.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) out.pixels[i] = glm::vec4(glm::vec3(direct.pixels[i]) + glm::vec3(0.0f), 1.0f);
+  });
+  executor.parallel_for("composite.add_seen", texel.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::size_t i = texel[j];
+      out.pixels[i] = glm::vec4(glm::vec3(direct.pixels[i]) + glm::vec3(seen.pixels[j]), 1.0f);
+    }
+  });
+  return out;
+}
 
 }  // namespace
 
@@ -182,7 +201,7 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
     }
     shade_cube_faces(executor, scene, distances.cubes[m], kept_face_options(distances, m, depth_range, candidates),
                      [&](const GBuffer& g, const Camera&, int face, const std::vector<std::uint8_t>*) {
-                       layers[m].specular[face] = specular_texels(g, layers[m].specular_texel[face]);
+                       layers[m].specular[face] = specular_texels(executor, g, layers[m].specular_texel[face]);
                        return ImageRGBA{};
                      },
                      &scratch);
@@ -210,13 +229,16 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
         FaceSearches& s = searched[k][m][f];
         s.object = texels.object;
         const std::uint32_t size = static_cast<std::uint32_t>(distances.cubes[m].size);
-        bool any = false;
-        for (std::size_t j = 0; j < texel.size(); ++j) {
-          const int x = static_cast<int>(texel[j] % size), y = static_cast<int>(texel[j] / size);
-          if (read[k][m].covers(f, 0, x, y)) any = true;
-          else s.object.pixels[j] = kNoId;
-        }
-        if (!any) {
+        constexpr std::size_t kChunk = 4096;
+        std::vector<std::uint8_t> any_in(par::Executor::chunk_count(texel.size(), kChunk), 0);
+        executor.parallel_for("multi_reflection_maps.read_texels", texel.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+          for (std::size_t j = begin; j < end; ++j) {
+            const int x = static_cast<int>(texel[j] % size), y = static_cast<int>(texel[j] / size);
+            if (read[k][m].covers(f, 0, x, y)) any_in[begin / kChunk] = 1;
+            else s.object.pixels[j] = kNoId;
+          }
+        });
+        if (std::find(any_in.begin(), any_in.end(), std::uint8_t(1)) == any_in.end()) {
           s.object = IdBuffer{};
           continue;
         }
@@ -263,19 +285,18 @@ ReflectorMaps render_multi_reflection_maps_where_read(par::Executor& executor, c
       const unsigned faces = distances.faces[m] & read[k][m].faces();
       CubeMap& cube = next.cubes.emplace_back();
       for (int f = 0; f < kCubeFaces; ++f) {
-        ImageRGBA specular(size, size, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
         if (!((faces >> f) & 1u) || direct[m][f].size() == 0) {
-          cube.colour[f] = std::move(specular);
+          cube.colour[f] = ImageRGBA(size, size, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
           continue;
         }
         FaceSearches& s = searched[k][m][f];
         if (s.object.width > 0) {
           const ObjectsSwapped round_texels(layers[m].specular[f], s.object);
           const ImageRGBA seen = distance_map_lookup(executor, layers[m].specular[f], env, maps, s.found, face_search);
-          const std::vector<std::uint32_t>& texel = layers[m].specular_texel[f];
-          for (std::size_t j = 0; j < texel.size(); ++j) specular.pixels[texel[j]] = seen.pixels[j];
+          cube.colour[f] = composite_at(executor, direct[m][f], layers[m].specular_texel[f], seen);
+        } else {
+          cube.colour[f] = composite_at(executor, direct[m][f], {}, ImageRGBA{});
         }
-        cube.colour[f] = composite(executor, direct[m][f], specular);
       }
       const PrefilterReuse reuse =
           prefilter_reuse(executor, cube.colour, faces, &read[k][m], maps.maps[m], faces_before[m], &read[k - 1][m],

@@ -306,7 +306,7 @@ CubeFaceShader reflector_face_shader(par::Executor& executor, const Scene& scene
     ImageRGBA direct = direct_light(executor, scene, g, cam, shadows, env, read);
     if (add_light) direct = add_light(g, direct);
     if (kept) {
-      kept->specular[face] = specular_texels(g, kept->specular_texel[face]);
+      kept->specular[face] = specular_texels(executor, g, kept->specular_texel[face]);
       kept->direct[face] = direct;
     }
     envmap_reflect_onto(executor, g, env, direct);
@@ -324,12 +324,23 @@ void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin) {
   mark_near(mask.tiles, mask.tile, n, mask.size, d, margin, whole);
 }
 
-GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
-  texel.clear();
-  for (std::size_t i = 0; i < g.object.size(); ++i)
-    if (g.covered(i) && is_specular(g.surface[i])) texel.push_back(static_cast<std::uint32_t>(i));
+GBuffer specular_texels(par::Executor& executor, const GBuffer& g, std::vector<std::uint32_t>& texel) {
+  // Counted per fixed chunk, then each chunk writes its texels from its offset: sample order
+  // whatever thread ran which chunk.
+  constexpr std::size_t kChunk = 4096;
+  const std::size_t total = g.object.size();
+  const std::size_t chunks = par::Executor::chunk_count(total, kChunk);
+  const auto wanted = [&](std::size_t i) { return g.covered(i) && is_specular(g.surface[i]); };
+  std::vector<std::size_t> offset(chunks + 1, 0);
+  executor.parallel_for("specular_texels.count", total, kChunk, [&](std::size_t begin, std::size_t end) {
+    std::size_t count = 0;
+    for (std::size_t i = begin; i < end; ++i) count += wanted(i);
+    offset[begin / kChunk + 1] = count;
+  });
+  for (std::size_t c = 0; c < chunks; ++c) offset[c + 1] += offset[c];
+  const int n = static_cast<int>(offset[chunks]);
+  texel.resize(static_cast<std::size_t>(n));
   GBuffer out;
-  const int n = static_cast<int>(texel.size());
   out.width = n;
   out.height = n > 0 ? 1 : 0;
   out.eye = g.eye;
@@ -341,16 +352,21 @@ GBuffer specular_texels(const GBuffer& g, std::vector<std::uint32_t>& texel) {
   out.surface.shared = g.surface.shared;
   if (!g.surface.own.empty()) out.surface.own = Buffer2D<SurfaceParams>(n, out.height);
   out.reflector = IdBuffer(n, out.height);
-  for (int k = 0; k < n; ++k) {
-    const std::size_t i = texel[k];
-    out.object.pixels[k] = g.object.pixels[i];
-    out.position.pixels[k] = g.position.pixels[i];
-    out.normal.pixels[k] = g.normal.pixels[i];
-    out.uv.pixels[k] = g.uv.pixels[i];
-    out.surface.slot.pixels[k] = g.surface.slot.pixels[i];
-    if (!g.surface.own.empty()) out.surface.own.pixels[k] = g.surface.own.pixels[i];
-    out.reflector.pixels[k] = g.reflector.pixels[i];
-  }
+  executor.parallel_for("specular_texels.write", total, kChunk, [&](std::size_t begin, std::size_t end) {
+    std::size_t k = offset[begin / kChunk];
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!wanted(i)) continue;
+      texel[k] = static_cast<std::uint32_t>(i);
+      out.object.pixels[k] = g.object.pixels[i];
+      out.position.pixels[k] = g.position.pixels[i];
+      out.normal.pixels[k] = g.normal.pixels[i];
+      out.uv.pixels[k] = g.uv.pixels[i];
+      out.surface.slot.pixels[k] = g.surface.slot.pixels[i];
+      if (!g.surface.own.empty()) out.surface.own.pixels[k] = g.surface.own.pixels[i];
+      out.reflector.pixels[k] = g.reflector.pixels[i];
+      ++k;
+    }
+  });
   return out;
 }
 
