@@ -227,18 +227,25 @@ CubeMap render_cube_map(par::Executor& executor, const Scene& scene, const glm::
       });
     ImageF& dist = cube.distance[face];
     dist = ImageF(options.size, options.size, std::numeric_limits<float>::infinity());
+    // What resolving reads (not the depths) kept for shading later, copied by the distance
+    // kernel's chunks, not serially after it.
+    VisibilityBuffer* kept = options.keep_visibility ? &cube.visibility[face] : nullptr;
+    if (kept) {
+      kept->width = vis.width, kept->height = vis.height;
+      kept->triangle = IdBuffer(vis.width, vis.height);
+      kept->object = IdBuffer(vis.width, vis.height);
+      kept->bary = Buffer2D<glm::vec2>(vis.width, vis.height);
+      kept->coverage = vis.coverage;
+    }
     executor.parallel_for("cube_map.distance", dist.size(), 4096,
                           [&](std::size_t begin, std::size_t end) {
                             visible_distances(scene.mesh, vis, centre, begin, end, dist.pixels.data() + begin);
+                            if (!kept) return;
+                            const auto from = static_cast<std::ptrdiff_t>(begin), to = static_cast<std::ptrdiff_t>(end);
+                            std::copy(vis.triangle.pixels.begin() + from, vis.triangle.pixels.begin() + to, kept->triangle.pixels.begin() + from);
+                            std::copy(vis.object.pixels.begin() + from, vis.object.pixels.begin() + to, kept->object.pixels.begin() + from);
+                            std::copy(vis.bary.pixels.begin() + from, vis.bary.pixels.begin() + to, kept->bary.pixels.begin() + from);
                           });
-    if (options.keep_visibility) {  // what resolving reads (not the depths)
-      VisibilityBuffer& kept = cube.visibility[face];
-      kept.width = vis.width, kept.height = vis.height;
-      kept.triangle = vis.triangle;
-      kept.object = vis.object;
-      kept.bary = vis.bary;
-      kept.coverage = vis.coverage;
-    }
     // Colour needs the full G-buffer; distance-only maps (shadows) skip it.
     if (shade) cube.colour[face] = shade_face(executor, scene, cube, options, face, vis, read, shade, s);
   }
