@@ -57,7 +57,21 @@ struct CubeMarch {
   explicit CubeMarch(const CubeMap& m) : map(m), faces(m) {}
   void operator()(const glm::vec3& x, const glm::vec3& r, float x_len, int n, int first, MarchBatch& b) const {
     const i32 k = L::iota(first);
+    batch(k, L::to_float(k) / float(n), n, x, r, x_len, b);
+  }
+  // The same batch of two marches (a and b) in one call: two independent chains of work side
+  // by side, each with its own operations.
+  void pair(const glm::vec3& xa, const glm::vec3& ra, float xa_len, const glm::vec3& xb, const glm::vec3& rb,
+            float xb_len, int n, int first, MarchBatch& a, MarchBatch& b) const {
+    const i32 k = L::iota(first);
     const f32 t = L::to_float(k) / float(n);
+    batch(k, t, n, xa, ra, xa_len, a);
+    batch(k, t, n, xb, rb, xb_len, b);
+  }
+
+ private:
+  [[gnu::always_inline]] void batch(const i32& k, const f32& t, int n, const glm::vec3& x, const glm::vec3& r, float x_len,
+                                    MarchBatch& b) const {
     const f32 d = L::select(k == 0, f32(0.0f), x_len * t / (1.0f - t));
     const f32 xs[3] = {f32(x.x), f32(x.y), f32(x.z)}, rs[3] = {f32(r.x), f32(r.y), f32(r.z)};
     L::mask reads;
@@ -65,24 +79,6 @@ struct CubeMarch {
     L::store(g, b.g);
     L::store(d, b.d);
     L::store(L::select(reads, i32(1), i32(0)), b.counted);
-  }
-  // The same batch of two marches (a and b) at once: two independent chains of work side by
-  // side, each with its own operations.
-  void pair(const glm::vec3& xa, const glm::vec3& ra, float xa_len, const glm::vec3& xb, const glm::vec3& rb,
-            float xb_len, int n, int first, MarchBatch& a, MarchBatch& b) const {
-    const i32 k = L::iota(first);
-    const f32 t = L::to_float(k) / float(n);
-    const f32 da = L::select(k == 0, f32(0.0f), xa_len * t / (1.0f - t));
-    const f32 db = L::select(k == 0, f32(0.0f), xb_len * t / (1.0f - t));
-    const f32 xas[3] = {f32(xa.x), f32(xa.y), f32(xa.z)}, ras[3] = {f32(ra.x), f32(ra.y), f32(ra.z)};
-    const f32 xbs[3] = {f32(xb.x), f32(xb.y), f32(xb.z)}, rbs[3] = {f32(rb.x), f32(rb.y), f32(rb.z)};
-    L::mask reads_a, reads_b;
-    const f32 ga = ratio8(map, faces, xas, ras, da, L::mask(k < n), reads_a);
-    const f32 gb = ratio8(map, faces, xbs, rbs, db, L::mask(k < n), reads_b);
-    L::store(ga, a.g), L::store(gb, b.g);
-    L::store(da, a.d), L::store(db, b.d);
-    L::store(L::select(reads_a, i32(1), i32(0)), a.counted);
-    L::store(L::select(reads_b, i32(1), i32(0)), b.counted);
   }
 };
 

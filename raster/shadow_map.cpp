@@ -159,12 +159,6 @@ float ShadowMap::filtered(const Taps& t) const {
   return lit / 9.0f;
 }
 
-void ShadowMap::visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const {
-  Taps t[8];
-  taps8(p, n, l, count, t);
-  for (int j = 0; j < count; ++j) out[j] = filtered(t[j]);
-}
-
 void ShadowMap::visibility_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes,
                                  float* out) const {
   Taps t[8];
@@ -173,11 +167,6 @@ void ShadowMap::visibility_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, c
     const int j = std::countr_zero(m);
     out[j] = filtered(t[j]);
   }
-}
-
-void ShadowMap::taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const {
-  using V = Vec3Lanes<8>;
-  taps_lanes(V::load(p, count), V::load(n, count), V::load(l, count), (1u << count) - 1u, out);
 }
 
 void ShadowMap::taps_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes,

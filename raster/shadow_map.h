@@ -33,10 +33,8 @@ struct ShadowMap {
   // and light leaks at most about one footprint under an occluder touching the receiver.
   // Asked only where the light reaches p (sample_light's irradiance is not zero).
   float visibility(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
-  // The same for `count` (1..8) points at once, out[j] for p[j], n[j], l[j].
-  void visibility8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, float* out) const;
   // The same for the points of eight in lanes whose bit is set in `lanes`, into out[j] (the
-  // others' left as they were): what a kernel holding its points in lanes asks.
+  // others' left as they were).
   void visibility_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes,
                         float* out) const;
 
@@ -48,11 +46,9 @@ struct ShadowMap {
     float biased = 0.0f;
   };
   Taps taps(const glm::vec3& p, const glm::vec3& n, const glm::vec3& l) const;
-  // taps for `count` (1..8) points: a cube map's (point and spot lights) eight share their
-  // arithmetic in lanes, with per lane the operations of taps in its order (the same bits);
-  // a directional map's run one by one.
-  void taps8(const glm::vec3* p, const glm::vec3* n, const glm::vec3* l, int count, Taps* out) const;
-  // taps8 for the lanes whose bit is set in `lanes`, into out[j].
+  // taps for the points of eight in lanes whose bit is set in `lanes`, into out[j]: a cube
+  // map's (point and spot lights) share their arithmetic in lanes, with per lane the
+  // operations of taps in its order (the same bits); a directional map's run one by one.
   void taps_lanes(const Vec3Lanes<8>& p, const Vec3Lanes<8>& n, const Vec3Lanes<8>& l, unsigned lanes, Taps* out) const;
   // The fraction of the taps at least `biased` away.
   float filtered(const Taps& t) const;
