@@ -193,17 +193,22 @@ struct MarkedEnvironment {
 
 }  // namespace
 
-void mark_refraction_reads(const RefractionInputs& in, const RefractionOptions& options, std::vector<CubeTileMask>& tiles) {
+void mark_refraction_reads(par::Executor& executor, const RefractionInputs& in, const RefractionOptions& options,
+                           std::vector<CubeTileMask>& tiles) {
   const GBuffer& g = *in.front;
-  std::vector<LookupTileMarker> markers;
-  for (std::size_t m = 0; m < tiles.size(); ++m) markers.emplace_back(tiles[m], in.maps->levels[m]);
-  const MarkedEnvironment environment{in, options.environment_search, markers};
-  ChunkCounts c;
-  for (std::size_t i = 0; i < g.object.size(); ++i) {
-    if (!g.covered(i) || !g.surface[i].is_refractor()) continue;
-    const SamplePath sp = trace_sample_path(in, options, i, c);
-    refractor_radiance(environment, g.surface[i], g.object.pixels[i], sp.p1, sp.path, sp.exits);
-  }
+  // Each chunk marks through markers of its own: a tile is only ever set, so the masks are
+  // the same whatever thread marked what.
+  executor.parallel_for("refraction_reads.mark", g.object.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    std::vector<LookupTileMarker> markers;
+    for (std::size_t m = 0; m < tiles.size(); ++m) markers.emplace_back(tiles[m], in.maps->levels[m]);
+    const MarkedEnvironment environment{in, options.environment_search, markers};
+    ChunkCounts c;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!g.covered(i) || !g.surface[i].is_refractor()) continue;
+      const SamplePath sp = trace_sample_path(in, options, i, c);
+      refractor_radiance(environment, g.surface[i], g.object.pixels[i], sp.p1, sp.path, sp.exits);
+    }
+  });
 }
 
 RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& in,
@@ -268,12 +273,12 @@ RefractionInputs pass_inputs(const Scene& scene, const Camera& camera, const GBu
 
 }  // namespace
 
-std::vector<CubeTileMask> RefractionReadsPass::operator()(par::NodeContext&, const GBuffer& gbuffer,
+std::vector<CubeTileMask> RefractionReadsPass::operator()(par::NodeContext& c, const GBuffer& gbuffer,
                                                           const VisibilityBuffer& visibility, const ReflectorMaps& maps,
                                                           const GBuffer* back, const VertexThickness* thickness,
                                                           const RefractorImpostors* impostors) const {
   std::vector<CubeTileMask> tiles = tile_masks_for_reads(maps);
-  mark_refraction_reads(pass_inputs(*scene, camera, gbuffer, visibility, maps, nullptr, back, thickness, impostors),
+  mark_refraction_reads(c.executor(), pass_inputs(*scene, camera, gbuffer, visibility, maps, nullptr, back, thickness, impostors),
                         options, tiles);
   return tiles;
 }

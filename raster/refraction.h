@@ -73,7 +73,9 @@ RefractionLayer refract_layer(par::Executor& executor, const RefractionInputs& i
 // (per map of in.maps, from tile_mask_for_reads; in.maps needs only its distances): the same
 // paths and searches, each search's colour read marked (its level-0 bilinear taps) instead of
 // made. Shading a refractor's map on those tiles alone gives refract_layer the same bytes.
-void mark_refraction_reads(const RefractionInputs& in, const RefractionOptions& options, std::vector<CubeTileMask>& tiles);
+// Launch "refraction_reads.mark".
+void mark_refraction_reads(par::Executor& executor, const RefractionInputs& in, const RefractionOptions& options,
+                           std::vector<CubeTileMask>& tiles);
 
 using VertexThickness = std::vector<float>;  // d_N per mesh vertex (two-face method)
 

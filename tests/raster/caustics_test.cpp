@@ -721,7 +721,7 @@ TEST(Caustics, LitMapsShadedWhereReadKeepEveryReadAndRefractorsWhole) {
     RefractionOptions o;
     o.method = method;
     std::vector<CubeTileMask> reads = tile_masks_for_reads(distances);
-    mark_refraction_reads(in, o, reads);
+    mark_refraction_reads(ex, in, o, reads);
     const ReflectorMaps read_only =
         shade_caustic_reflector_maps(ex, s, shadows, env, distances, found, &reads, caustics, 0.05f);
     EXPECT_LT(rendered_texels(read_only), rendered_texels(lit));
