@@ -894,9 +894,8 @@ CausticTexels8 caustic_texels8(const CausticMaps& maps, std::size_t k, const Cub
   f32 flux[3];
   bilinear_rgb8(RgbaFaces(m.colour), at, flux);
   out.flux = {flux[0], flux[1], flux[2]};
-  // The nearest texel (distance_at's).
-  const i32 last(m.size - 1), zero(0);
-  const i32 x = L::clamp(L::to_int(at.x), zero, last), y = L::clamp(L::to_int(at.y), zero, last);
+  i32 x, y;
+  nearest_texel8(at, m.size, x, y);
   alignas(32) std::int32_t face[8], px[8], py[8];
   L::store_aligned(at.face, face), L::store_aligned(x, px), L::store_aligned(y, py);
   alignas(32) float wi[3][8];

@@ -6,7 +6,6 @@
 #pragma once
 
 #include <immintrin.h>
-#include <stdexcept>
 
 #include "parallel/lanes.h"
 #include "raster/cube_map.h"
@@ -20,29 +19,17 @@ struct CubeCoordLanes {
 
 namespace detail {
 
-// The axes of cube_coord's faces (kCubeFaceAxes): faces 2k and 2k + 1 look along axis k; a
-// face's right axis is z on the x faces and x on the others, its up axis z on the y faces and
-// y on the others. Checked against the table once; each face's signs in lanes 0..5 of a
-// register.
+// The axes of cube_coord's faces (kCubeFaceAxes, made from the face cameras' frames; the
+// CubeCoordLanes test holds these to it): faces 2k and 2k + 1 look along axis k; a face's right
+// axis is z on the x faces and x on the others, its up axis z on the y faces and y on the
+// others; and each face's signs along them.
 constexpr int kRightAxis[3] = {2, 0, 0}, kUpAxis[3] = {1, 2, 1};
-struct CubeFaceSigns {
-  __m256 forward, right, up;
-  CubeFaceSigns() {
-    alignas(32) float signs[3][8] = {};
-    for (int f = 0; f < kCubeFaces; ++f) {
-      const CubeFaceAxes& a = kCubeFaceAxes[f];
-      if (a.forward != f / 2 || a.right != kRightAxis[f / 2] || a.up != kUpAxis[f / 2])
-        throw std::logic_error("cube_coord8: the cube faces' axes are not the ones it was written for");
-      signs[0][f] = a.forward_sign, signs[1][f] = a.right_sign, signs[2][f] = a.up_sign;
-    }
-    forward = _mm256_load_ps(signs[0]), right = _mm256_load_ps(signs[1]), up = _mm256_load_ps(signs[2]);
-  }
-};
+constexpr float kForwardSign[kCubeFaces] = {1, -1, 1, -1, 1, -1};
+constexpr float kRightSign[kCubeFaces] = {1, -1, -1, -1, -1, 1};
+constexpr float kUpSign[kCubeFaces] = {1, 1, -1, 1, 1, 1};
 
-inline const CubeFaceSigns& cube_face_signs() {
-  static const CubeFaceSigns signs;
-  return signs;
-}
+// A face table's six entries in lanes 0..5 of a register (a permute by face reads them).
+inline __m256 face_lanes(const float (&v)[kCubeFaces]) { return _mm256_setr_ps(v[0], v[1], v[2], v[3], v[4], v[5], 0, 0); }
 
 }  // namespace detail
 
@@ -58,15 +45,25 @@ inline const CubeFaceSigns& cube_face_signs() {
   face = L::select(!(major >= 0.0f), face + 1, face);
   // Each lane's face's signed components (cube_coord's a.forward_sign * d[a.forward] and so
   // on): the face's sign times the component its axis names.
-  const detail::CubeFaceSigns& signs = detail::cube_face_signs();
-  const auto sign = [&](__m256 of_face) { return f32(_mm256_permutevar8x32_ps(of_face, static_cast<__m256i>(face))); };
+  const auto sign = [&](const float (&of_face)[kCubeFaces]) {
+    return f32(_mm256_permutevar8x32_ps(detail::face_lanes(of_face), static_cast<__m256i>(face)));
+  };
   static_assert(detail::kRightAxis[1] == 0 && detail::kRightAxis[2] == 0 && detail::kUpAxis[0] == detail::kUpAxis[2]);
-  const f32 depth = sign(signs.forward) * major;
-  const f32 along_right = sign(signs.right) * L::select(is_x, d[detail::kRightAxis[0]], d[0]);
-  const f32 along_up = sign(signs.up) * L::select(is_y, d[detail::kUpAxis[1]], d[detail::kUpAxis[0]]);
+  const f32 depth = sign(detail::kForwardSign) * major;
+  const f32 along_right = sign(detail::kRightSign) * L::select(is_x, d[detail::kRightAxis[0]], d[0]);
+  const f32 along_up = sign(detail::kUpSign) * L::select(is_y, d[detail::kUpAxis[1]], d[detail::kUpAxis[0]]);
   const float s = static_cast<float>(size);
   return {face, L::clamp((along_right / depth + 1.0f) * 0.5f * s, f32(0.0f), f32(s)),
           L::clamp((1.0f - along_up / depth) * 0.5f * s, f32(0.0f), f32(s))};
+}
+
+// The texel holding each lane's coordinate (CubeMap::distance_at's): truncated, at most
+// size − 1 (and at least 0, which a finite coordinate in [0, size] already is).
+[[gnu::always_inline]] inline void nearest_texel8(const CubeCoordLanes& c, int size, par::Lanes<8>::i32& x,
+                                                  par::Lanes<8>::i32& y) {
+  using L = par::Lanes<8>;
+  const L::i32 last(size - 1), zero(0);
+  x = L::clamp(L::to_int(c.x), zero, last), y = L::clamp(L::to_int(c.y), zero, last);
 }
 
 }  // namespace speculum::raster

@@ -36,12 +36,11 @@ struct DistanceFaces {
   const CubeCoordLanes c = cube_coord8(l, map.size);
   // distance_at's texel; lanes that read nothing (l = 0: their coordinates are NaN, which
   // no float-to-int conversion may see) read texel 0 of face 0 instead.
-  const i32 last(map.size - 1), zero(0);
-  const f32 at_x = L::select(reads, c.x, f32(0.0f)), at_y = L::select(reads, c.y, f32(0.0f));
-  const i32 tx = L::clamp(L::to_int(at_x), zero, last), ty = L::clamp(L::to_int(at_y), zero, last);
-  const i32 face = L::select(reads, c.face, zero);
+  const CubeCoordLanes at{L::select(reads, c.face, i32(0)), L::select(reads, c.x, f32(0.0f)), L::select(reads, c.y, f32(0.0f))};
+  i32 tx, ty;
+  nearest_texel8(at, map.size, tx, ty);
   alignas(32) std::int32_t fx[8], texel[8];
-  L::store_aligned(face, fx), L::store_aligned(ty * i32(map.size) + tx, texel);
+  L::store_aligned(at.face, fx), L::store_aligned(ty * i32(map.size) + tx, texel);
   alignas(32) float stored_at[8];
   for (int j = 0; j < 8; ++j) stored_at[j] = faces.pixels[fx[j]][texel[j]];
   const f32 stored = L::load_aligned(stored_at);

@@ -14,6 +14,7 @@
 #include "core/optics.h"
 #include "core/sampling.h"
 
+#include "parallel/compact.h"
 #include "raster/direct_light.h"
 #include "raster/envmap_reflect.h"
 #include "raster/planar_mirror.h"
@@ -325,21 +326,14 @@ void mark_tiles_near(CubeTileMask& mask, const glm::vec3& d, float margin) {
 }
 
 GBuffer specular_texels(par::Executor& executor, const GBuffer& g, std::vector<std::uint32_t>& texel) {
-  // Counted per fixed chunk, then each chunk writes its texels from its offset: sample order
-  // whatever thread ran which chunk.
   constexpr std::size_t kChunk = 4096;
-  const std::size_t total = g.object.size();
-  const std::size_t chunks = par::Executor::chunk_count(total, kChunk);
-  const auto wanted = [&](std::size_t i) { return g.covered(i) && is_specular(g.surface[i]); };
-  std::vector<std::size_t> offset(chunks + 1, 0);
-  executor.parallel_for("specular_texels.count", total, kChunk, [&](std::size_t begin, std::size_t end) {
-    std::size_t count = 0;
-    for (std::size_t i = begin; i < end; ++i) count += wanted(i);
-    offset[begin / kChunk + 1] = count;
+  std::vector<std::uint8_t> keep(g.object.size());
+  executor.parallel_for("specular_texels.keep", keep.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) keep[i] = g.covered(i) && is_specular(g.surface[i]);
   });
-  for (std::size_t c = 0; c < chunks; ++c) offset[c + 1] += offset[c];
-  const int n = static_cast<int>(offset[chunks]);
-  texel.resize(static_cast<std::size_t>(n));
+  texel.resize(keep.size());
+  texel.resize(par::compact_scatter(executor, "specular_texels", keep, texel));
+  const int n = static_cast<int>(texel.size());
   GBuffer out;
   out.width = n;
   out.height = n > 0 ? 1 : 0;
@@ -352,11 +346,9 @@ GBuffer specular_texels(par::Executor& executor, const GBuffer& g, std::vector<s
   out.surface.shared = g.surface.shared;
   if (!g.surface.own.empty()) out.surface.own = Buffer2D<SurfaceParams>(n, out.height);
   out.reflector = IdBuffer(n, out.height);
-  executor.parallel_for("specular_texels.write", total, kChunk, [&](std::size_t begin, std::size_t end) {
-    std::size_t k = offset[begin / kChunk];
-    for (std::size_t i = begin; i < end; ++i) {
-      if (!wanted(i)) continue;
-      texel[k] = static_cast<std::uint32_t>(i);
+  executor.parallel_for("specular_texels.gather", texel.size(), kChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t i = texel[k];
       out.object.pixels[k] = g.object.pixels[i];
       out.position.pixels[k] = g.position.pixels[i];
       out.normal.pixels[k] = g.normal.pixels[i];
@@ -364,7 +356,6 @@ GBuffer specular_texels(par::Executor& executor, const GBuffer& g, std::vector<s
       out.surface.slot.pixels[k] = g.surface.slot.pixels[i];
       if (!g.surface.own.empty()) out.surface.own.pixels[k] = g.surface.own.pixels[i];
       out.reflector.pixels[k] = g.reflector.pixels[i];
-      ++k;
     }
   });
   return out;

@@ -231,7 +231,8 @@ CubeMapOptions kept_face_options(const ReflectorMaps& distances, std::size_t m, 
                                  const CubeTileMask& tiles);
 
 // The covered specular samples of `g`, compacted to one row in sample order; `texel`
-// receives their indices in g. Launches "specular_texels.count" and "specular_texels.write".
+// receives their indices in g. Launches "specular_texels.keep", "specular_texels/..." (the
+// compaction) and "specular_texels.gather".
 GBuffer specular_texels(par::Executor& executor, const GBuffer& g, std::vector<std::uint32_t>& texel);
 
 // Texels rendered: the texels of the tiles rendered on the faces each map has.

@@ -23,10 +23,21 @@
 namespace speculum::raster {
 namespace {
 
-// cube_coord8 against cube_coord, bit for bit: directions on every face, along the axes, on
-// the edges and corners between faces (the ties of the largest component), with signed zeros,
-// and random ones, eight at a time in every arrangement of lanes.
+// cube_coord8 against cube_coord, bit for bit (and its face table against the cameras'):
+// directions on every face, along the axes, on the edges and corners between faces (the ties
+// of the largest component), with signed zeros, and random ones, eight at a time in every
+// arrangement of lanes.
 TEST(CubeCoordLanes, EightCoordinatesHaveTheBitsOfOneAtATime) {
+  // The faces' axes and signs cube_coord8 is written with are those of the face cameras.
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const CubeFaceAxes& a = kCubeFaceAxes[f];
+    EXPECT_EQ(a.forward, f / 2) << f;
+    EXPECT_EQ(a.right, detail::kRightAxis[f / 2]) << f;
+    EXPECT_EQ(a.up, detail::kUpAxis[f / 2]) << f;
+    EXPECT_EQ(a.forward_sign, detail::kForwardSign[f]) << f;
+    EXPECT_EQ(a.right_sign, detail::kRightSign[f]) << f;
+    EXPECT_EQ(a.up_sign, detail::kUpSign[f]) << f;
+  }
   std::vector<glm::vec3> dirs;
   const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 0.3f, -0.7f};
   for (const float x : values)
